@@ -1,0 +1,28 @@
+"""Exceptions raised by rvfem.
+
+Every error a user can cause (a bad case file, an impossible geometry, a contact problem that does
+not settle) is an :class:`RvfemError`; the command line turns these into one readable message and a
+non-zero exit code. Anything else is a bug.
+"""
+
+from __future__ import annotations
+
+
+class RvfemError(Exception):
+    """Base class of all errors a user can cause and fix."""
+
+
+class CaseError(RvfemError, ValueError):
+    """A case file (or a case built in code) is incomplete, mistyped or non-physical."""
+
+
+class GeometryError(RvfemError, ValueError):
+    """The disc geometry is impossible: undercut profile, overlapping features, walls too thin."""
+
+
+class MeshError(RvfemError, RuntimeError):
+    """Gmsh could not mesh the disc, or the mesh is unusable."""
+
+
+class ContactError(RvfemError, RuntimeError):
+    """The contact problem has no solution or the active set does not settle."""
