@@ -1,0 +1,652 @@
+"""Contact solve on the condensed disc: pins, crank-bearing rollers and the carrier rotation.
+
+The model (project design notes §4) in the disc's body frame:
+
+* The disc is a 2D plane-stress body; its stiffness K never changes with the crank angle θ.
+* Every load that can act on the disc enters through a fixed **footprint grid** on its boundary:
+  column k is a unit force (1 N) in direction d_k, spread over the boundary arc around the grid
+  point x_k with an elliptical (Hertz-like) density of half-width a. Pin contacts use the profile
+  grid (direction: inward normal of the profile), rollers use a grid on each bore (direction:
+  radially outward from the bore centre, i.e. into the disc material). A contact between grid points
+  shares its force between the two neighbouring columns (linear interpolation), so its load and
+  its displacement are work-conjugate.
+* **Condensation** (design notes §8): the compliance of the disc between grid columns,
+  C = Bᵀ K_s⁻¹ B, is computed lazily, column by column, the first time a column carries load, and
+  reused for every later crank angle. K_s is K with a statically determinate 3-DOF support; for the
+  self-equilibrated loads the contact problem produces, it differs from the floating disc only by
+  a rigid-body motion ``a`` (2 translations, 1 rotation), which is an unknown of the small system.
+* Pins are rigid (Signorini: gap ≥ 0, force ≥ 0, force·gap = 0, primal–dual active set) or
+  compliant (Palmgren line contact, one contact). Rollers are compression-only springs along their
+  radial line with the Palmgren law for both raceways, δ = 2·3.84e-5·Q^0.9 / L^0.8 (mm, N), or a
+  linear stiffness; the approach is the radial relative displacement of eccentric and bore minus
+  half the radial clearance.
+* The carrier with its eccentrics is one rigid body that can only rotate. **Torque convention**:
+  its rotation φ turns the eccentric centres c_i about the *disc centre* (eccentric displacement
+  φ·ẑ×c_i) and its conjugate load is the disc torque T_disc = T_out/discs as a moment about the
+  disc centre. This is the handbook's convention (ΣP_x·e·Zc = T_disc, Gao et al. eq. 4); about the
+  reducer axis the same pin forces give a moment larger by Zp/Zc.
+
+Per crank angle the unknowns are the contact forces λ (pins and rollers), the rigid motion ``a``
+and φ; the equations are the contact laws, the disc's equilibrium Rᵀλ = 0 and the carrier's
+Σ m_c λ_c = T_disc. They are solved by a semismooth Newton method (the primal–dual active set for
+the rigid pins) on this small dense system.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from .errors import ContactError
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "FootprintGrid",
+    "Interface",
+    "Compliance",
+    "ContactSet",
+    "AngleSolution",
+    "build_interface",
+    "palmgren_law",
+    "linear_law",
+    "solve_contact",
+]
+
+PALMGREN_COEFF = 3.84e-5
+"""Palmgren's line-contact approach coefficient for steel on steel, δ = 3.84e-5·Q^0.9/L^0.8 (mm, N)
+(Harris & Kotzalas, *Rolling Bearing Analysis*, line contact; one roller–raceway contact)."""
+
+
+# ------------------------------------------------------------------------------------------------
+# Footprint grids and the load operator B
+# ------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FootprintGrid:
+    """The footprint columns of one closed boundary: one column per boundary vertex.
+
+    Attributes
+    ----------
+    name : str
+        Boundary name (``"profile"``, ``"bore_0"``, ...).
+    offset : int
+        Index of the grid's first column among all columns of the interface.
+    polyline : ndarray (n, 2)
+        Boundary vertices in order along the curve (counter-clockwise), mm; closed.
+    arc : ndarray (n + 1,)
+        Cumulative arc length at the vertices (arc[-1] = length), mm. Column k sits at arc[k].
+    centre : ndarray (2,) or None
+        Bore centre for bore grids (directions radial from it), None for the profile.
+    """
+
+    name: str
+    offset: int
+    polyline: np.ndarray
+    arc: np.ndarray
+    centre: np.ndarray | None = None
+
+    @property
+    def length(self) -> float:
+        return float(self.arc[-1])
+
+    @property
+    def count(self) -> int:
+        return len(self.polyline)
+
+    def point_at(self, s: np.ndarray) -> np.ndarray:
+        """Points of the polyline at arc lengths ``s`` (wrapped), mm."""
+        i, t = self._locate(s)
+        j = (i + 1) % self.count
+        return (1 - t)[:, None] * self.polyline[i] + t[:, None] * self.polyline[j]
+
+    def _locate(self, s):
+        s = np.mod(np.asarray(s, dtype=float), self.length)
+        i = np.clip(np.searchsorted(self.arc, s, side="right") - 1, 0, self.count - 1)
+        t = (s - self.arc[i]) / (self.arc[i + 1] - self.arc[i])
+        return i, t
+
+    def arc_of(self, points: np.ndarray) -> np.ndarray:
+        """Arc length of the polyline point closest to each of ``points`` (projection), mm."""
+        n = self.count
+        tree = cKDTree(self.polyline)
+        _, nearest = tree.query(points)
+        best_s = np.empty(len(points))
+        best_d = np.full(len(points), np.inf)
+        for shift in (-1, 0):  # the edge before and the edge after the nearest vertex
+            i = (nearest + shift) % n
+            j = (i + 1) % n
+            a, b = self.polyline[i], self.polyline[j]
+            ab = b - a
+            t = np.clip(np.einsum("ij,ij->i", points - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+            d = np.linalg.norm(a + t[:, None] * ab - points, axis=1)
+            better = d < best_d
+            best_d[better] = d[better]
+            best_s[better] = (self.arc[i] + t * (self.arc[i + 1] - self.arc[i]))[better]
+        return best_s
+
+    def columns_at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Global column indices (m, 2) and weights (m, 2) interpolating positions ``s``."""
+        i, t = self._locate(s)
+        cols = self.offset + np.stack([i, (i + 1) % self.count], axis=1)
+        return cols, np.stack([1.0 - t, t], axis=1)
+
+
+@dataclass(frozen=True)
+class Interface:
+    """All footprint columns of a disc and their load operator.
+
+    Attributes
+    ----------
+    B : scipy.sparse.csc_matrix (n_dofs, n_cols)
+        Column k is the consistent nodal load vector of the unit footprint load k.
+    points, directions : ndarray (n_cols, 2)
+        Grid point and force direction (on the disc) of each column.
+    resultants : ndarray (n_cols, 3)
+        Bᵀ·R: the exact force (Fx, Fy, N) and moment about the disc centre (Mz, N·mm) of each column.
+    grids : dict name → FootprintGrid
+    """
+
+    B: sp.csc_matrix
+    points: np.ndarray
+    directions: np.ndarray
+    resultants: np.ndarray
+    grids: dict[str, FootprintGrid]
+    half_widths: dict[str, float]
+
+    @property
+    def n_columns(self) -> int:
+        return self.B.shape[1]
+
+
+def _ordered_loop(edges: np.ndarray) -> np.ndarray:
+    """Vertex indices of a closed loop given its edges (k, 2) in any order/orientation."""
+    nbrs: dict[int, list[int]] = {}
+    for a, b in edges:
+        nbrs.setdefault(int(a), []).append(int(b))
+        nbrs.setdefault(int(b), []).append(int(a))
+    start = int(edges[0, 0])
+    loop = [start]
+    prev, cur = None, start
+    while True:
+        nxt = [v for v in nbrs[cur] if v != prev]
+        if not nxt:
+            break
+        prev, cur = cur, nxt[0]
+        if cur == start:
+            break
+        loop.append(cur)
+    if len(loop) != len(nbrs):
+        raise ValueError("boundary edges do not form one closed loop")
+    return np.asarray(loop)
+
+
+def _facet_lookup(mesh) -> tuple[np.ndarray, np.ndarray]:
+    f = np.sort(mesh.facets, axis=0)
+    keys = f[0].astype(np.int64) * mesh.p.shape[1] + f[1]
+    order = np.argsort(keys)
+    return keys[order], order
+
+
+def build_interface(basis, boundaries: dict[str, np.ndarray], rigid_modes: np.ndarray,
+                    bore_centres: dict[str, np.ndarray], half_width: dict[str, float],
+                    n_gauss: int = 6) -> Interface:
+    """Build the footprint columns and the load operator B on the named boundaries.
+
+    Column k of a boundary sits at its k-th vertex; its unit force is spread over the arc
+    |s − s_k| ≤ a with the elliptical density √(1 − ((s − s_k)/a)²) and turned into consistent
+    nodal loads with the element's shape functions on the boundary edges (Gauss quadrature).
+
+    Parameters
+    ----------
+    basis : skfem.CellBasis
+        Vector P1 or P2 basis of the disc (straight-sided triangles).
+    boundaries : dict name → (k, 2) int
+        Boundary edges (mesh vertex indices) of each closed boundary that gets columns.
+    rigid_modes : ndarray (n_dofs, 3)
+        Rigid-body modes (x translation, y translation, rotation about the origin).
+    bore_centres : dict name → (2,)
+        Centre of each bore: its columns push radially away from it (into the disc). Boundaries
+        not listed push along the inward normal of an outer boundary.
+    half_width : dict name → float
+        Footprint half-width a per boundary, mm.
+    n_gauss : int
+        Gauss points per edge piece for the footprint density.
+    """
+    mesh = basis.mesh
+    order2 = basis.elem.elems[0].maxdeg > 1 if hasattr(basis.elem, "elems") else False
+    keys, korder = _facet_lookup(mesh)
+    nverts = mesh.p.shape[1]
+    gx, gw = np.polynomial.legendre.leggauss(n_gauss)
+    gx = 0.5 * (gx + 1.0)
+    gw = 0.5 * gw
+
+    rows, cols, vals = [], [], []
+    points, directions, grids, widths = [], [], {}, {}
+    offset = 0
+    for name, edges in boundaries.items():
+        loop = _ordered_loop(np.asarray(edges))
+        poly = mesh.p[:, loop].T.copy()
+        centre = bore_centres.get(name)
+        # orientation: the disc lies to the left of an outer boundary traversed counter-clockwise;
+        # for a hole (bore) the disc is outside. Make every loop counter-clockwise.
+        area2 = np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
+        if area2 < 0:
+            loop, poly = loop[::-1].copy(), poly[::-1].copy()
+        seg = np.roll(poly, -1, axis=0) - poly
+        seglen = np.linalg.norm(seg, axis=1)
+        arc = np.concatenate([[0.0], np.cumsum(seglen)])
+        length = arc[-1]
+        grid = FootprintGrid(name, offset, poly, arc, None if centre is None else np.asarray(centre, float))
+        grids[name] = grid
+        count = grid.count
+        a = float(half_width[name])
+        widths[name] = a
+        s_k = arc[:-1]
+        x_k = poly
+        if centre is None:
+            h = 0.25 * float(seglen.min())
+            tang = grid.point_at(s_k + h) - grid.point_at(s_k - h)
+            tang /= np.linalg.norm(tang, axis=1)[:, None]
+            d_k = np.stack([-tang[:, 1], tang[:, 0]], axis=1)  # left of a CCW outer loop = inward
+        else:
+            d_k = x_k - centre
+            d_k /= np.linalg.norm(d_k, axis=1)[:, None]
+        points.append(x_k)
+        directions.append(d_k)
+
+        # DOFs of each polyline edge: vertex x/y dofs, and the P2 midpoint dofs
+        v0, v1 = loop, np.roll(loop, -1)
+        dof0 = basis.nodal_dofs[:, v0]
+        dof1 = basis.nodal_dofs[:, v1]
+        if order2:
+            ekey = np.minimum(v0, v1).astype(np.int64) * nverts + np.maximum(v0, v1)
+            pos = np.searchsorted(keys, ekey)
+            if not np.all(keys[np.minimum(pos, len(keys) - 1)] == ekey):
+                raise ValueError(f"boundary '{name}' has edges that are not mesh facets")
+            dofm = basis.facet_dofs[:, korder[pos]]
+
+        # pieces of (column, edge) overlap, vectorised per column
+        for k in range(count):
+            lo, hi = s_k[k] - a, s_k[k] + a
+            for shift in (-length, 0.0, length):
+                e_lo = max(0, np.searchsorted(arc, lo + shift, side="right") - 1)
+                e_hi = min(len(poly), np.searchsorted(arc, hi + shift, side="left"))
+                for e in range(e_lo, e_hi):
+                    s0, s1 = max(arc[e], lo + shift), min(arc[e + 1], hi + shift)
+                    if s1 <= s0:
+                        continue
+                    sq = s0 + (s1 - s0) * gx
+                    r = (sq - shift - s_k[k]) / a
+                    dens = np.sqrt(np.clip(1.0 - r * r, 0.0, None)) * gw * (s1 - s0)
+                    xi = (sq - arc[e]) / seglen[e]
+                    if order2:
+                        shape = [(1 - xi) * (1 - 2 * xi), xi * (2 * xi - 1), 4 * xi * (1 - xi)]
+                        dofs = [dof0[:, e], dof1[:, e], dofm[:, e]]
+                    else:
+                        shape = [1 - xi, xi]
+                        dofs = [dof0[:, e], dof1[:, e]]
+                    for N, d in zip(shape, dofs):
+                        w = float(np.dot(N, dens))
+                        rows.extend([d[0], d[1]])
+                        cols.extend([offset + k, offset + k])
+                        vals.extend([w * d_k[k, 0], w * d_k[k, 1]])
+        offset += count
+
+    B = sp.csc_matrix((vals, (rows, cols)), shape=(basis.N, offset))
+    B.sum_duplicates()
+    # normalise every column to a unit force exactly (the quadrature of the density is ~1/ (π a/2))
+    dirs = np.vstack(directions)
+    res = np.asarray(B.T @ rigid_modes)
+    scale = np.einsum("ij,ij->i", res[:, :2], dirs)
+    B = (B @ sp.diags(1.0 / scale)).tocsc()
+    res = np.asarray(B.T @ rigid_modes)
+    return Interface(B, np.vstack(points), dirs, res, grids, widths)
+
+
+# ------------------------------------------------------------------------------------------------
+# Lazily computed compliance between columns
+# ------------------------------------------------------------------------------------------------
+
+
+class Compliance:
+    """C = Bᵀ K_s⁻¹ B, computed a batch of columns at a time when first needed and cached.
+
+    Holds the only mutable state of a solve (the cache); one instance per disc model.
+
+    Parameters
+    ----------
+    solve : callable
+        ``solve(rhs)`` → K_s⁻¹·rhs for a dense (n_dofs, m) array.
+    B : sparse (n_dofs, n_cols)
+    """
+
+    def __init__(self, solve, B: sp.csc_matrix):
+        self._solve = solve
+        self.B = B
+        n = B.shape[1]
+        self.C = np.zeros((n, n))
+        self.known = np.zeros(n, dtype=bool)
+        self.solve_seconds = 0.0
+        self.columns_solved = 0
+
+    def ensure(self, columns: np.ndarray) -> None:
+        """Make sure ``C[:, columns]`` is available."""
+        need = np.unique(columns[~self.known[columns]])
+        if need.size == 0:
+            return
+        t0 = time.perf_counter()
+        X = self._solve(self.B[:, need].toarray())
+        self.C[:, need] = np.asarray(self.B.T @ X)
+        self.known[need] = True
+        self.solve_seconds += time.perf_counter() - t0
+        self.columns_solved += need.size
+
+    def ensure_all(self, batch: int = 256) -> None:
+        """Compute every column (used to front-load the work, e.g. before a full cycle)."""
+        missing = np.flatnonzero(~self.known)
+        for i in range(0, missing.size, batch):
+            self.ensure(missing[i:i + batch])
+
+
+# ------------------------------------------------------------------------------------------------
+# Contact laws
+# ------------------------------------------------------------------------------------------------
+
+
+def palmgren_law(length: float, contacts: int = 2):
+    """Force–approach law of a roller line contact after Palmgren.
+
+    δ = contacts · 3.84e-5 · Q^0.9 / L^0.8  (δ mm, Q N, L mm), inverted to
+    Q(δ) = (δ · L^0.8 / (contacts · 3.84e-5))^(1/0.9) for δ > 0, 0 otherwise.
+
+    Returns a function ``law(delta) -> (Q, dQ/dδ)`` (arrays).
+    """
+    c = contacts * PALMGREN_COEFF / length**0.8
+    p = 1.0 / 0.9
+
+    def law(delta):
+        d = np.maximum(delta, 0.0)
+        q = (d / c) ** p
+        dq = np.where(d > 0, p / c * (d / c) ** (p - 1.0), 0.0)
+        return q, dq
+
+    return law
+
+
+def linear_law(stiffness: float, bilateral: bool = False):
+    """Linear spring Q = k·δ (compression only unless ``bilateral``), k in N/mm."""
+
+    def law(delta):
+        if bilateral:
+            return stiffness * delta, np.full_like(delta, stiffness)
+        return stiffness * np.maximum(delta, 0.0), np.where(delta > 0, stiffness, 0.0)
+
+    return law
+
+
+# ------------------------------------------------------------------------------------------------
+# One crank angle
+# ------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ContactSet:
+    """The contacts of one crank angle, in interface terms.
+
+    Attributes
+    ----------
+    W : sparse (n_cols, n_contacts)
+        Weights of each contact on the interface columns.
+    signorini : ndarray bool (n_contacts,)
+        True for rigid pins (gap ≥ 0 ⟂ λ ≥ 0); False for springs.
+    gap0 : ndarray (n_contacts,)
+        Initial gap of Signorini contacts (mm, negative = overlap), 0 for springs.
+    offset : ndarray (n_contacts,)
+        Constant part of a spring's approach (mm): −gap for compliant pins, −clearance/2 for rollers.
+    lever : ndarray (n_contacts,)
+        m_c: approach per unit carrier rotation (mm/rad) = c_i × F̂_c for bearing contacts.
+    laws : list of (slice, law)
+        Force laws of the spring contacts.
+    """
+
+    W: sp.csc_matrix
+    signorini: np.ndarray
+    gap0: np.ndarray
+    offset: np.ndarray
+    lever: np.ndarray
+    laws: list
+
+
+@dataclass(frozen=True)
+class AngleSolution:
+    """Solution of one crank angle.
+
+    Attributes
+    ----------
+    force : ndarray (n_contacts,)
+        Contact force magnitudes λ (N), on the disc along each contact's direction.
+    vectors : ndarray (n_contacts, 2)
+        Force vectors on the disc, N.
+    gap : ndarray (n_contacts,)
+        Final gap of Signorini contacts / −approach of springs, mm.
+    rigid : ndarray (3,)
+        Rigid-body motion of the disc relative to the K_s support: ux, uy (mm), rotation (rad).
+    carrier_rotation : float
+        φ, rad.
+    iterations : int
+    residual : dict
+        Equilibrium residuals: ``force_N`` (|ΣF|), ``moment_Nmm`` (|ΣM| about the disc centre),
+        ``carrier_Nmm`` (|Σ m λ − T|), ``relative`` (force residual / total contact force).
+    """
+
+    force: np.ndarray
+    vectors: np.ndarray
+    gap: np.ndarray
+    rigid: np.ndarray
+    carrier_rotation: float
+    iterations: int
+    residual: dict = field(default_factory=dict)
+
+
+def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, torque: float, *,
+                  start: AngleSolution | None = None, max_iterations: int = 50, label: str = "",
+                  tol_gap: float = 1e-9, names: list[str] | None = None,
+                  rigid_dofs: tuple[int, ...] = (0, 1, 2)) -> AngleSolution:
+    """Solve the contact problem of one crank angle (semismooth Newton / primal–dual active set).
+
+    Parameters
+    ----------
+    cset : ContactSet
+    iface : Interface
+    compliance : Compliance
+        Lazily filled column compliance C (filled further as contacts become active).
+    torque : float or None
+        Disc torque T_disc, N·mm (moment about the disc centre, see module docstring). None: no
+        carrier (the body is loaded by the contacts' prescribed gaps alone).
+    start : AngleSolution, optional
+        Warm start (usually the previous crank angle). Without one, a first solve with secant
+        linear springs provides the start (Palmgren's law has zero stiffness at zero load).
+    max_iterations : int
+        Bound of the Newton / active-set loop.
+    label : str
+        Names the crank angle in error messages.
+    tol_gap : float
+        Gap tolerance of the rigid pins, mm.
+    names : list of str, optional
+        Contact names for error messages.
+    rigid_dofs : tuple of int
+        Rigid-body motions of the body that are unknowns (0: x, 1: y, 2: rotation). A motion left
+        out is held by the support of K_s; use this only for a mode no contact can resist (e.g.
+        the rotation of a round body under frictionless radial contacts), whose load is zero.
+
+    Raises
+    ------
+    ContactError
+        If the active set does not settle within ``max_iterations``; names the contacts that keep
+        flipping.
+    """
+    nc = cset.W.shape[1]
+    if start is not None and start.force.shape != (nc,):
+        start = None
+    if start is None and cset.laws and torque is not None:
+        ks = _nominal_stiffness(cset, torque)
+        linear = ContactSet(cset.W, cset.signorini, cset.gap0, cset.offset, cset.lever,
+                            [(idx, linear_law(ks)) for idx, _ in cset.laws])
+        start = _newton(linear, iface, compliance, torque, None, max_iterations, label, tol_gap,
+                        names, rigid_dofs, engage_all=True)
+    return _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_gap, names,
+                   rigid_dofs)
+
+
+def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_gap, names,
+            rigid_dofs=(0, 1, 2), engage_all=False):
+    W = cset.W.tocsc()
+    nc = W.shape[1]
+    Rc = np.asarray(W.T @ iface.resultants)          # (nc, 3): Fx, Fy, Mz per unit λ
+    Rfull = Rc.copy()
+    dropped = [k for k in range(3) if k not in rigid_dofs]
+    Rc[:, dropped] = 0.0
+    carrier = torque is not None                     # without a carrier: no φ unknown
+    torque = 0.0 if torque is None else torque
+    sig = cset.signorini
+    spring = ~sig
+    r_typ = max(float(np.abs(cset.lever).max()), 1.0)
+
+    def G_cols(idx):
+        if idx.size == 0:
+            return np.zeros((nc, 0))
+        sub = W[:, idx]
+        cols = np.unique(sub.indices)
+        compliance.ensure(cols)
+        return np.asarray(W.T @ (compliance.C[:, cols] @ sub[cols, :].toarray()))
+
+    def state(lam, a, phi):
+        nz = np.flatnonzero(lam != 0)
+        v = G_cols(nz) @ lam[nz] + Rc @ a
+        delta = cset.offset + cset.lever * phi - v
+        q = np.zeros(nc)
+        dq = np.zeros(nc)
+        for idx, law in cset.laws:
+            q[idx], dq[idx] = law(delta[idx])
+        return v, delta, q, dq
+
+    if start is not None:
+        lam, a, phi = start.force.copy(), start.rigid.copy(), start.carrier_rotation
+        active = sig & ((start.force > 0) | (cset.gap0 <= tol_gap))
+    else:
+        lam, a, phi = np.zeros(nc), np.zeros(3), 0.0
+        active = sig & (cset.gap0 <= tol_gap)
+    g_act = G_cols(np.flatnonzero(active)) if active.any() else None
+    kappa = 1.0 / float(np.median(np.diag(g_act[active]))) if g_act is not None else 1e6
+    scale_f = max(abs(torque) / r_typ, 1.0)
+    colscale = np.concatenate([np.ones(nc), [1 / kappa, 1 / kappa, 1 / (kappa * r_typ), 1 / (kappa * r_typ)]])
+    history = []
+
+    v, delta, q, dq = state(lam, a, phi)
+    for it in range(1, max_iterations + 1):
+        if engage_all and it == 1:
+            # first linear solve: every spring engaged so that the system is stable
+            for idx, law in cset.laws:
+                q[idx] = law(np.abs(delta[idx]))[0] * np.sign(delta[idx])
+                dq[idx] = law(np.ones(np.size(delta[idx])))[1]
+        J = np.flatnonzero(active | (spring & (dq > 0)) | (lam != 0))
+        Gj = G_cols(J)
+        n = nc + 4 if carrier else nc + 3
+        Jm = np.zeros((n, n))
+        r = np.zeros(n)
+        si = np.flatnonzero(spring)
+        r[si] = lam[si] - q[si]
+        Jm[si, si] = 1.0
+        Jm[np.ix_(si, J)] += dq[si, None] * Gj[si]
+        Jm[si, nc:nc + 3] = dq[si, None] * Rc[si]
+        if carrier:
+            Jm[si, nc + 3] = -dq[si] * cset.lever[si]
+        ai = np.flatnonzero(active)
+        r[ai] = kappa * (cset.gap0[ai] + v[ai])
+        Jm[np.ix_(ai, J)] = kappa * Gj[ai]
+        Jm[ai, nc:nc + 3] = kappa * Rc[ai]
+        ii = np.flatnonzero(sig & ~active)
+        r[ii] = lam[ii]
+        Jm[ii, ii] = 1.0
+        r[nc:nc + 2] = Rc[:, :2].T @ lam
+        Jm[nc:nc + 2, :nc] = Rc[:, :2].T
+        r[nc + 2] = Rc[:, 2] @ lam / r_typ
+        Jm[nc + 2, :nc] = Rc[:, 2] / r_typ
+        if carrier:
+            r[nc + 3] = (cset.lever @ lam - torque) / r_typ
+            Jm[nc + 3, :nc] = cset.lever / r_typ
+        for k in dropped:
+            Jm[nc + k, nc + k] = 1.0
+        cscale = colscale[:n]
+        try:
+            y = np.linalg.solve(Jm * cscale[None, :], -r)
+        except np.linalg.LinAlgError:
+            y = np.linalg.lstsq(Jm * cscale[None, :], -r, rcond=None)[0]
+        step = y * cscale
+        lam = lam + step[:nc]
+        lam[ii] = 0.0
+        a = a + step[nc:nc + 3]
+        if carrier:
+            phi = phi + step[nc + 3]
+
+        v, delta, q, dq = state(lam, a, phi)
+        gap = cset.gap0 + v
+        new_active = sig & ((lam - kappa * gap) > 0)
+        history.append(new_active)
+        spring_res = float(np.abs(lam[spring] - q[spring]).max()) if spring.any() else 0.0
+        gap_res = float(np.abs(gap[active]).max()) if active.any() else 0.0
+        settled = np.array_equal(new_active, active)
+        active = new_active
+        if settled and spring_res <= 1e-8 * scale_f and gap_res <= tol_gap and not (engage_all and it == 1):
+            break
+    else:
+        changes = np.zeros(nc, dtype=int)
+        for h0, h1 in zip(history[:-1], history[1:]):
+            changes += h0 != h1
+        flipping = [names[i] if names else str(i) for i in np.flatnonzero(changes)]
+        raise ContactError(
+            f"contact active set did not settle {label}within {max_iterations} iterations"
+            + (f"; contacts that keep flipping: {', '.join(flipping)}" if flipping else "")
+            + ". Check the profile modifications and clearances or refine the angle step "
+            "(analysis.max_active_set_iterations raises the bound)."
+        )
+
+    lam = np.where(sig & ~active, 0.0, lam)
+    lam[spring] = q[spring]
+    Rc = Rfull
+    res_f = float(np.linalg.norm(Rc[:, :2].T @ lam))
+    residual = {
+        "force_N": res_f,
+        "moment_Nmm": float(abs(Rc[:, 2] @ lam)),
+        "carrier_Nmm": float(abs(cset.lever @ lam - torque)),
+        "relative": res_f / max(float(np.abs(lam).sum()), 1e-30),
+    }
+    gap_out = np.where(sig, cset.gap0 + v, -delta)
+    return AngleSolution(lam, Rc[:, :2] * lam[:, None], gap_out, a, float(phi), it, residual)
+
+
+def _nominal_stiffness(cset: ContactSet, torque: float) -> float:
+    """A secant spring stiffness (N/mm) for the first, linearised solve of a cycle."""
+    for idx, law in cset.laws:
+        # secant through an estimated roller load of the order of the bearing loads
+        lever = np.abs(cset.lever[idx]).max() if np.size(idx) else 0.0
+        if lever > 0:
+            q_ref = abs(torque) / lever / 4.0
+            # invert the law numerically: find δ with q(δ) = q_ref
+            lo, hi = 0.0, 1.0
+            for _ in range(80):
+                mid = 0.5 * (lo + hi)
+                if law(np.array([mid]))[0][0] < q_ref:
+                    lo = mid
+                else:
+                    hi = mid
+            return q_ref / max(hi, 1e-15)
+    return 1e5

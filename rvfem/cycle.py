@@ -1,0 +1,432 @@
+"""The flexible load cycle: the disc model of a case, one crank angle, a full crank revolution.
+
+Typical use from a notebook::
+
+    from rvfem.case import load_case
+    from rvfem.mesh import mesh_case
+    from rvfem.cycle import build_system, solve_angle, load_cycle
+
+    case = load_case("cases/rv40e_fanholes.toml")
+    system = build_system(case, mesh_case(case))
+    one = solve_angle(system, theta=0.0)             # crank angle in rad
+    cycle = load_cycle(system)                       # 0…360° at the case's angle step
+
+The stiffness of the disc is assembled and factorised once (:func:`build_system`); every crank
+angle reuses it through the lazily filled column compliance of :mod:`rvfem.contact`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import contact
+from .case import Case
+from .contact import AngleSolution, Compliance, ContactSet, Interface
+from .errors import CaseError
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "DiscSystem",
+    "AngleResult",
+    "CycleResult",
+    "build_system",
+    "contact_set",
+    "solve_angle",
+    "load_cycle",
+    "displacement",
+    "bore_centres",
+    "roller_angles",
+]
+
+
+def bore_centres(case: Case) -> np.ndarray:
+    """Centres c_i of the crank bores in the disc frame, (N, 2), mm."""
+    a = np.radians(case.cranks.angles_deg)
+    return case.cranks.circle_radius * np.stack([np.cos(a), np.sin(a)], axis=1)
+
+
+def roller_angles(case: Case, theta: float) -> np.ndarray:
+    """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad.
+
+    Measured about each bore centre from the disc's x axis. The eccentric turns by θ relative to
+    the disc (the disc only translates relative to the carrier), so the cage turns by
+    θ·(1 − γ)/2 with γ = D_we/D_m (outer ring fixed). The cages of the N bearings are phased by
+    Δ_i·(1 + γ)/2 for a crank at Δ_i from the first, which makes the N bearings equivalent by the
+    disc's N-fold symmetry (their load curves are then exact 360°/N shifts when Zc is divisible
+    by N). Rollers of one bearing are 2π/Z apart.
+    """
+    b = case.crank_bearing
+    gamma = b.roller_diameter / b.pitch_diameter
+    alpha = np.radians(case.cranks.angles_deg)
+    cage = theta * (1.0 - gamma) / 2.0 + (alpha - alpha[0]) * (1.0 + gamma) / 2.0
+    return cage[:, None] + 2.0 * np.pi * np.arange(b.rollers)[None, :] / b.rollers
+
+
+@dataclass(frozen=True)
+class DiscSystem:
+    """Everything that does not change with the crank angle.
+
+    Attributes
+    ----------
+    case : Case
+    mesh : mesh object with ``points``, ``triangles``, ``boundaries``
+    model : the FE model (:mod:`rvfem.fem`)
+    interface : contact.Interface
+    compliance : contact.Compliance
+        Cache of the column compliance (filled lazily; the only mutable part).
+    solve : callable
+        K_s⁻¹ applied to a right-hand side.
+    rigid_modes : ndarray (n_dofs, 3)
+    bearing_model : str
+        ``"rollers"`` or ``"rigid_bore"``.
+    setup_seconds : dict
+        Wall times of assembly, factorisation and interface build.
+    """
+
+    case: Case
+    mesh: object
+    model: object
+    interface: Interface
+    compliance: Compliance
+    solve: object
+    rigid_modes: np.ndarray
+    bearing_model: str
+    stiffness_scale: float
+    pin_model: str
+    setup_seconds: dict = field(default_factory=dict)
+
+
+def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
+                 stiffness_scale: float = 1.0, pin_model: str | None = None,
+                 bearing_stiffness_scale: float = 1.0) -> DiscSystem:
+    """Assemble and factorise the disc and build its footprint interface.
+
+    Parameters
+    ----------
+    case : Case
+    mesh : DiscMesh
+        From :func:`rvfem.mesh.mesh_case`.
+    order : {1, 2}, optional
+        Element order; default ``case.analysis.element_order``.
+    bearing_model : {"rollers", "rigid_bore"}, optional
+        Default ``case.crank_bearing.model``.
+    stiffness_scale : float
+        Multiplies the disc's Young's modulus (1000 gives the "rigid disc" limit of the design
+        notes' validation ladder).
+    pin_model : {"rigid", "hertz"}, optional
+        Default ``case.pins.model``.
+    bearing_stiffness_scale : float
+        Multiplies the ``rigid_bore`` bearing stiffness (for the rigid-limit checks).
+    """
+    from . import fem
+
+    order = order or case.analysis.element_order
+    bearing_model = bearing_model or case.crank_bearing.model
+    pin_model = pin_model or case.pins.model
+    if bearing_model not in ("rollers", "rigid_bore"):
+        raise CaseError(f"bearing model must be 'rollers' or 'rigid_bore', got {bearing_model!r}")
+    if case.analysis.friction > 0:
+        raise CaseError(
+            f"{case.source}: 'analysis.friction' = {case.analysis.friction}: pin friction is not "
+            "modelled yet; set it to 0 (the frictionless result is what rvfem computes)"
+        )
+    times = {}
+    t0 = time.perf_counter()
+    model = fem.build_model(mesh.points, mesh.triangles,
+                            youngs_modulus=case.material.youngs_modulus * stiffness_scale,
+                            poissons_ratio=case.material.poissons_ratio,
+                            thickness=case.cycloid.thickness, order=order)
+    times["assembly"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    factor = fem.factorize(model)
+    times["factorization"] = time.perf_counter() - t0
+    rigid = fem.rigid_body_modes(model)
+
+    t0 = time.perf_counter()
+    centres = bore_centres(case)
+    names = ["profile"] + [f"bore_{i}" for i in range(case.cranks.count)]
+    boundaries = {n: mesh.boundaries[n] for n in names}
+    spacing = {"profile": case.mesh.size_flank}
+    half = {"profile": 1.5 * case.mesh.size_flank}
+    for i in range(case.cranks.count):
+        spacing[f"bore_{i}"] = case.mesh.size_bore
+        half[f"bore_{i}"] = 1.5 * case.mesh.size_bore
+    iface = contact.build_interface(model.basis, boundaries, rigid,
+                                    {f"bore_{i}": centres[i] for i in range(len(centres))},
+                                    spacing, half)
+    times["interface"] = time.perf_counter() - t0
+    compliance = Compliance(factor.solve, iface.B)
+    return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
+                      stiffness_scale, pin_model, times | {"bearing_stiffness_scale": bearing_stiffness_scale})
+
+
+def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
+    """The contacts of crank angle θ (rad): every pin, then the bearing contacts.
+
+    Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
+    """
+    from .geometry import pin_profile_contacts
+
+    case = system.case
+    iface = system.interface
+    prof = iface.grids["profile"]
+    pc = pin_profile_contacts(case, theta)
+    zp = case.pins.count
+    s = prof.arc_of(np.asarray(pc.point))
+    cols, wts = prof.columns_at(s)
+    rows_w = [cols.ravel()]
+    cols_w = [np.repeat(np.arange(zp), 2)]
+    vals_w = [wts.ravel()]
+    gap0 = np.zeros(zp)
+    offset = np.zeros(zp)
+    signorini = np.zeros(zp, dtype=bool)
+    names = [f"pin {j}" for j in range(zp)]
+    laws = []
+    if system.pin_model == "rigid":
+        signorini[:] = True
+        gap0[:] = pc.gap
+    else:
+        offset[:] = -np.asarray(pc.gap)
+        laws.append((np.arange(zp), contact.palmgren_law(case.cycloid.thickness, contacts=1)))
+
+    centres = bore_centres(case)
+    b = case.crank_bearing
+    n = zp
+    lever_parts = [np.zeros(zp)]
+    bearing_of = []
+    if system.bearing_model == "rollers":
+        psi = roller_angles(case, theta)
+        law = (contact.palmgren_law(b.roller_length, contacts=2) if b.stiffness_law == "palmgren"
+               else contact.linear_law(b.linear_stiffness_N_per_mm))
+        idx = []
+        for i, c in enumerate(centres):
+            grid = iface.grids[f"bore_{i}"]
+            pts = c + b.bore_radius * np.stack([np.cos(psi[i]), np.sin(psi[i])], axis=1)
+            cc, ww = grid.columns_at(grid.arc_of(pts))
+            z = len(psi[i])
+            rows_w.append(cc.ravel())
+            cols_w.append(np.repeat(np.arange(n, n + z), 2))
+            vals_w.append(ww.ravel())
+            names += [f"bearing {i} roller {k}" for k in range(z)]
+            idx.append(np.arange(n, n + z))
+            bearing_of += [i] * z
+            n += z
+        nb = n - zp
+        laws.append((np.concatenate(idx), law))
+        gap0 = np.concatenate([gap0, np.zeros(nb)])
+        offset = np.concatenate([offset, np.full(nb, -0.5 * b.radial_clearance)])
+        signorini = np.concatenate([signorini, np.zeros(nb, dtype=bool)])
+    else:
+        k_b = b.rigid_bore_stiffness_N_per_mm * system.setup_seconds.get("bearing_stiffness_scale", 1.0)
+        for i, c in enumerate(centres):
+            grid = iface.grids[f"bore_{i}"]
+            ang = np.arctan2(*(iface.points[grid.offset:grid.offset + grid.count] - c).T[::-1])
+            colsb = grid.offset + np.arange(grid.count)
+            for comp, w in (("x", np.cos(ang)), ("y", np.sin(ang))):
+                rows_w.append(colsb)
+                cols_w.append(np.full(grid.count, n))
+                vals_w.append(2.0 / grid.count * w)
+                names.append(f"bearing {i} {comp}")
+                bearing_of.append(i)
+                n += 1
+        nb = n - zp
+        laws.append((np.arange(zp, n), contact.linear_law(k_b, bilateral=True)))
+        gap0 = np.concatenate([gap0, np.zeros(nb)])
+        offset = np.concatenate([offset, np.zeros(nb)])
+        signorini = np.concatenate([signorini, np.zeros(nb, dtype=bool)])
+
+    W = sp.csc_matrix((np.concatenate(vals_w), (np.concatenate(rows_w), np.concatenate(cols_w))),
+                      shape=(iface.n_columns, n))
+    F = np.asarray(W.T @ iface.resultants[:, :2])     # force on the disc per unit λ
+    cb = centres[np.asarray(bearing_of, dtype=int)]
+    lever = np.concatenate([np.zeros(zp), cb[:, 0] * F[zp:, 1] - cb[:, 1] * F[zp:, 0]])
+    return ContactSet(W, signorini, gap0, offset, lever, laws), names
+
+
+@dataclass(frozen=True)
+class AngleResult:
+    """Loads at one crank angle (all forces act on the disc, N; disc frame).
+
+    Attributes
+    ----------
+    theta : float
+        Crank angle, rad.
+    bearing_forces : ndarray (N, 2)
+        Force of each crank bearing on the disc.
+    roller_loads : ndarray (N, Z) or None
+        Roller loads (``rollers`` model), N.
+    roller_angles : ndarray (N, Z) or None
+        Roller positions about each bore centre, rad.
+    pin_forces : ndarray (Zp,)
+        Pin force magnitudes, N.
+    pin_vectors : ndarray (Zp, 2)
+    pin_gaps : ndarray (Zp,)
+        Final pin gaps (rigid pins) or −approach (compliant pins), mm.
+    carrier_rotation : float
+        φ, rad (carrier relative to the pin housing, about the disc centre).
+    solution : contact.AngleSolution
+    """
+
+    theta: float
+    bearing_forces: np.ndarray
+    roller_loads: np.ndarray | None
+    roller_angles: np.ndarray | None
+    pin_forces: np.ndarray
+    pin_vectors: np.ndarray
+    pin_gaps: np.ndarray
+    carrier_rotation: float
+    solution: AngleSolution
+    contacts: ContactSet
+
+    @property
+    def bearing_loads(self) -> np.ndarray:
+        """|F| of each bearing, N."""
+        return np.linalg.norm(self.bearing_forces, axis=1)
+
+    @property
+    def pins_in_contact(self) -> int:
+        return int(np.count_nonzero(self.pin_forces > 1e-9 * max(self.pin_forces.max(), 1.0)))
+
+
+def solve_angle(system: DiscSystem, theta: float, start: AngleResult | None = None) -> AngleResult:
+    """Solve one crank angle θ (rad). ``start`` warm-starts from a neighbouring angle."""
+    case = system.case
+    cset, names = contact_set(system, theta)
+    sol = contact.solve_contact(
+        cset, system.interface, system.compliance, case.loads.disc_torque_Nmm,
+        start=None if start is None else start.solution,
+        max_iterations=case.analysis.max_active_set_iterations,
+        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names,
+    )
+    zp = case.pins.count
+    n = case.cranks.count
+    if system.bearing_model == "rollers":
+        z = case.crank_bearing.rollers
+        vec = sol.vectors[zp:].reshape(n, z, 2)
+        bearing = vec.sum(axis=1)
+        rollers = sol.force[zp:].reshape(n, z)
+        angles = roller_angles(case, theta)
+    else:
+        bearing = sol.vectors[zp:].reshape(n, 2, 2).sum(axis=1)
+        rollers = angles = None
+    return AngleResult(theta, bearing, rollers, angles, sol.force[:zp], sol.vectors[:zp],
+                       sol.gap[:zp], sol.carrier_rotation, sol, cset)
+
+
+def displacement(system: DiscSystem, result: AngleResult) -> np.ndarray:
+    """Displacement field (n_dofs,) of the disc at a solved angle, mm (rigid motion included)."""
+    f = system.interface.B @ (result.contacts.W @ result.solution.force)
+    return system.solve(np.asarray(f)) + system.rigid_modes @ result.solution.rigid
+
+
+@dataclass(frozen=True)
+class CycleResult:
+    """A full crank revolution (arrays indexed by angle first).
+
+    Attributes
+    ----------
+    theta : ndarray (n,)
+        Crank angles, rad.
+    bearing_forces : ndarray (n, N, 2)
+        Force of each bearing on the disc, N.
+    roller_loads : ndarray (n, N, Z) or None
+    pin_forces : ndarray (n, Zp)
+    pins_in_contact : ndarray (n,)
+    carrier_rotation : ndarray (n,)
+        rad.
+    equilibrium_residual : ndarray (n,)
+        |ΣF| / Σ|λ| of the disc at each angle (dimensionless).
+    iterations : ndarray (n,)
+    fields : dict angle (rad) → displacement (n_dofs,)
+        At the case's saved angles and the angle of the maximum bearing load.
+    timings : dict
+    """
+
+    theta: np.ndarray
+    bearing_forces: np.ndarray
+    roller_loads: np.ndarray | None
+    roller_angles: np.ndarray | None
+    pin_forces: np.ndarray
+    pins_in_contact: np.ndarray
+    carrier_rotation: np.ndarray
+    equilibrium_residual: np.ndarray
+    iterations: np.ndarray
+    fields: dict
+    timings: dict
+
+    @property
+    def bearing_loads(self) -> np.ndarray:
+        """|F|, (n, N), N."""
+        return np.linalg.norm(self.bearing_forces, axis=2)
+
+    def torsional_stiffness_Nm_per_arcmin(self, torque_Nmm: float) -> float:
+        """Mean disc torque / carrier rotation, N·m/arcmin."""
+        phi = float(np.mean(np.abs(self.carrier_rotation)))
+        return abs(torque_Nmm) / 1000.0 / (phi * 180.0 * 60.0 / math.pi)
+
+
+def cycle_angles(case: Case) -> np.ndarray:
+    """Crank angles of a full revolution at the case's step (endpoint excluded), rad."""
+    n = int(round(360.0 / case.analysis.angle_step_deg))
+    return np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+
+
+def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress=None,
+               saved_angles_deg: tuple[float, ...] | None = None) -> CycleResult:
+    """Solve every crank angle of a revolution, warm-starting each from the previous one.
+
+    Parameters
+    ----------
+    system : DiscSystem
+    thetas : ndarray, optional
+        Crank angles, rad; default a full revolution at ``case.analysis.angle_step_deg``.
+    progress : callable, optional
+        Called as ``progress(i, n)`` after each angle (the CLI draws its progress bar with it).
+    saved_angles_deg : tuple, optional
+        Angles whose displacement fields are kept; default ``case.analysis.saved_angles_deg``
+        (the nearest solved angle is used) plus the angle of the maximum bearing load.
+    """
+    case = system.case
+    thetas = cycle_angles(case) if thetas is None else np.asarray(thetas, dtype=float)
+    t0 = time.perf_counter()
+    results: list[AngleResult] = []
+    prev = None
+    for i, th in enumerate(thetas):
+        prev = solve_angle(system, float(th), prev)
+        results.append(prev)
+        if progress is not None:
+            progress(i + 1, len(thetas))
+    t_cycle = time.perf_counter() - t0
+
+    bf = np.stack([r.bearing_forces for r in results])
+    loads = np.linalg.norm(bf, axis=2)
+    saved = case.analysis.saved_angles_deg if saved_angles_deg is None else saved_angles_deg
+    keep = {int(np.argmin(np.abs(np.angle(np.exp(1j * (thetas - math.radians(a))))))) for a in saved}
+    keep.add(int(np.unravel_index(np.argmax(loads), loads.shape)[0]))
+    t1 = time.perf_counter()
+    fields = {float(thetas[k]): displacement(system, results[k]) for k in sorted(keep)}
+    t_fields = time.perf_counter() - t1
+    rollers = None if results[0].roller_loads is None else np.stack([r.roller_loads for r in results])
+    rangles = None if results[0].roller_angles is None else np.stack([r.roller_angles for r in results])
+    return CycleResult(
+        theta=thetas,
+        bearing_forces=bf,
+        roller_loads=rollers,
+        roller_angles=rangles,
+        pin_forces=np.stack([r.pin_forces for r in results]),
+        pins_in_contact=np.array([r.pins_in_contact for r in results]),
+        carrier_rotation=np.array([r.carrier_rotation for r in results]),
+        equilibrium_residual=np.array([r.solution.residual["relative"] for r in results]),
+        iterations=np.array([r.solution.iterations for r in results]),
+        fields=fields,
+        timings={"cycle": t_cycle, "fields": t_fields,
+                 "columns_solved": system.compliance.columns_solved,
+                 "column_solve": system.compliance.solve_seconds},
+    )
