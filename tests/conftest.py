@@ -1,0 +1,81 @@
+"""Shared helpers for the tests: paths of the shipped cases and a small TOML line editor."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES_DIR = ROOT / "cases"
+
+
+class CaseText:
+    """Edits a case file's text line by line (keys addressed by table), for validation tests."""
+
+    def __init__(self, text: str):
+        self.lines = text.splitlines()
+
+    @classmethod
+    def shipped(cls, name: str = "rv40e") -> "CaseText":
+        return cls((CASES_DIR / f"{name}.toml").read_text(encoding="utf-8"))
+
+    def _table_span(self, table: str) -> tuple[int, int]:
+        header = re.compile(r"^\s*\[\[?([^\]]+)\]\]?")
+        start = 0 if table == "" else None
+        for i, line in enumerate(self.lines):
+            m = header.match(line)
+            if m:
+                if start is not None:
+                    return start, i
+                if m.group(1).strip() == table:
+                    start = i + 1
+        if start is None:
+            raise KeyError(f"no table [{table}] in the case text")
+        return start, len(self.lines)
+
+    def _find(self, table: str, key: str) -> int:
+        lo, hi = self._table_span(table)
+        pattern = re.compile(rf"^\s*{re.escape(key)}\s*=")
+        for i in range(lo, hi):
+            if pattern.match(self.lines[i]):
+                return i
+        raise KeyError(f"no key {key!r} in [{table}]")
+
+    def set(self, table: str, key: str, value: str) -> "CaseText":
+        """Set ``key`` in ``[table]`` to the TOML literal ``value`` (adding the key if absent)."""
+        try:
+            self.lines[self._find(table, key)] = f"{key} = {value}"
+        except KeyError:
+            lo, _ = self._table_span(table)
+            self.lines.insert(lo, f"{key} = {value}")
+        return self
+
+    def drop(self, table: str, key: str) -> "CaseText":
+        del self.lines[self._find(table, key)]
+        return self
+
+    def drop_table(self, table: str) -> "CaseText":
+        lo, hi = self._table_span(table)
+        del self.lines[lo - 1:hi]
+        return self
+
+    def append(self, text: str) -> "CaseText":
+        self.lines.extend(text.strip("\n").splitlines())
+        return self
+
+    def prepend(self, text: str) -> "CaseText":
+        self.lines[0:0] = text.strip("\n").splitlines()
+        return self
+
+    def write(self, directory: Path, name: str = "case.toml") -> Path:
+        path = directory / name
+        path.write_text("\n".join(self.lines) + "\n", encoding="utf-8")
+        return path
+
+
+@pytest.fixture
+def case_text() -> CaseText:
+    """An editable copy of the shipped RV-40E case."""
+    return CaseText.shipped("rv40e")

@@ -1,0 +1,116 @@
+"""Command line: exit codes, one-line errors without tracebacks, JSON output."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from rvfem import __version__, cli
+
+from conftest import CASES_DIR
+
+CRV80E = str(CASES_DIR / "crv80e.toml")
+
+
+def test_check_valid_case(capsys):
+    assert cli.main(["check", CRV80E]) == 0
+    out, err = capsys.readouterr()
+    assert out.count("\n") == 1 and out.startswith("OK") and "'crv80e'" in out
+    assert err == ""
+
+
+def test_check_invalid_case_gives_one_line_and_exit_2(case_text, tmp_path, capsys):
+    path = case_text.set("cycloid", "eccentricity", "-1.3").write(tmp_path, "bad.toml")
+    assert cli.main(["check", str(path)]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.count("\n") == 1
+    assert str(path) in err and "'cycloid.eccentricity'" in err and "must be positive" in err
+    assert "Traceback" not in err
+
+
+def test_check_missing_file(tmp_path, capsys):
+    assert cli.main(["check", str(tmp_path / "nope.toml")]) == 2
+    assert "cannot read the case file" in capsys.readouterr().err
+
+
+def test_rigid_table(capsys):
+    assert cli.main(["rigid", CRV80E]) == 0
+    out = capsys.readouterr().out
+    assert "bearing speed 600 rpm" in out
+    assert "C = 21948.7 N" in out
+    assert out.count("5576.9") == 3 and out.count("4374.1") == 3
+
+
+def test_rigid_json(capsys):
+    assert cli.main(["rigid", CRV80E, "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["case"] == "crv80e"
+    assert report["bearing_speed_rpm"] == pytest.approx(600.0)
+    assert report["dynamic_load_rating_N"] == pytest.approx(21948.7, abs=0.05)
+    assert len(report["bearings"]) == 3
+    for b in report["bearings"]:
+        assert b["max_load_N"] == pytest.approx(5576.2, rel=5e-4)
+        assert b["equivalent_load_N"] == pytest.approx(4374.1, abs=0.05)
+        assert b["L10h_h"] == pytest.approx(6008.0, abs=1.0)
+        assert b["hertz_inner"]["peak_pressure_MPa"] > b["hertz_outer"]["peak_pressure_MPa"] > 0
+    assert "duty_cycle" not in report
+
+
+def test_rigid_reports_the_duty_cycle(case_text, tmp_path, capsys):
+    case_text.append("[[loads.duty_cycle]]\ntime_share = 1.0\nspeed_rpm = 15.0\ntorque_Nm = 412.0")
+    path = case_text.write(tmp_path)
+    assert cli.main(["rigid", str(path), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    duty = report["duty_cycle"]
+    # one row at the rated point: the service life is the rated life
+    assert duty["service_life_h"] == pytest.approx(report["bearings"][0]["L10h_h"], rel=1e-12)
+
+
+def test_rigid_rejects_a_case_outside_the_handbook_model(case_text, tmp_path, capsys):
+    path = case_text.set("cranks", "angles_deg", "[90, 200, 330]").write(tmp_path)
+    assert cli.main(["rigid", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "equally spaced" in err and "Traceback" not in err
+
+
+def test_usage_errors_exit_2(capsys):
+    assert cli.main([]) == 2
+    assert cli.main(["frobnicate"]) == 2
+    assert cli.main(["rigid"]) == 2
+    capsys.readouterr()
+
+
+def test_version(capsys):
+    assert cli.main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"rvfem {__version__}"
+
+
+def test_keyboard_interrupt_exits_130(monkeypatch, capsys):
+    def interrupted(path):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "load_case", interrupted)
+    assert cli.main(["check", CRV80E]) == 130
+    assert "Traceback" not in capsys.readouterr().err
+
+
+def test_every_subcommand_is_registered_once():
+    names = [c.name for c in cli.SUBCOMMANDS]
+    assert len(names) == len(set(names)) and {"check", "rigid"} <= set(names)
+
+
+def test_entry_point_in_a_subprocess(case_text, tmp_path):
+    """The installed module run as a program: verbose logging, a bad case, no traceback."""
+    ok = subprocess.run([sys.executable, "-m", "rvfem.cli", "-vv", "rigid", CRV80E],
+                        capture_output=True, text=True, timeout=60)
+    assert ok.returncode == 0 and "5576.9" in ok.stdout
+    assert "DEBUG rvfem.rigid" in ok.stderr
+    path = case_text.set("pins", "count", "39").write(tmp_path)
+    bad = subprocess.run([sys.executable, "-m", "rvfem.cli", "rigid", str(path)],
+                         capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 2
+    assert bad.stdout == "" and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
