@@ -185,6 +185,41 @@ def _run_rigid(args: argparse.Namespace) -> int:
 
 
 # --------------------------------------------------------------------------------------------
+# rvfem mesh CASE [--cache-dir DIR] [--force]
+# --------------------------------------------------------------------------------------------
+
+
+def _add_mesh_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("case", help="case file (TOML)")
+    parser.add_argument("--cache-dir", default="meshes",
+                        help="directory of cached meshes and previews (default: meshes)")
+    parser.add_argument("--force", action="store_true", help="re-mesh even if a cached mesh exists")
+
+
+def _run_mesh(args: argparse.Namespace) -> int:
+    import time
+
+    from .geometry import disc_geometry
+    from .mesh import mesh_case, mesh_preview_png
+
+    case = load_case(args.case)
+    start = time.perf_counter()
+    geom = disc_geometry(case)
+    mesh = mesh_case(case, args.cache_dir, use_cache=not args.force, geometry=geom)
+    elapsed = time.perf_counter() - start
+    png = mesh_preview_png(mesh, mesh.path.with_suffix(".png"), title=f"{case.name}: disc mesh")
+    thinnest = geom.walls[0]
+    print(f"mesh of case '{case.name}' ({args.case}): {mesh.path}"
+          f" ({'cached' if mesh.from_cache else 'generated'} in {elapsed:.2f} s)")
+    print(f"  {mesh.n_nodes} nodes, {mesh.n_elements} linear triangles, "
+          f"min element quality ({mesh.quality_measure}) {mesh.min_quality:.3f}")
+    print(f"  boundaries: {', '.join(f'{n} ({len(e)} edges)' for n, e in mesh.boundaries.items())}")
+    print(f"  thinnest wall {thinnest.thickness:.2f} mm between {thinnest.first} and {thinnest.second}")
+    print(f"  preview: {png}")
+    return EXIT_OK
+
+
+# --------------------------------------------------------------------------------------------
 # Registry and entry point
 # --------------------------------------------------------------------------------------------
 
@@ -193,6 +228,7 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
     Subcommand("check", "validate a case file", _add_check_arguments, _run_check),
     Subcommand("rigid", "rigid handbook crank-bearing loads, rating, life and Hertz pressures",
                _add_rigid_arguments, _run_rigid),
+    Subcommand("mesh", "mesh the disc (Gmsh, cached) and write a PNG preview", _add_mesh_arguments, _run_mesh),
 )
 
 

@@ -40,7 +40,8 @@ import numpy as np
 
 from .case import Case, case_to_dict
 from .errors import MeshError
-from .geometry import Arc, Circle, DiscGeometry, FanHole, LineSegment, disc_geometry
+from .geometry import (SPLINE_POINTS_PER_SEGMENT, Arc, Circle, DiscGeometry, FanHole, LineSegment,
+                       disc_geometry)
 
 __all__ = [
     "DiscMesh",
@@ -178,7 +179,7 @@ def mesh_key(case: Case) -> str:
 
     Included: cycloid teeth, eccentricity, central hole, modifications and pitch errors; pin count,
     pin-circle radius and pin radius; cranks; the bore radius; fan and round holes; the three mesh
-    sizes; :data:`MESHER_VERSION` and the Gmsh version. Not included: thickness, material, loads,
+    sizes; :data:`MESHER_VERSION`, the number of spline points per tooth space and the Gmsh version. Not included: thickness, material, loads,
     analysis options, bearing data other than the bore radius, ``mesh.min_wall`` (a check, not a
     shape) and the case name.
     """
@@ -193,6 +194,7 @@ def mesh_key(case: Case) -> str:
         "round_holes": d.get("round_holes"),
         "mesh": {k: d["mesh"][k] for k in ("size_flank", "size_bore", "size_interior")},
         "mesher": MESHER_VERSION,
+        "spline_points": SPLINE_POINTS_PER_SEGMENT,
         "gmsh": gmsh.__version__,
     }
     return hashlib.sha256(json.dumps(shaping, sort_keys=True).encode()).hexdigest()
