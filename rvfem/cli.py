@@ -161,8 +161,9 @@ def _format_rigid(report: dict, out: TextIO) -> None:
             f"{b['hertz_outer']['peak_pressure_MPa']:9.1f}\n"
         )
     w(
-        f"\n  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Hertz at Q_max = {report['stribeck_factor']:g}·F_max/Z "
-        "(inner: eccentric, outer: disc bore)\n"
+        "\n  at °: crank angle θ of the eccentric relative to the carrier; F_m = (mean F^p)^(1/p) over a turn\n"
+        f"  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Hertz at Q_max = {report['stribeck_factor']:g}·F_max/Z "
+        "(p_in: eccentric, p_out: disc bore)\n"
     )
     duty = report.get("duty_cycle")
     if duty:

@@ -1,0 +1,40 @@
+# rvfem: two commands for a fresh machine.
+#   make run    create .venv if missing, install rvfem, run the main job on the default case
+#   make test   create .venv if missing, install rvfem with the dev extra, run the test suite
+# Both are idempotent: the installation is redone only when pyproject.toml changes.
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+
+# The main job: arguments of the `rvfem` command that `make run` executes.
+MAIN_JOB ?= rigid cases/rv40e.toml
+
+.PHONY: run test install install-dev help
+
+help:
+	@echo "make run    - install (if needed) and run: rvfem $(MAIN_JOB)"
+	@echo "make test   - install with the dev extra (if needed) and run pytest"
+
+run: $(VENV)/.installed
+	$(BIN)/rvfem $(MAIN_JOB)
+
+test: $(VENV)/.installed-dev
+	$(BIN)/python -m pytest
+
+install: $(VENV)/.installed
+
+install-dev: $(VENV)/.installed-dev
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+
+$(VENV)/.installed: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --progress-bar off -e .
+	-.ci/ensure-gmsh-libs $(BIN)/python
+	touch $@
+
+$(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --progress-bar off -e '.[dev]'
+	-.ci/ensure-gmsh-libs $(BIN)/python
+	touch $@ $(VENV)/.installed
