@@ -14,6 +14,7 @@ import argparse
 import json
 import logging
 import math
+import os
 import sys
 from dataclasses import asdict, dataclass
 from typing import Callable, TextIO
@@ -37,6 +38,7 @@ __all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT
 EXIT_OK = 0
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
+EXIT_BROKEN_PIPE = 141
 
 logger = logging.getLogger(__name__)
 
@@ -256,7 +258,8 @@ def _setup_logging(verbosity: int) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit code (0 ok, 2 user error, 130 interrupted)."""
+    """Run the command line; returns the exit code (0 ok, 2 user error, 130 interrupted,
+    141 output pipe closed early)."""
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -271,9 +274,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("rvfem: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except BrokenPipeError:  # e.g. `rvfem rigid case.toml | head`
-        sys.stderr.close()
-        return EXIT_OK
+    except BrokenPipeError:  # e.g. `rvfem rigid case.toml | head -3`: stop quietly
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
 
 
 if __name__ == "__main__":  # pragma: no cover

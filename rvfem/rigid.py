@@ -342,6 +342,7 @@ def handbook_bearing_loads(case: Case, theta=None) -> RigidLoads:
     """
     comp = handbook_components(case)
     th = load_cycle_angles(case.analysis.angle_step_deg) if theta is None else _as_theta(theta)
+    logger.info("rigid handbook loads of %s: %d bearings at %d crank angles", case.name, case.cranks.count, th.size)
     alpha = np.radians(np.asarray(case.cranks.angles_deg, dtype=float))
     beta = th[None, :] - alpha[:, None]
     f_t = comp.f1 + comp.f2 * np.cos(beta) - comp.f3 * np.sin(beta)
