@@ -328,24 +328,30 @@ class Compliance:
     B : sparse (n_dofs, n_cols)
     """
 
-    def __init__(self, solve, B: sp.csc_matrix):
+    def __init__(self, solve, B: sp.csc_matrix, batch: int = 16):
         self._solve = solve
+        self.batch = batch  # right-hand sides per back-substitution call (measured optimum)
         self.B = B
         n = B.shape[1]
         self.C = np.zeros((n, n))
         self.known = np.zeros(n, dtype=bool)
         self.solve_seconds = 0.0
+        self.version = 0
         self.columns_solved = 0
 
     def ensure(self, columns: np.ndarray) -> None:
         """Make sure ``C[:, columns]`` is available."""
+        columns = np.asarray(columns)
         need = np.unique(columns[~self.known[columns]])
         if need.size == 0:
             return
         t0 = time.perf_counter()
-        X = self._solve(self.B[:, need].toarray())
-        self.C[:, need] = np.asarray(self.B.T @ X)
+        for i in range(0, need.size, self.batch):
+            part = need[i:i + self.batch]
+            X = self._solve(self.B[:, part].toarray())
+            self.C[:, part] = np.asarray(self.B.T @ X)
         self.known[need] = True
+        self.version += 1
         self.solve_seconds += time.perf_counter() - t0
         self.columns_solved += need.size
 
@@ -520,13 +526,23 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
     spring = ~sig
     r_typ = max(float(np.abs(cset.lever).max()), 1.0)
 
+    # compliance between the contacts, G = Wᵀ C W, on the columns the contacts touch; column j of
+    # G is valid once the interface columns of contact j are known (C is filled column-wise and
+    # symmetric, so the rows of every other contact come with it)
+    touched = np.unique(W.indices)
+    Wsub = W[touched, :].toarray()
+    cache = {"version": -1, "G": None}
+
+    nonzero = Wsub != 0
+
     def G_cols(idx):
         if idx.size == 0:
             return np.zeros((nc, 0))
-        sub = W[:, idx]
-        cols = np.unique(sub.indices)
-        compliance.ensure(cols)
-        return np.asarray(W.T @ (compliance.C[:, cols] @ sub[cols, :].toarray()))
+        compliance.ensure(touched[nonzero[:, idx].any(axis=1)])
+        if cache["version"] != compliance.version:
+            cache["G"] = Wsub.T @ compliance.C[np.ix_(touched, touched)] @ Wsub
+            cache["version"] = compliance.version
+        return cache["G"][:, idx]
 
     def state(lam, a, phi):
         nz = np.flatnonzero(lam != 0)

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+from threadpoolctl import threadpool_limits
 
 from . import contact
 from .case import Case
@@ -44,6 +45,13 @@ __all__ = [
     "bore_centres",
     "roller_angles",
 ]
+
+
+FOOTPRINT_ELEMENTS = 1.5
+"""Half-width of the pin and roller load footprints in element sizes (mesh.size_flank at the
+profile, mesh.size_bore at the bores). The Hertz half-widths of these contacts (≈0.1 mm) are below
+one element at the default sizes, so the footprint spreads each force over a few elements; the
+bearing loads do not depend on it (global equilibrium), only the stress right under a contact."""
 
 
 def bore_centres(case: Case) -> np.ndarray:
@@ -100,6 +108,8 @@ class DiscSystem:
     bearing_model: str
     stiffness_scale: float
     pin_model: str
+    geometry: object
+    bearing_stiffness_scale: float = 1.0
     setup_seconds: dict = field(default_factory=dict)
 
 
@@ -126,6 +136,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
         Multiplies the ``rigid_bore`` bearing stiffness (for the rigid-limit checks).
     """
     from . import fem
+    from .geometry import disc_geometry
 
     order = order or case.analysis.element_order
     bearing_model = bearing_model or case.crank_bearing.model
@@ -138,6 +149,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
             "modelled yet; set it to 0 (the frictionless result is what rvfem computes)"
         )
     times = {}
+    geometry = disc_geometry(case)
     t0 = time.perf_counter()
     model = fem.build_model(mesh.points, mesh.triangles,
                             youngs_modulus=case.material.youngs_modulus * stiffness_scale,
@@ -147,24 +159,21 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     t0 = time.perf_counter()
     factor = fem.factorize(model)
     times["factorization"] = time.perf_counter() - t0
-    rigid = fem.rigid_body_modes(model)
+    rigid = fem.rigid_body_modes(model)  # about the disc centre (the origin)
 
     t0 = time.perf_counter()
     centres = bore_centres(case)
     names = ["profile"] + [f"bore_{i}" for i in range(case.cranks.count)]
     boundaries = {n: mesh.boundaries[n] for n in names}
-    spacing = {"profile": case.mesh.size_flank}
-    half = {"profile": 1.5 * case.mesh.size_flank}
+    half = {"profile": FOOTPRINT_ELEMENTS * case.mesh.size_flank}
     for i in range(case.cranks.count):
-        spacing[f"bore_{i}"] = case.mesh.size_bore
-        half[f"bore_{i}"] = 1.5 * case.mesh.size_bore
+        half[f"bore_{i}"] = FOOTPRINT_ELEMENTS * case.mesh.size_bore
     iface = contact.build_interface(model.basis, boundaries, rigid,
-                                    {f"bore_{i}": centres[i] for i in range(len(centres))},
-                                    spacing, half)
+                                    {f"bore_{i}": centres[i] for i in range(len(centres))}, half)
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
-                      stiffness_scale, pin_model, times | {"bearing_stiffness_scale": bearing_stiffness_scale})
+                      stiffness_scale, pin_model, geometry, bearing_stiffness_scale, times)
 
 
 def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
@@ -177,7 +186,7 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     case = system.case
     iface = system.interface
     prof = iface.grids["profile"]
-    pc = pin_profile_contacts(case, theta)
+    pc = pin_profile_contacts(system.geometry, theta)
     zp = case.pins.count
     s = prof.arc_of(np.asarray(pc.point))
     cols, wts = prof.columns_at(s)
@@ -224,7 +233,7 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
         offset = np.concatenate([offset, np.full(nb, -0.5 * b.radial_clearance)])
         signorini = np.concatenate([signorini, np.zeros(nb, dtype=bool)])
     else:
-        k_b = b.rigid_bore_stiffness_N_per_mm * system.setup_seconds.get("bearing_stiffness_scale", 1.0)
+        k_b = b.rigid_bore_stiffness_N_per_mm * system.bearing_stiffness_scale
         for i, c in enumerate(centres):
             grid = iface.grids[f"bore_{i}"]
             ang = np.arctan2(*(iface.points[grid.offset:grid.offset + grid.count] - c).T[::-1])
@@ -398,11 +407,14 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
     t0 = time.perf_counter()
     results: list[AngleResult] = []
     prev = None
-    for i, th in enumerate(thetas):
-        prev = solve_angle(system, float(th), prev)
-        results.append(prev)
-        if progress is not None:
-            progress(i + 1, len(thetas))
+    # the per-angle systems are small (~100 unknowns): threaded BLAS only adds overhead there
+    # (measured 7x slower on two cores), so the cycle runs BLAS single-threaded
+    with threadpool_limits(limits=1, user_api="blas"):
+        for i, th in enumerate(thetas):
+            prev = solve_angle(system, float(th), prev)
+            results.append(prev)
+            if progress is not None:
+                progress(i + 1, len(thetas))
     t_cycle = time.perf_counter() - t0
 
     bf = np.stack([r.bearing_forces for r in results])
