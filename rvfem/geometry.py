@@ -151,16 +151,17 @@ class Profile:
     blend_half_width : float
         Half-width in s of the pitch-error blend around each root, rad.
     points, normals : ndarray (Zc·SAMPLES_PER_SEGMENT, 2)
-        Dense samples, counter-clockwise, closed (the first point is not repeated), and the unit
-        outward normals there.
+        Dense samples, counter-clockwise, equally spaced in arc length within each segment,
+        starting at the tip before segment 0, closed (the first point is not repeated), and the
+        unit outward normals there. The roots (s = 0) and tips (s = ±s_h) are samples.
     curvature : ndarray
         Signed curvature at the samples, 1/mm: positive where the profile is convex (tips),
         negative where concave (tooth spaces).
     segment, param : ndarray
         Segment index j and base-curve parameter s of every sample.
     spline_points : ndarray (Zc, SPLINE_POINTS_PER_SEGMENT, 2)
-        Points per segment for Gmsh, tip to tip; the last point of segment j equals the first of
-        segment j + 1.
+        Points per segment for Gmsh, tip to tip, equally spaced in arc length; the last point of
+        segment j equals the first of segment j + 1.
     """
 
     teeth: int
@@ -329,6 +330,24 @@ def _half_range(R: float, e: float, a: float, r: float, zc: int, d: int) -> floa
     return brentq(f, 0.0, hi, xtol=1e-15)
 
 
+def _arc_length_params(R: float, e: float, a: float, r: float, s_h: float, n: int) -> np.ndarray:
+    """n + 1 parameters from −s_h to s_h, equally spaced in arc length of the base profile,
+    symmetric about the root (s = 0 is included for even n, the ends are exactly ±s_h)."""
+    half = n // 2
+    fine = np.linspace(0.0, s_h, 64 * max(half, 1) + 1)
+    speed = np.abs(_base_curve(R, e, a, r, fine)[1])
+    arc = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(fine))])
+    if n % 2 == 0:
+        u = arc[-1] * np.arange(half + 1) / half
+        pos = np.interp(u, arc, fine)
+        pos[0], pos[-1] = 0.0, s_h
+        return np.concatenate([-pos[:0:-1], pos])
+    u = arc[-1] * (np.arange(half + 1) + 0.5) / (half + 0.5)
+    pos = np.interp(u, arc, fine)
+    pos[-1] = s_h
+    return np.concatenate([-pos[::-1], pos])
+
+
 def check_undercut(R: float, e: float, a: float, r: float, s_h: float) -> tuple[float, float]:
     """Minimum radius of curvature of the convex part of the profile, and the parameter s there.
 
@@ -391,7 +410,7 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
         ang = math.degrees(math.atan2(p.imag, p.real)) % (360.0 / zc)
         r_crit = r + rho_min
         raise GeometryError(
-            f"undercut cycloid profile: the minimum radius of curvature of the tooth tips is "
+            f"undercut cycloid profile: the minimum radius of curvature of the convex part of the teeth is "
             f"{rho_min:.4g} mm (≤ 0) at profile angle {ang:.3f}° from a root (repeats on every "
             f"lobe); the generating pin radius r_rp + ΔRrp = {r:.4g} mm must stay below "
             f"{r_crit:.4g} mm for e = {e} mm, Rp + ΔRp = {R:.4g} mm — reduce pins.radius or "
@@ -407,9 +426,9 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
         points=np.empty((0, 2)), normals=np.empty((0, 2)), curvature=np.empty(0),
         segment=np.empty(0, int), param=np.empty(0), spline_points=np.empty((0, 0, 2)),
     )
-    # dense samples: uniform in s, [−s_h, s_h) per segment, counter-clockwise
+    # dense samples: equal arc length, [−s_h, s_h) per segment, counter-clockwise
     n = samples_per_segment
-    s1 = -s_h + 2 * s_h * np.arange(n) / n
+    s1 = _arc_length_params(R, e, a, r, s_h, n)[:-1]
     seg = np.repeat(np.arange(zc), n)
     ss = np.tile(s1, zc)
     P, P1, P2 = profile_eval(prof, seg, ss, derivatives=True)
@@ -424,7 +443,7 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
             "the profile folds over itself where the pitch-error rotation blends between teeth; "
             f"the pitch errors (max |E_t| = {np.max(np.abs(pitch_errors(case))):.4g} mm) are far "
             "too large — they are meant to be micrometres")
-    sp = np.linspace(-s_h, s_h, spline_points)
+    sp = _arc_length_params(R, e, a, r, s_h, spline_points - 1)
     spl = profile_eval(prof, np.repeat(np.arange(zc), spline_points), np.tile(sp, zc))
     spl = spl.reshape(zc, spline_points)
     # make tip points shared exactly (round-off) between neighbouring segments
@@ -884,6 +903,8 @@ def _fan_holes(case: Case, bores: tuple[Circle, ...]) -> list[FanHole]:
         for h in holes:
             h.validate()
         return holes
+    if fan.outer_radius - fan.inner_radius <= 2 * fan.fillet_radius:
+        _fan_hole("hole_0", fan, angles[0], math.pi / fan.count).validate()   # raises the message
     # span from the ligament: the widest hole whose wall to every bore is ≥ ligament
     L = fan.ligament
 
