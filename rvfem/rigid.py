@@ -68,6 +68,7 @@ __all__ = [
     "handbook_load_extremes",
     "equivalent_load",
     "summarize_bearing_loads",
+    "summarize_loads",
     "classical_pin_forces",
 ]
 
@@ -435,8 +436,23 @@ def summarize_bearing_loads(loads: RigidLoads, exponent: float) -> tuple[Bearing
     tuple of BearingLoadSummary
         One per bearing, loads in N, angles in degrees.
     """
-    mags = loads.magnitude
-    theta_deg = np.degrees(loads.theta) % 360.0
+    return summarize_loads(loads.theta, loads.magnitude, exponent)
+
+
+def summarize_loads(theta: np.ndarray, magnitude: np.ndarray, exponent: float) -> tuple[BearingLoadSummary, ...]:
+    """:func:`summarize_bearing_loads` for any sampled load curves (rigid or finite-element).
+
+    Parameters
+    ----------
+    theta : ndarray (n,)
+        Crank angles, rad, uniformly covering one turn.
+    magnitude : ndarray (N, n)
+        Load magnitude of each bearing, N.
+    exponent : float
+        Exponent p of the equivalent load.
+    """
+    mags = np.asarray(magnitude, dtype=float)
+    theta_deg = np.degrees(np.asarray(theta, dtype=float)) % 360.0
     eq = np.atleast_1d(equivalent_load(mags, exponent))
     out = []
     for i in range(mags.shape[0]):
