@@ -1,0 +1,258 @@
+"""Gmsh meshing of the disc: area, physical groups, closed boundaries, quality, cache, preview.
+
+Coarse meshes keep this file fast; one test meshes the default fan-hole case at its own sizes to
+check the node budget the load cycle relies on.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+from pathlib import Path
+
+import gmsh
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from rvfem.case import load_case
+from rvfem.errors import MeshError
+from rvfem.geometry import disc_geometry
+from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, mesh_preview_png, read_msh, to_skfem
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+MIN_QUALITY = 0.5
+"""Accepted smallest minSICN (1 = equilateral). Frontal-Delaunay gives about 0.65-0.7 here."""
+
+
+def coarse(case, flank=0.6, bore=0.6, interior=3.0):
+    return case.replace(mesh=dataclasses.replace(case.mesh, size_flank=flank, size_bore=bore,
+                                                 size_interior=interior))
+
+
+@pytest.fixture(scope="module")
+def fan_case():
+    return coarse(load_case(CASES / "rv40e_fanholes.toml"))
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("meshes")
+
+
+@pytest.fixture(scope="module")
+def fan_mesh(fan_case, cache):
+    return mesh_case(fan_case, cache)
+
+
+# ------------------------------------------------------------------------------------------------
+# Independent exact area
+# ------------------------------------------------------------------------------------------------
+
+
+def classical_profile_area(Rp, e, r, zp, n=400_000):
+    """Shoelace area of a dense polygon of the classical one-tooth-difference profile
+    x = Rp cos φ − e cos Zpφ − r (cos φ − k cos Zpφ)/√S, y likewise (k = eZp/Rp)."""
+    phi = 2 * np.pi * np.arange(n) / n
+    k = e * zp / Rp
+    S = np.sqrt(1 + k * k - 2 * k * np.cos((zp - 1) * phi))
+    x = Rp * np.cos(phi) - e * np.cos(zp * phi) - r * (np.cos(phi) - k * np.cos(zp * phi)) / S
+    y = Rp * np.sin(phi) - e * np.sin(zp * phi) - r * (np.sin(phi) - k * np.sin(zp * phi)) / S
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def filleted_sector_area(ri, ro, half_span, f):
+    """Annular sector area minus the four corner pieces the fillets cut off. A corner piece lies
+    between the radial side, the arc and the fillet circle (centre at radius ρ_c = r_o − f or
+    r_i + f, at angle γ inside the side, sin γ = f/ρ_c); at radius ρ it spans the angle γ − ψ(ρ),
+    cos ψ = (ρ² + ρ_c² − f²)/(2ρρ_c) (law of cosines), between the side's tangent point and the
+    arc, integrated in polar coordinates."""
+    def corner(rc, g, outer):
+        # region between the arc (radius ro or ri), the radial side and the fillet circle:
+        # integrate over ρ between the tangent point on the side and the arc
+        t = rc * math.cos(g)
+        lo, hi = (t, ro) if outer else (ri, t)
+
+        def width(rho):          # angular width of the corner piece at radius ρ
+            cpsi = (rho * rho + rc * rc - f * f) / (2 * rho * rc)
+            return g - math.acos(max(-1.0, min(1.0, cpsi)))
+        return quad(lambda p: width(p) * p, lo, hi, epsabs=1e-13, epsrel=1e-13)[0]
+
+    go, gi = math.asin(f / (ro - f)), math.asin(f / (ri + f))
+    sector = half_span * (ro * ro - ri * ri)
+    return sector - 2 * corner(ro - f, go, True) - 2 * corner(ri + f, gi, False)
+
+
+# ------------------------------------------------------------------------------------------------
+# Tests
+# ------------------------------------------------------------------------------------------------
+
+
+def test_mesh_area_equals_exact_area(fan_case, fan_mesh):
+    geom = disc_geometry(fan_case)
+    fan = fan_case.fan_holes
+    half = math.radians(60.0) - math.asin((18.0 + fan.ligament) / 36.0)   # span from the ligament
+    hole = filleted_sector_area(fan.inner_radius, fan.outer_radius, half, fan.fillet_radius)
+    exact = (classical_profile_area(64.0, 1.3, 3.0, 40) - math.pi * 12.0**2 - 3 * math.pi * 18.0**2
+             - 3 * hole)
+    assert fan_mesh.area == pytest.approx(exact, rel=1e-3)
+    assert geom.area == pytest.approx(exact, rel=1e-5)
+
+
+def test_arrays_layout_and_orientation(fan_mesh):
+    p, t = fan_mesh.points, fan_mesh.triangles
+    assert p.dtype == np.float64 and p.flags.c_contiguous and p.shape[1] == 2
+    assert np.issubdtype(t.dtype, np.integer) and t.flags.c_contiguous and t.shape[1] == 3
+    assert fan_mesh.n_nodes == len(p) and fan_mesh.n_elements == len(t)
+    q = p[t]
+    area2 = (q[:, 1, 0] - q[:, 0, 0]) * (q[:, 2, 1] - q[:, 0, 1]) - (q[:, 1, 1] - q[:, 0, 1]) * (q[:, 2, 0] - q[:, 0, 0])
+    assert np.all(area2 > 0)                                  # counter-clockwise
+    assert np.array_equal(np.unique(t), np.arange(len(p)))   # every node used, indices contiguous
+
+
+def test_physical_groups_present_and_closed(fan_mesh):
+    expected = {"profile", "central_hole", "bore_0", "bore_1", "bore_2", "hole_0", "hole_1", "hole_2"}
+    assert set(fan_mesh.boundaries) == expected
+    # the mesh's own boundary (edges with one triangle) is exactly the union of the named curves
+    t = fan_mesh.triangles
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    uniq, count = np.unique(e, axis=0, return_counts=True)
+    free = {tuple(x) for x in uniq[count == 1]}
+    named = set()
+    for name, edges in fan_mesh.boundaries.items():
+        assert edges.shape[1] == 2 and len(edges) > 10
+        assert np.array_equal(edges[1:, 0], edges[:-1, 1]), name          # ordered along the curve
+        assert edges[-1, 1] == edges[0, 0], name                          # closed
+        assert len(np.unique(edges[:, 0])) == len(edges), name            # one loop, no revisits
+        named |= {tuple(sorted(x)) for x in edges.tolist()}
+        # disc on the left: profile counter-clockwise, holes clockwise
+        xy = fan_mesh.points[edges[:, 0]]
+        signed = 0.5 * np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1])
+        assert (signed > 0) == (name == "profile"), name
+    assert named == free
+
+
+def test_boundary_nodes_lie_on_their_features(fan_case, fan_mesh):
+    centres = [(36 * math.cos(math.radians(a)), 36 * math.sin(math.radians(a))) for a in (90, 210, 330)]
+    for i, c in enumerate(centres):
+        xy = fan_mesh.points[fan_mesh.boundary_nodes(f"bore_{i}")]
+        np.testing.assert_allclose(np.hypot(xy[:, 0] - c[0], xy[:, 1] - c[1]), 18.0, atol=1e-9)
+    xy = fan_mesh.points[fan_mesh.boundary_nodes("central_hole")]
+    np.testing.assert_allclose(np.hypot(xy[:, 0], xy[:, 1]), 12.0, atol=1e-9)
+    # profile nodes: on the spline through the analytical profile (≤ 1 µm off), radius between
+    # root and tip
+    xy = fan_mesh.points[fan_mesh.boundary_nodes("profile")]
+    rad = np.hypot(xy[:, 0], xy[:, 1])
+    assert rad.min() >= 59.7 - 1e-6 and rad.max() <= 62.3 + 1e-6
+    geom = disc_geometry(fan_case)
+    from rvfem.geometry import _closest_points        # Newton-refined distance to the profile
+    z = xy[:, 0] + 1j * xy[:, 1]
+    _, _, P, _ = _closest_points(geom.profile, z)
+    assert np.max(np.abs(z - P)) < 1e-3
+    # fan-hole nodes: inside the annulus [17, 49]
+    for name in ("hole_0", "hole_1", "hole_2"):
+        xy = fan_mesh.points[fan_mesh.boundary_nodes(name)]
+        rad = np.hypot(xy[:, 0], xy[:, 1])
+        assert rad.min() >= 17.0 - 1e-9 and rad.max() <= 49.0 + 1e-9
+
+
+def test_min_quality_above_threshold(fan_mesh):
+    assert fan_mesh.quality_measure == "minSICN"
+    assert fan_mesh.min_quality > MIN_QUALITY
+
+
+def test_cache_hit_and_miss(fan_case, fan_mesh, cache):
+    path = mesh_path(fan_case, cache)
+    assert fan_mesh.path == path and path.is_file()
+    mtime = path.stat().st_mtime_ns
+    again = mesh_case(fan_case, cache)
+    assert again.from_cache and again.path == path and path.stat().st_mtime_ns == mtime
+    assert np.array_equal(again.points, fan_mesh.points)
+    assert np.array_equal(again.triangles, fan_mesh.triangles)
+    for name, edges in fan_mesh.boundaries.items():
+        assert np.array_equal(again.boundaries[name], edges)
+    assert again.min_quality == pytest.approx(fan_mesh.min_quality, abs=1e-12)
+    # loads, material, thickness, min_wall do not shape the mesh: same file, still a hit
+    other = fan_case.replace(loads=dataclasses.replace(fan_case.loads, torque_Nm=99.0),
+                             material=dataclasses.replace(fan_case.material, youngs_modulus=1e5),
+                             cycloid=dataclasses.replace(fan_case.cycloid, thickness=12.0),
+                             mesh=dataclasses.replace(fan_case.mesh, min_wall=1.0))
+    assert mesh_key(other) == mesh_key(fan_case)
+    assert mesh_case(other, cache).from_cache
+    # a shaping input changes the key; the first call misses
+    moved = fan_case.replace(fan_holes=dataclasses.replace(fan_case.fan_holes, inner_radius=17.5))
+    assert mesh_path(moved, cache) != path
+    assert mesh_key(coarse(fan_case, flank=0.7)) != mesh_key(fan_case)
+    assert mesh_key(with_mod(fan_case, 0.001)) != mesh_key(fan_case)
+    miss = mesh_case(moved, cache)
+    assert not miss.from_cache and miss.path != path
+    # use_cache=False re-meshes in place
+    assert not mesh_case(fan_case, cache, use_cache=False).from_cache
+
+
+def with_mod(case, equidistant):
+    m = dataclasses.replace(case.cycloid.modification, equidistant=equidistant)
+    return case.replace(cycloid=dataclasses.replace(case.cycloid, modification=m))
+
+
+def test_preview_png_is_not_blank(fan_mesh, tmp_path):
+    import matplotlib.image as mpimg
+
+    out = mesh_preview_png(fan_mesh, tmp_path / "preview.png")
+    img = mpimg.imread(out)
+    assert img.ndim == 3 and img.shape[0] > 400 and img.shape[1] > 800
+    rgb = img[..., :3]
+    ink = np.mean(np.any(rgb < 0.9, axis=-1))
+    assert ink > 0.05                      # lines drawn over a good part of the picture
+    assert np.std(rgb) > 0.05
+
+
+def test_to_skfem(fan_mesh):
+    m = to_skfem(fan_mesh)
+    assert m.p.shape == (2, fan_mesh.n_nodes) and m.t.shape == (3, fan_mesh.n_elements)
+    assert m.p.flags.c_contiguous and m.t.flags.c_contiguous
+    for name, edges in fan_mesh.boundaries.items():
+        facets = m.boundaries[name]
+        assert len(facets) == len(edges)
+        got = {tuple(x) for x in np.sort(m.facets[:, facets], axis=0).T.tolist()}
+        assert got == {tuple(sorted(x)) for x in edges.tolist()}
+    # skfem's own area
+    from skfem import Basis, ElementTriP1
+    basis = Basis(m, ElementTriP1())
+    assert float(np.sum(basis.dx)) == pytest.approx(fan_mesh.area, rel=1e-12)
+
+
+def test_gmsh_session_finalizes_on_error_and_is_silent(capfd, tmp_path):
+    with pytest.raises(RuntimeError):
+        with gmsh_session():
+            assert gmsh.isInitialized()
+            raise RuntimeError("boom")
+    assert not gmsh.isInitialized()
+    with pytest.raises(MeshError, match="cannot nest"):
+        with gmsh_session():
+            with gmsh_session():
+                pass
+    assert not gmsh.isInitialized()
+    with pytest.raises(MeshError, match="no such mesh file"):
+        read_msh(tmp_path / "missing.msh")
+    capfd.readouterr()
+    case = coarse(load_case(CASES / "rv40e_solid.toml"), 0.8, 0.8, 4.0)
+    mesh_case(case, tmp_path)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_default_fanholes_case_size_and_quality(tmp_path):
+    """The project's default case at its own sizes: 10-20k nodes (the load cycle budget), good
+    quality, and the fine size really is applied along the flanks and the bores."""
+    case = load_case(CASES / "rv40e_fanholes.toml")
+    m = mesh_case(case, tmp_path)
+    assert 10_000 <= m.n_nodes <= 20_000
+    assert m.min_quality > MIN_QUALITY
+    for name, h in (("profile", case.mesh.size_flank), ("bore_0", case.mesh.size_bore)):
+        e = m.boundaries[name]
+        length = np.linalg.norm(m.points[e[:, 1]] - m.points[e[:, 0]], axis=1)
+        assert np.median(length) == pytest.approx(h, rel=0.15)
+        assert length.max() < 1.5 * h
