@@ -70,6 +70,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from matplotlib.path import Path as _MplPath
 from scipy.optimize import brentq, minimize_scalar
+from scipy.spatial import cKDTree
 
 from .case import Case
 from .errors import GeometryError
@@ -88,6 +89,7 @@ __all__ = [
     "pin_centres",
     "crank_centres",
     "pin_profile_contacts",
+    "closest_points",
     "disc_geometry",
     "check_undercut",
     "pitch_errors",
@@ -179,6 +181,8 @@ class Profile:
     segment: np.ndarray = field(repr=False)
     param: np.ndarray = field(repr=False)
     spline_points: np.ndarray = field(repr=False)
+    tree: cKDTree | None = field(default=None, repr=False)
+    """k-d tree of :attr:`points` (start values of the closest-point search)."""
 
     @property
     def tooth_difference(self) -> int:
@@ -406,7 +410,7 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
     s_h = _half_range(R, e, a, r, zc, d)
     rho_min, s_min = check_undercut(R, e, a, r, s_h)
     if rho_min <= 0.0:
-        p = _base_curve(R, e, a, r, np.array(s_min))[0] * np.exp(1j * math.radians(mod.rotation_deg))
+        p = _base_curve(R, e, a, r, np.array(s_min))[0]            # root of the base curve at 0°
         ang = math.degrees(math.atan2(p.imag, p.real)) % (360.0 / zc)
         r_crit = r + rho_min
         raise GeometryError(
@@ -454,7 +458,7 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
         blend_half_width=blend_w,
         points=_readonly(_c2xy(P)), normals=_readonly(_c2xy(normal)),
         curvature=_readonly(kappa), segment=_readonly(seg), param=_readonly(ss),
-        spline_points=_readonly(_c2xy(spl)),
+        spline_points=_readonly(_c2xy(spl)), tree=cKDTree(_c2xy(P)),
     )
 
 
@@ -524,11 +528,42 @@ class PinContacts:
     param: np.ndarray
 
 
+def closest_points(profile: Profile, xy: np.ndarray):
+    """Closest points on the actual profile to arbitrary points.
+
+    Parameters
+    ----------
+    profile : Profile
+    xy : ndarray (n, 2)
+        Points, mm.
+
+    Returns
+    -------
+    segment, param : ndarray (n,)
+        Segment and base-curve parameter of each closest point.
+    points, normals : ndarray (n, 2)
+        The closest points (mm) and the unit outward normals there.
+
+    Notes
+    -----
+    Start at the nearest dense sample, then Newton iterations on the stationarity condition
+    f(s) = (P(s) − x)·P'(s) = 0 with f' = |P'|² + (P − x)·P'' (analytic derivatives), continuing
+    across segment ends for Zp − Zc = 1 and stopping at the tip corners for Zp − Zc > 1. Converges
+    to round-off.
+    """
+    xy = np.asarray(xy, dtype=float)
+    seg, s, P, P1 = _closest_points(profile, xy[:, 0] + 1j * xy[:, 1])
+    return seg, s, _c2xy(P), _c2xy(-1j * P1 / np.abs(P1))
+
+
 def _closest_points(profile: Profile, c: np.ndarray, tol: float = 1e-15, max_iter: int = 50):
-    """Closest points on the profile to complex points c: nearest sample, then Newton on
-    f(s) = Re(conj(P(s) − c)·P'(s)) = 0. Returns (segment, s, P, P1)."""
-    pts = profile.points[:, 0] + 1j * profile.points[:, 1]
-    idx = np.argmin(np.abs(c[:, None] - pts[None, :]), axis=1)
+    """Closest points on the profile to complex points c (see :func:`closest_points`).
+    Returns (segment, s, P, P1) with complex P, P1."""
+    if profile.tree is not None:
+        idx = profile.tree.query(_c2xy(c))[1]
+    else:
+        pts = profile.points[:, 0] + 1j * profile.points[:, 1]
+        idx = np.argmin(np.abs(c[:, None] - pts[None, :]), axis=1)
     seg = profile.segment[idx].copy()
     s = profile.param[idx].copy()
     s_h = profile.half_range
@@ -565,9 +600,9 @@ def pin_profile_contacts(geom_or_case, theta: float) -> PinContacts:
 
     Parameters
     ----------
-    geom_or_case : DiscGeometry, Profile or Case
-        Pass a :class:`DiscGeometry` (or its profile) when calling this for many angles; a Case is
-        turned into a profile first (which repeats the undercut check every call).
+    geom_or_case : DiscGeometry or Case
+        Pass a :class:`DiscGeometry` when calling this for many angles; a Case is turned into a
+        profile first (which repeats the profile construction and checks on every call).
     theta : float
         Crank angle, rad.
 
@@ -985,10 +1020,11 @@ def _wall(a, b) -> Wall:
 
 
 def _profile_wall(profile: Profile, f) -> Wall:
+    """Thinnest wall between the profile (its dense samples) and a feature (exact distance). A
+    feature entirely outside the profile is caught separately in :func:`disc_geometry`."""
     pts = profile.points
     d = f.signed_distance(pts)
     i = int(np.argmin(d))
-    # a feature entirely outside the profile would show a positive distance: catch it separately
     return Wall("profile", f.name, float(d[i]), (float(pts[i, 0]), float(pts[i, 1])))
 
 
@@ -1038,12 +1074,11 @@ def disc_geometry(case: Case) -> DiscGeometry:
     thinnest = walls[0]
     min_wall = case.mesh.min_wall
     if thinnest.thickness <= 0:
-        verb = "cuts the profile" if thinnest.first == "profile" else f"overlaps {thinnest.first}"
-        who = thinnest.second
         if thinnest.first == "profile":
-            msg = f"{who} cuts the cycloid profile (it reaches {-thinnest.thickness:.3f} mm beyond the tooth roots)"
+            msg = (f"{thinnest.second} cuts the cycloid profile (overlap {-thinnest.thickness:.3f} mm; "
+                   f"root radius {profile.root_radius:.3f} mm)")
         else:
-            msg = f"{who} {verb} (overlap {-thinnest.thickness:.3f} mm)"
+            msg = f"{thinnest.second} overlaps {thinnest.first} (overlap {-thinnest.thickness:.3f} mm)"
         raise GeometryError(
             f"{msg} near ({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm; move or "
             "shrink the features (fan_holes / round_holes / crank_bearing.bore_radius / "
