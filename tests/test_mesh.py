@@ -254,3 +254,30 @@ def test_default_fanholes_case_size_and_quality(tmp_path):
         length = np.linalg.norm(m.points[e[:, 1]] - m.points[e[:, 0]], axis=1)
         assert np.median(length) == pytest.approx(h, rel=0.15)
         assert length.max() < 1.5 * h
+
+
+def test_cli_mesh_subcommand(tmp_path, capsys):
+    from rvfem.cli import main
+
+    text = (CASES / "rv40e_fanholes.toml").read_text()
+    text = text.replace("size_flank = 0.35", "size_flank = 0.8").replace("size_bore = 0.4", "size_bore = 0.8")
+    case_file = tmp_path / "coarse.toml"
+    case_file.write_text(text)
+    cache = tmp_path / "cache"
+    assert main(["mesh", str(case_file), "--cache-dir", str(cache)]) == 0
+    out = capsys.readouterr().out
+    mesh = mesh_case(load_case(case_file), cache)
+    assert mesh.from_cache
+    assert f"{mesh.n_nodes} nodes, {mesh.n_elements} linear triangles" in out
+    assert f"(minSICN) {mesh.min_quality:.3f}" in out and "generated" in out
+    png = mesh.path.with_suffix(".png")
+    assert png.is_file() and str(png) in out
+    assert main(["mesh", str(case_file), "--cache-dir", str(cache)]) == 0
+    assert "cached" in capsys.readouterr().out
+    # a geometry error is one line on stderr and exit code 2, and nothing is meshed
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("bore_radius = 18.0", "bore_radius = 22.0"))
+    assert main(["mesh", str(bad), "--cache-dir", str(tmp_path / "none")]) == 2
+    err = capsys.readouterr().err
+    assert "rvfem mesh: error:" in err and "mesh.min_wall" in err
+    assert not (tmp_path / "none").exists()
