@@ -84,7 +84,9 @@ class FootprintGrid:
     arc : ndarray (n + 1,)
         Cumulative arc length at the vertices (arc[-1] = length), mm. Column k sits at arc[k].
     centre : ndarray (2,) or None
-        Bore centre for bore grids (directions radial from it), None for the profile.
+        Bore centre for bore grids (one column per vertex, pushing radially away from it), None
+        for the profile (two columns per vertex, unit forces in x and y, so that a contact force
+        of any direction is represented exactly).
     """
 
     name: str
@@ -92,6 +94,11 @@ class FootprintGrid:
     polyline: np.ndarray
     arc: np.ndarray
     centre: np.ndarray | None = None
+
+    @property
+    def components(self) -> int:
+        """Columns per vertex: 1 (radial, bores) or 2 (x and y, profile)."""
+        return 1 if self.centre is not None else 2
 
     @property
     def length(self) -> float:
@@ -132,11 +139,25 @@ class FootprintGrid:
             best_s[better] = (self.arc[i] + t * (self.arc[i + 1] - self.arc[i]))[better]
         return best_s
 
-    def columns_at(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Global column indices (m, 2) and weights (m, 2) interpolating positions ``s``."""
+    def columns_at(self, s: np.ndarray, direction: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Columns and weights of unit forces at arc positions ``s``.
+
+        The force is shared linearly between the two neighbouring vertices. On a radial grid the
+        direction is the columns' own (``direction`` is ignored); on an x/y grid ``direction``
+        ((m, 2) unit vectors, the force on the disc) is required.
+
+        Returns
+        -------
+        cols, weights : ndarray (m, 2) radial or (m, 4) x/y
+        """
         i, t = self._locate(s)
-        cols = self.offset + np.stack([i, (i + 1) % self.count], axis=1)
-        return cols, np.stack([1.0 - t, t], axis=1)
+        j = (i + 1) % self.count
+        if self.components == 1:
+            return self.offset + np.stack([i, j], axis=1), np.stack([1.0 - t, t], axis=1)
+        d = np.asarray(direction, dtype=float)
+        cols = self.offset + np.stack([2 * i, 2 * i + 1, 2 * j, 2 * j + 1], axis=1)
+        w = np.stack([(1 - t) * d[:, 0], (1 - t) * d[:, 1], t * d[:, 0], t * d[:, 1]], axis=1)
+        return cols, w
 
 
 @dataclass(frozen=True)
@@ -213,8 +234,10 @@ def build_interface(basis, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
     rigid_modes : ndarray (n_dofs, 3)
         Rigid-body modes (x translation, y translation, rotation about the origin).
     bore_centres : dict name → (2,)
-        Centre of each bore: its columns push radially away from it (into the disc). Boundaries
-        not listed push along the inward normal of an outer boundary.
+        Centre of each bore: one column per vertex, pushing radially away from the centre (into
+        the disc). Boundaries not listed get two columns per vertex (x and y), so that contact
+        forces keep their exact direction (the profile: a direction interpolated between vertex
+        normals is off by several degrees near the inflection points of coarse profiles).
     half_width : dict name → float
         Footprint half-width a per boundary, mm.
     n_gauss : int
@@ -247,19 +270,16 @@ def build_interface(basis, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
         grid = FootprintGrid(name, offset, poly, arc, None if centre is None else np.asarray(centre, float))
         grids[name] = grid
         count = grid.count
+        ncomp = grid.components
         a = float(half_width[name])
         widths[name] = a
         s_k = arc[:-1]
-        x_k = poly
-        if centre is None:
-            h = 0.25 * float(seglen.min())
-            tang = grid.point_at(s_k + h) - grid.point_at(s_k - h)
-            tang /= np.linalg.norm(tang, axis=1)[:, None]
-            d_k = np.stack([-tang[:, 1], tang[:, 0]], axis=1)  # left of a CCW outer loop = inward
-        else:
-            d_k = x_k - centre
+        if ncomp == 1:
+            d_k = poly - centre
             d_k /= np.linalg.norm(d_k, axis=1)[:, None]
-        points.append(x_k)
+        else:
+            d_k = np.tile(np.eye(2), (count, 1))
+        points.append(np.repeat(poly, ncomp, axis=0))
         directions.append(d_k)
 
         # DOFs of each polyline edge: vertex x/y dofs, and the P2 midpoint dofs
@@ -295,10 +315,13 @@ def build_interface(basis, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
                         dofs = [dof0[:, e], dof1[:, e]]
                     for N, d in zip(shape, dofs):
                         w = float(np.dot(N, dens))
-                        rows.extend([d[0], d[1]])
-                        cols.extend([offset + k, offset + k])
-                        vals.extend([w * d_k[k, 0], w * d_k[k, 1]])
-        offset += count
+                        for c in range(ncomp):
+                            col = offset + ncomp * k + c
+                            dk = d_k[ncomp * k + c]
+                            rows.extend([d[0], d[1]])
+                            cols.extend([col, col])
+                            vals.extend([w * dk[0], w * dk[1]])
+        offset += ncomp * count
 
     B = sp.csc_matrix((vals, (rows, cols)), shape=(basis.N, offset))
     B.sum_duplicates()

@@ -110,12 +110,14 @@ class DiscSystem:
     pin_model: str
     geometry: object
     bearing_stiffness_scale: float = 1.0
+    pin_stiffness_N_per_mm: float | None = None
     setup_seconds: dict = field(default_factory=dict)
 
 
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
                  stiffness_scale: float = 1.0, pin_model: str | None = None,
-                 bearing_stiffness_scale: float = 1.0) -> DiscSystem:
+                 bearing_stiffness_scale: float = 1.0,
+                 pin_stiffness_N_per_mm: float | None = None) -> DiscSystem:
     """Assemble and factorise the disc and build its footprint interface.
 
     Parameters
@@ -130,8 +132,10 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     stiffness_scale : float
         Multiplies the disc's Young's modulus (1000 gives the "rigid disc" limit of the design
         notes' validation ladder).
-    pin_model : {"rigid", "hertz"}, optional
-        Default ``case.pins.model``.
+    pin_model : {"rigid", "hertz", "linear"}, optional
+        Default ``case.pins.model``. ``"linear"`` (a validation device: the classical pin-force
+        distribution assumes pin deflections proportional to the forces) needs
+        ``pin_stiffness_N_per_mm``.
     bearing_stiffness_scale : float
         Multiplies the ``rigid_bore`` bearing stiffness (for the rigid-limit checks).
     """
@@ -141,6 +145,10 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     order = order or case.analysis.element_order
     bearing_model = bearing_model or case.crank_bearing.model
     pin_model = pin_model or case.pins.model
+    if pin_model not in ("rigid", "hertz", "linear"):
+        raise CaseError(f"pin model must be 'rigid', 'hertz' or 'linear', got {pin_model!r}")
+    if pin_model == "linear" and not (pin_stiffness_N_per_mm and pin_stiffness_N_per_mm > 0):
+        raise CaseError("pin model 'linear' needs a positive pin_stiffness_N_per_mm")
     if bearing_model not in ("rollers", "rigid_bore"):
         raise CaseError(f"bearing model must be 'rollers' or 'rigid_bore', got {bearing_model!r}")
     if case.analysis.friction > 0:
@@ -173,7 +181,8 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
-                      stiffness_scale, pin_model, geometry, bearing_stiffness_scale, times)
+                      stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
+                      pin_stiffness_N_per_mm, times)
 
 
 def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
@@ -189,9 +198,9 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     pc = pin_profile_contacts(system.geometry, theta)
     zp = case.pins.count
     s = prof.arc_of(np.asarray(pc.point))
-    cols, wts = prof.columns_at(s)
+    cols, wts = prof.columns_at(s, -np.asarray(pc.normal))   # pins push along the inward normal
     rows_w = [cols.ravel()]
-    cols_w = [np.repeat(np.arange(zp), 2)]
+    cols_w = [np.repeat(np.arange(zp), cols.shape[1])]
     vals_w = [wts.ravel()]
     gap0 = np.zeros(zp)
     offset = np.zeros(zp)
@@ -203,7 +212,9 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
         gap0[:] = pc.gap
     else:
         offset[:] = -np.asarray(pc.gap)
-        laws.append((np.arange(zp), contact.palmgren_law(case.cycloid.thickness, contacts=1)))
+        law = (contact.palmgren_law(case.cycloid.thickness, contacts=1) if system.pin_model == "hertz"
+               else contact.linear_law(system.pin_stiffness_N_per_mm))
+        laws.append((np.arange(zp), law))
 
     centres = bore_centres(case)
     b = case.crank_bearing
