@@ -658,8 +658,10 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
             "(analysis.max_active_set_iterations raises the bound)."
         )
 
+    # λ from the last Newton step satisfies the (linear) equilibrium equations to round-off and
+    # the spring laws to the tolerance above; it is not replaced by q(δ), which would trade the
+    # former for the latter
     lam = np.where(sig & ~active, 0.0, lam)
-    lam[spring] = q[spring]
     Rc = Rfull
     res_f = float(np.linalg.norm(Rc[:, :2].T @ lam))
     residual = {

@@ -1,0 +1,126 @@
+"""Contact solver against closed forms: Hertz line contact and the Signorini conditions.
+
+An elastic cylinder (plane stress, thickness L) is squeezed between two rigid flat plates; every
+boundary vertex near the two poles is a Signorini contact. Hertz (Johnson, *Contact Mechanics*,
+§4.3, a cylinder on a rigid flat, plane stress E* = E) gives the half-width b = √(4FR/(πE*L))
+and the peak pressure p0 = 2F/(πbL) from the contact force F alone.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from rvfem import contact, fem
+from rvfem.errors import ContactError
+from rvfem.mesh import gmsh_session
+
+R, L, E, NU = 10.0, 1.0, 2.0e5, 0.3
+H_CONTACT = 0.03  # element size in the contact zones, mm
+
+
+@pytest.fixture(scope="module")
+def squeezed_cylinder():
+    """P1 model of the cylinder, its rim interface and the Signorini contact set near the poles."""
+    with gmsh_session("cylinder") as gmsh:
+        gmsh.model.occ.addDisk(0, 0, 0, R, R)
+        gmsh.model.occ.synchronize()
+        field = gmsh.model.mesh.field
+        f = field.add("MathEval")
+        # uniform H_CONTACT within |x| < 1 near both poles, growing away from them
+        field.setString(f, "F", f"{H_CONTACT} + 0.2*Max(Abs(x) - 1.0, 0) + 0.2*Max({R} - 0.8 - Abs(y), 0)")
+        field.setAsBackgroundMesh(f)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
+        gmsh.model.mesh.generate(2)
+        tags, xyz, _ = gmsh.model.mesh.getNodes()
+        _, _, tri = gmsh.model.mesh.getElements(2)
+        _, _, lines = gmsh.model.mesh.getElements(1)
+    index = np.zeros(int(tags.max()) + 1, dtype=int)
+    index[tags.astype(int)] = np.arange(len(tags))
+    points = xyz.reshape(-1, 3)[:, :2]
+    triangles = index[tri[0].astype(int)].reshape(-1, 3)
+    rim = index[lines[0].astype(int)].reshape(-1, 2)
+    model = fem.build_model(points, triangles, E, NU, L, order=1)
+    factor = fem.factorize(model)
+    iface = contact.build_interface(model.basis, {"rim": rim}, fem.rigid_body_modes(model), {},
+                                    {"rim": 0.25 * H_CONTACT})
+    grid = iface.grids["rim"]
+    near = np.flatnonzero(np.abs(grid.polyline[:, 0]) < 0.9)      # candidate vertices
+    cols, w = grid.columns_at(grid.arc[near], -grid.polyline[near] / R)  # push towards the centre
+    n = len(near)
+    W = sp.csc_matrix((w.ravel(), (cols.ravel(), np.repeat(np.arange(n), cols.shape[1]))),
+                      shape=(iface.n_columns, n))
+    return model, factor, iface, grid.polyline[near], W
+
+
+def _squeeze(squeezed_cylinder, approach):
+    model, factor, iface, xy, W = squeezed_cylinder
+    # plates at y = ±(R − approach): gap of each vertex to its plate
+    gap0 = (R - np.abs(xy[:, 1])) - approach
+    cset = contact.ContactSet(W, np.ones(len(xy), bool), gap0, np.zeros(len(xy)), np.zeros(len(xy)), [])
+    comp = contact.Compliance(factor.solve, iface.B)
+    # the round body's rotation and x translation are not resisted by frictionless plates
+    sol = contact.solve_contact(cset, iface, comp, None, rigid_dofs=(1,), max_iterations=60)
+    return sol, xy
+
+
+def test_hertz_half_width_and_peak_pressure(squeezed_cylinder):
+    sol, xy = _squeeze(squeezed_cylinder, approach=0.02)
+    top = xy[:, 1] > 0
+    force = sol.force[top].sum()
+    b_hertz = math.sqrt(4 * force * R / (math.pi * E * L))
+    p_hertz = 2 * force / (math.pi * b_hertz * L)
+    x_top = xy[top, 0]
+    loaded = sol.force[top] > 0
+    # the edge of contact lies between the last loaded and the first unloaded vertex
+    b_lo = np.abs(x_top[loaded]).max()
+    b_hi = np.abs(x_top[~loaded]).min()
+    b_fe = 0.5 * (b_lo + b_hi)
+    assert b_hertz / H_CONTACT > 8, "the contact must span many elements for this check"
+    assert b_fe == pytest.approx(b_hertz, rel=0.05)
+    # nodal force / tributary length is the pressure at the centre vertex
+    p_fe = sol.force[top].max() / (H_CONTACT * L)
+    assert p_fe == pytest.approx(p_hertz, rel=0.03)
+    # the two plates' forces balance (equilibrium of the floating cylinder)
+    assert abs(sol.vectors[:, 1].sum()) <= 1e-9 * force
+
+
+def test_signorini_conditions_hold(squeezed_cylinder):
+    sol, _ = _squeeze(squeezed_cylinder, approach=0.01)
+    assert sol.force.min() >= 0.0                      # no tensile contact force
+    assert sol.gap.min() >= -1e-9                      # no penetration
+    scale = sol.force.max()
+    assert np.all(np.abs(sol.force * sol.gap) <= 1e-9 * scale)   # complementarity
+
+
+def test_force_grows_as_approach_to_the_power_of_hertz(squeezed_cylinder):
+    # rigid plates on a cylinder: the load–approach law is nearly linear (log-corrected) in 2D;
+    # doubling the approach must at least double the force but not more than 2.3×
+    f1 = _squeeze(squeezed_cylinder, 0.01)[0].force.sum()
+    f2 = _squeeze(squeezed_cylinder, 0.02)[0].force.sum()
+    assert 2.0 < f2 / f1 < 2.3
+
+
+def test_unsettled_active_set_names_the_label(squeezed_cylinder):
+    model, factor, iface, xy, W = squeezed_cylinder
+    gap0 = (R - np.abs(xy[:, 1])) - 0.02
+    cset = contact.ContactSet(W, np.ones(len(xy), bool), gap0, np.zeros(len(xy)), np.zeros(len(xy)), [])
+    comp = contact.Compliance(factor.solve, iface.B)
+    with pytest.raises(ContactError, match="did not settle at crank angle 12.00°"):
+        contact.solve_contact(cset, iface, comp, None, rigid_dofs=(1,), max_iterations=1,
+                              label="at crank angle 12.00° ")
+
+
+def test_footprint_columns_carry_unit_force_and_exact_moment(squeezed_cylinder):
+    _, _, iface, _, _ = squeezed_cylinder
+    res = iface.resultants
+    force = np.einsum("ij,ij->i", res[:, :2], iface.directions)
+    assert np.allclose(force, 1.0, atol=1e-12)
+    # moment about the origin of a unit force at a rim point: x × d (the footprint is symmetric)
+    moment = iface.points[:, 0] * iface.directions[:, 1] - iface.points[:, 1] * iface.directions[:, 0]
+    assert np.allclose(res[:, 2], moment, atol=1e-3)

@@ -1,0 +1,214 @@
+"""The flexible load cycle: rigid limits, equilibrium, symmetry and the flexibility effect.
+
+Coarse meshes (0.6 mm at the flanks and bores) keep this file fast; the mesh-convergence study
+with the default sizes lives in ``benchmarks/bench_convergence.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rvfem import compare, cycle, rigid
+from rvfem.case import case_from_dict, case_to_dict, load_case
+from rvfem.errors import CaseError, ContactError
+from rvfem.mesh import mesh_case
+
+from conftest import CASES_DIR
+
+STEP = np.radians(10.0)
+THETA = np.arange(36) * STEP   # 10° steps: the 120° shifts of three cranks are whole samples
+
+
+def coarse(name: str, **changes) -> "Case":
+    data = case_to_dict(load_case(CASES_DIR / f"{name}.toml"))
+    data["mesh"].update(size_flank=0.6, size_bore=0.6, size_interior=4.0)
+    for table, values in changes.items():
+        data[table].update(values)
+    return case_from_dict(data, source=f"{name} (coarse)")
+
+
+@pytest.fixture(scope="module")
+def mesh_dir(tmp_path_factory):
+    return tmp_path_factory.mktemp("meshes")
+
+
+@pytest.fixture(scope="module")
+def solid(mesh_dir):
+    case = coarse("rv40e_solid")
+    return case, mesh_case(case, mesh_dir)
+
+
+@pytest.fixture(scope="module")
+def fanholes(mesh_dir):
+    case = coarse("rv40e_fanholes")
+    return case, mesh_case(case, mesh_dir)
+
+
+# ------------------------------------------------------------------------------------------------
+# rigid limits
+# ------------------------------------------------------------------------------------------------
+
+
+def test_rigid_limit_reproduces_handbook_and_classical_pin_forces(solid):
+    """Disc 10⁶× stiffer, bearings 1000× stiffer, linear pin springs: the handbook's assumptions
+    (rigid disc held at its centre, pin deflections ∝ the disc rotation's lever arms). Then the
+    FE must give the classical pin forces and the handbook bearing loads."""
+    case, mesh = solid
+    system = cycle.build_system(case, mesh, stiffness_scale=1e6, bearing_model="rigid_bore",
+                                bearing_stiffness_scale=1e3, pin_model="linear",
+                                pin_stiffness_N_per_mm=3e5)
+    result = cycle.load_cycle(system, THETA, saved_angles_deg=())
+    hb = rigid.handbook_bearing_loads(case, THETA)
+    f_max = hb.magnitude.max()
+    assert np.abs(result.bearing_loads.T - hb.magnitude).max() <= 0.03 * f_max
+    # the vectors too, not only the magnitudes
+    hb_vec = np.stack([hb.fx, hb.fy], axis=-1).transpose(1, 0, 2)
+    assert np.abs(result.bearing_forces - hb_vec).max() <= 0.03 * f_max
+    pins = rigid.classical_pin_forces(case, THETA, exact_moment=True)
+    classical = pins.magnitude.T
+    assert np.abs(result.pin_forces - classical).max() <= 0.01 * classical.max()
+    # half of the pins carry load (0 < φ < π), the other half touch without load
+    assert set(result.pins_in_contact) == {case.pins.count // 2}
+
+
+def test_rigid_disc_shares_load_equally_with_linear_rollers(solid):
+    """Disc 1000× stiffer, zero clearance, linear roller springs: each bearing carries 1/N of the
+    FE's own pin resultant plus the torque share (exact for linear springs on a rigid disc)."""
+    _, mesh = solid
+    case = coarse("rv40e_solid", crank_bearing={"stiffness_law": "linear", "linear_stiffness_N_per_mm": 2e5})
+    system = cycle.build_system(case, mesh, stiffness_scale=1e3)
+    result = cycle.load_cycle(system, THETA, saved_angles_deg=())
+    share = compare.equal_share_forces(case, result)
+    assert np.abs(result.bearing_forces - share).max() <= 0.005 * result.bearing_loads.max()
+
+
+def test_rigid_disc_with_palmgren_rollers_deviates_from_equal_share_by_the_nonlinearity(solid):
+    """With Palmgren's law (Q ∝ δ^1.11) the more deflected bearing is the stiffer one and draws
+    more than its equal share; the deviation is small but clearly above the linear case's."""
+    case, mesh = solid
+    system = cycle.build_system(case, mesh, stiffness_scale=1e3)
+    result = cycle.load_cycle(system, THETA, saved_angles_deg=())
+    share = compare.equal_share_forces(case, result)
+    dev = np.abs(result.bearing_forces - share).max() / result.bearing_loads.max()
+    assert 0.005 < dev < 0.05
+
+
+# ------------------------------------------------------------------------------------------------
+# invariants of every solve
+# ------------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def solid_cycle(solid):
+    case, mesh = solid
+    system = cycle.build_system(case, mesh)
+    return case, system, cycle.load_cycle(system, THETA, saved_angles_deg=(0.0,))
+
+
+def test_equilibrium_closes_to_round_off(solid_cycle):
+    case, system, result = solid_cycle
+    assert result.equilibrium_residual.max() < 1e-9
+    # carrier: the bearings' moment about the disc centre is the disc torque at every angle
+    c = cycle.bore_centres(case)
+    moment = (c[None, :, 0] * result.bearing_forces[..., 1] - c[None, :, 1] * result.bearing_forces[..., 0]).sum(axis=1)
+    assert np.allclose(moment, case.loads.disc_torque_Nmm, rtol=1e-9)
+    # pins + bearings of one solution: no net force and no net moment on the disc
+    for th in THETA[::6]:
+        one = cycle.solve_angle(system, th)
+        total = one.pin_vectors.sum(axis=0) + one.bearing_forces.sum(axis=0)
+        assert np.abs(total).max() <= 1e-9 * one.bearing_loads.max()
+
+
+def test_bearing_curves_are_shifts_by_360_over_n(solid_cycle):
+    """Zc = 39 is divisible by N = 3: bearing i sees bearing 0's loads 120°·i later. The mesh is
+    unstructured, so the symmetry holds to discretisation accuracy, not to round-off."""
+    case, _, result = solid_cycle
+    loads = result.bearing_loads
+    shift = int(round(2 * math.pi / case.cranks.count / STEP))
+    for i in range(1, case.cranks.count):
+        assert np.abs(loads[:, i] - np.roll(loads[:, 0], i * shift)).max() <= 0.005 * loads.max()
+
+
+def test_loads_scale_with_torque_only_nonlinearly_through_the_contacts(solid):
+    """Doubling the torque doubles the handbook loads; the FE loads rise by almost exactly 2× too
+    (the active sets barely change), a check that the torque enters with the right units."""
+    case, mesh = solid
+    double = coarse("rv40e_solid", loads={"torque_Nm": 2 * case.loads.torque_Nm})
+    r1 = cycle.solve_angle(cycle.build_system(case, mesh), 0.3)
+    r2 = cycle.solve_angle(cycle.build_system(double, mesh), 0.3)
+    assert r2.bearing_loads == pytest.approx(2 * r1.bearing_loads, rel=0.05)
+
+
+def test_clearance_and_modification_reduce_contact_and_stay_in_equilibrium(solid):
+    case, mesh = solid
+    data = case_to_dict(case)
+    data["crank_bearing"]["radial_clearance"] = 0.005
+    data["cycloid"]["modification"] = {"equidistant": 0.01, "shift": -0.005, "rotation_deg": 0.0}
+    modified = case_from_dict(data, source="modified")
+    system = cycle.build_system(modified, mesh_case(modified, mesh.path.parent))
+    base = cycle.solve_angle(cycle.build_system(case, mesh), 0.0)
+    mod = cycle.solve_angle(system, 0.0)
+    assert mod.pins_in_contact < base.pins_in_contact
+    assert mod.solution.residual["relative"] < 1e-9
+    assert mod.bearing_loads.max() > base.bearing_loads.max()
+
+
+def test_field_of_a_saved_angle_reproduces_the_contact_displacements(solid_cycle):
+    case, system, result = solid_cycle
+    (theta, u), = [(t, u) for t, u in result.fields.items() if abs(t) < 1e-12]
+    one = cycle.solve_angle(system, theta)
+    # the roller approach predicted by the small system equals the one read off the full field
+    B, W = system.interface.B, one.contacts.W
+    v_field = np.asarray(W.T @ (B.T @ u))
+    Rc = np.asarray(W.T @ system.interface.resultants)
+    v_small = (np.asarray(W.T @ system.compliance.C @ W @ one.solution.force)).ravel() + Rc @ one.solution.rigid
+    assert np.allclose(v_field, v_small, atol=1e-9 * np.abs(v_field).max())
+
+
+# ------------------------------------------------------------------------------------------------
+# the flexibility effect and the comparison
+# ------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("bearing_model", ["rollers", "rigid_bore"])
+def test_fan_holes_raise_the_maximum_bearing_load(solid, fanholes, bearing_model):
+    maxima = {}
+    for name, (case, mesh) in (("solid", solid), ("fanholes", fanholes)):
+        system = cycle.build_system(case, mesh, bearing_model=bearing_model)
+        result = cycle.load_cycle(system, THETA, saved_angles_deg=())
+        maxima[name] = compare.rigid_vs_flexible(case, result).bearings[0].delta_max_percent
+    assert maxima["fanholes"] > maxima["solid"] + 3.0
+
+
+def test_comparison_reports_life_ratio_consistent_with_loads(solid_cycle):
+    case, _, result = solid_cycle
+    comp = compare.rigid_vs_flexible(case, result)
+    for b in comp.bearings:
+        assert b.life_ratio == pytest.approx((b.rigid.equivalent_N / b.flexible.equivalent_N) ** (10 / 3))
+        assert b.flexible.L10h / b.rigid.L10h == pytest.approx(b.life_ratio)
+        assert b.delta_max_percent == pytest.approx(100 * (b.flexible.max_N / b.rigid.max_N - 1))
+
+
+# ------------------------------------------------------------------------------------------------
+# errors
+# ------------------------------------------------------------------------------------------------
+
+
+def test_friction_is_refused_with_a_clear_message(solid):
+    case, mesh = solid
+    data = case_to_dict(case)
+    data["analysis"]["friction"] = 0.05
+    with pytest.raises(CaseError, match="analysis.friction"):
+        cycle.build_system(case_from_dict(data, source="f.toml"), mesh)
+
+
+def test_active_set_bound_names_the_crank_angle(solid):
+    case, mesh = solid
+    data = case_to_dict(case)
+    data["analysis"]["max_active_set_iterations"] = 1
+    tight = case_from_dict(data, source="tight.toml")
+    with pytest.raises(ContactError, match=r"crank angle 0\.00°"):
+        cycle.solve_angle(cycle.build_system(tight, mesh), 0.0)
