@@ -946,8 +946,10 @@ def remove_rigid_motion(
 # Factorisation
 # --------------------------------------------------------------------------------------------
 
-#: Order in which ``solver="auto"`` tries the backends. Measured with
-#: ``benchmarks/bench_factorization.py`` (see its docstring for the numbers).
+#: Order in which ``solver="auto"`` tries the backends, by measurement
+#: (``benchmarks/bench_factorization.py``, numbers in its docstring): on a 15k-vertex annulus
+#: CHOLMOD back-substitutes 1000 columns in 3.8 s (P1) / 24 s (P2), PARDISO in 5.1 s / 29 s,
+#: SuperLU (symmetric mode, MMD on AᵀA+A) in 7.1 s / 65 s; factorisation 0.2–2.6 s for all.
 SOLVER_PREFERENCE: tuple[str, ...] = ("cholmod", "pardiso", "superlu")
 
 

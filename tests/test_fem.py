@@ -447,13 +447,13 @@ def test_kirsch_full_field_away_from_the_hole(kirsch_p2):
     far = r >= 1.5 * a
     ref = s_ex(*pts[far].T)
     for got, want in zip((st.nodal.sxx, st.nodal.syy, st.nodal.sxy), ref):
-        assert np.abs(got[far] - want).max() / s0 < 5e-3
+        assert np.abs(got[far] - want).max() / s0 < 5e-3  # measured ≤ 3.6e-3 (P2, 96 chords)
     # displacement: equal up to a rigid motion (the FE body floats)
     ux, uy = u_ex(*m.node_coords.T)
     ue = np.zeros(m.n_dofs)
     ue[m.node_dofs[:, 0]], ue[m.node_dofs[:, 1]] = ux, uy
     diff, _ = fem.remove_rigid_motion(m, u - ue)
-    assert np.abs(diff).max() / np.abs(ue).max() < 2e-3
+    assert np.abs(diff).max() / np.abs(ue).max() < 5e-4       # measured 2.0e-4
 
 
 # --------------------------------------------------------------------------------------------
