@@ -41,9 +41,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from .errors import ContactError
+from .evaluation import PALMGREN_COEFFICIENT
 
 log = logging.getLogger(__name__)
 
@@ -59,11 +59,6 @@ __all__ = [
     "solve_contact",
 ]
 
-PALMGREN_COEFF = 3.84e-5
-"""Palmgren's line-contact approach coefficient for steel on steel, δ = 3.84e-5·Q^0.9/L^0.8 (mm, N)
-(Harris & Kotzalas, *Rolling Bearing Analysis*, line contact; one roller–raceway contact)."""
-
-
 # ------------------------------------------------------------------------------------------------
 # Footprint grids and the load operator B
 # ------------------------------------------------------------------------------------------------
@@ -71,7 +66,7 @@ PALMGREN_COEFF = 3.84e-5
 
 @dataclass(frozen=True)
 class FootprintGrid:
-    """The footprint columns of one closed boundary: one column per boundary vertex.
+    """The footprint columns of one closed boundary: one or two columns per boundary vertex.
 
     Attributes
     ----------
@@ -79,10 +74,8 @@ class FootprintGrid:
         Boundary name (``"profile"``, ``"bore_0"``, ...).
     offset : int
         Index of the grid's first column among all columns of the interface.
-    polyline : ndarray (n, 2)
-        Boundary vertices in order along the curve (counter-clockwise), mm; closed.
-    arc : ndarray (n + 1,)
-        Cumulative arc length at the vertices (arc[-1] = length), mm. Column k sits at arc[k].
+    chain : rvfem.fem.BoundaryChain
+        The boundary loop; column k sits at its vertex k (arc length ``chain.s[k]``).
     centre : ndarray (2,) or None
         Bore centre for bore grids (one column per vertex, pushing radially away from it), None
         for the profile (two columns per vertex, unit forces in x and y, so that a contact force
@@ -91,8 +84,7 @@ class FootprintGrid:
 
     name: str
     offset: int
-    polyline: np.ndarray
-    arc: np.ndarray
+    chain: object
     centre: np.ndarray | None = None
 
     @property
@@ -101,43 +93,18 @@ class FootprintGrid:
         return 1 if self.centre is not None else 2
 
     @property
-    def length(self) -> float:
-        return float(self.arc[-1])
+    def count(self) -> int:
+        """Number of vertices."""
+        return len(self.chain.vertices) - 1
 
     @property
-    def count(self) -> int:
-        return len(self.polyline)
-
-    def point_at(self, s: np.ndarray) -> np.ndarray:
-        """Points of the polyline at arc lengths ``s`` (wrapped), mm."""
-        i, t = self._locate(s)
-        j = (i + 1) % self.count
-        return (1 - t)[:, None] * self.polyline[i] + t[:, None] * self.polyline[j]
-
-    def _locate(self, s):
-        s = np.mod(np.asarray(s, dtype=float), self.length)
-        i = np.clip(np.searchsorted(self.arc, s, side="right") - 1, 0, self.count - 1)
-        t = (s - self.arc[i]) / (self.arc[i + 1] - self.arc[i])
-        return i, t
+    def polyline(self) -> np.ndarray:
+        """Vertex coordinates in loop order, (count, 2), mm."""
+        return self.chain.points[:-1]
 
     def arc_of(self, points: np.ndarray) -> np.ndarray:
-        """Arc length of the polyline point closest to each of ``points`` (projection), mm."""
-        n = self.count
-        tree = cKDTree(self.polyline)
-        _, nearest = tree.query(points)
-        best_s = np.empty(len(points))
-        best_d = np.full(len(points), np.inf)
-        for shift in (-1, 0):  # the edge before and the edge after the nearest vertex
-            i = (nearest + shift) % n
-            j = (i + 1) % n
-            a, b = self.polyline[i], self.polyline[j]
-            ab = b - a
-            t = np.clip(np.einsum("ij,ij->i", points - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
-            d = np.linalg.norm(a + t[:, None] * ab - points, axis=1)
-            better = d < best_d
-            best_d[better] = d[better]
-            best_s[better] = (self.arc[i] + t * (self.arc[i + 1] - self.arc[i]))[better]
-        return best_s
+        """Arc length of the boundary point closest to each of ``points``, mm."""
+        return self.chain.locate(points)[0]
 
     def columns_at(self, s: np.ndarray, direction: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Columns and weights of unit forces at arc positions ``s``.
@@ -150,7 +117,10 @@ class FootprintGrid:
         -------
         cols, weights : ndarray (m, 2) radial or (m, 4) x/y
         """
-        i, t = self._locate(s)
+        arc = self.chain.s
+        s = np.mod(np.asarray(s, dtype=float), arc[-1])
+        i = np.clip(np.searchsorted(arc, s, side="right") - 1, 0, self.count - 1)
+        t = (s - arc[i]) / (arc[i + 1] - arc[i])
         j = (i + 1) % self.count
         if self.components == 1:
             return self.offset + np.stack([i, j], axis=1), np.stack([1.0 - t, t], axis=1)
@@ -187,48 +157,18 @@ class Interface:
         return self.B.shape[1]
 
 
-def _ordered_loop(edges: np.ndarray) -> np.ndarray:
-    """Vertex indices of a closed loop given its edges (k, 2) in any order/orientation."""
-    nbrs: dict[int, list[int]] = {}
-    for a, b in edges:
-        nbrs.setdefault(int(a), []).append(int(b))
-        nbrs.setdefault(int(b), []).append(int(a))
-    start = int(edges[0, 0])
-    loop = [start]
-    prev, cur = None, start
-    while True:
-        nxt = [v for v in nbrs[cur] if v != prev]
-        if not nxt:
-            break
-        prev, cur = cur, nxt[0]
-        if cur == start:
-            break
-        loop.append(cur)
-    if len(loop) != len(nbrs):
-        raise ValueError("boundary edges do not form one closed loop")
-    return np.asarray(loop)
-
-
-def _facet_lookup(mesh) -> tuple[np.ndarray, np.ndarray]:
-    f = np.sort(mesh.facets, axis=0)
-    keys = f[0].astype(np.int64) * mesh.p.shape[1] + f[1]
-    order = np.argsort(keys)
-    return keys[order], order
-
-
-def build_interface(basis, boundaries: dict[str, np.ndarray], rigid_modes: np.ndarray,
-                    bore_centres: dict[str, np.ndarray], half_width: dict[str, float],
-                    n_gauss: int = 6) -> Interface:
+def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.ndarray,
+                    bore_centres: dict[str, np.ndarray], half_width: dict[str, float]) -> Interface:
     """Build the footprint columns and the load operator B on the named boundaries.
 
     Column k of a boundary sits at its k-th vertex; its unit force is spread over the arc
-    |s − s_k| ≤ a with the elliptical density √(1 − ((s − s_k)/a)²) and turned into consistent
-    nodal loads with the element's shape functions on the boundary edges (Gauss quadrature).
+    |s − s_k| ≤ a with the Hertz (elliptical) density and turned into consistent nodal loads
+    (:func:`rvfem.fem.footprint_weights`, :func:`rvfem.fem.load_operator`).
 
     Parameters
     ----------
-    basis : skfem.CellBasis
-        Vector P1 or P2 basis of the disc (straight-sided triangles).
+    model : rvfem.fem.FEModel
+        P1 or P2 model of the disc.
     boundaries : dict name → (k, 2) int
         Boundary edges (mesh vertex indices) of each closed boundary that gets columns.
     rigid_modes : ndarray (n_dofs, 3)
@@ -240,98 +180,36 @@ def build_interface(basis, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
         normals is off by several degrees near the inflection points of coarse profiles).
     half_width : dict name → float
         Footprint half-width a per boundary, mm.
-    n_gauss : int
-        Gauss points per edge piece for the footprint density.
     """
-    mesh = basis.mesh
-    order2 = basis.elem.elems[0].maxdeg > 1 if hasattr(basis.elem, "elems") else False
-    keys, korder = _facet_lookup(mesh)
-    nverts = mesh.p.shape[1]
-    gx, gw = np.polynomial.legendre.leggauss(n_gauss)
-    gx = 0.5 * (gx + 1.0)
-    gw = 0.5 * gw
+    from . import fem
 
-    rows, cols, vals = [], [], []
-    points, directions, grids, widths = [], [], {}, {}
+    blocks, points, directions, grids, widths = [], [], [], {}, {}
     offset = 0
     for name, edges in boundaries.items():
-        loop = _ordered_loop(np.asarray(edges))
-        poly = mesh.p[:, loop].T.copy()
+        chains = fem.boundary_chains(model, edges)
+        if len(chains) != 1 or not chains[0].closed:
+            raise ValueError(f"boundary '{name}' is not one closed loop")
+        chain = chains[0]
         centre = bore_centres.get(name)
-        # orientation: the disc lies to the left of an outer boundary traversed counter-clockwise;
-        # for a hole (bore) the disc is outside. Make every loop counter-clockwise.
-        area2 = np.sum(poly[:, 0] * np.roll(poly[:, 1], -1) - np.roll(poly[:, 0], -1) * poly[:, 1])
-        if area2 < 0:
-            loop, poly = loop[::-1].copy(), poly[::-1].copy()
-        seg = np.roll(poly, -1, axis=0) - poly
-        seglen = np.linalg.norm(seg, axis=1)
-        arc = np.concatenate([[0.0], np.cumsum(seglen)])
-        length = arc[-1]
-        grid = FootprintGrid(name, offset, poly, arc, None if centre is None else np.asarray(centre, float))
+        grid = FootprintGrid(name, offset, chain, None if centre is None else np.asarray(centre, float))
         grids[name] = grid
-        count = grid.count
-        ncomp = grid.components
-        a = float(half_width[name])
-        widths[name] = a
-        s_k = arc[:-1]
-        if ncomp == 1:
-            d_k = poly - centre
+        widths[name] = a = float(half_width[name])
+        weights = fem.footprint_weights(model, chain, chain.s[:-1], a)
+        if grid.components == 1:
+            d_k = grid.polyline - grid.centre
             d_k /= np.linalg.norm(d_k, axis=1)[:, None]
+            blocks.append(fem.load_operator(model, weights, d_k))
         else:
-            d_k = np.tile(np.eye(2), (count, 1))
-        points.append(np.repeat(poly, ncomp, axis=0))
+            d_k = np.tile(np.eye(2), (grid.count, 1))
+            bx = fem.load_operator(model, weights, (1.0, 0.0))
+            by = fem.load_operator(model, weights, (0.0, 1.0))
+            order = np.argsort(np.r_[2 * np.arange(grid.count), 2 * np.arange(grid.count) + 1], kind="stable")
+            blocks.append(sp.hstack([bx, by]).tocsc()[:, order])
+        points.append(np.repeat(grid.polyline, grid.components, axis=0))
         directions.append(d_k)
-
-        # DOFs of each polyline edge: vertex x/y dofs, and the P2 midpoint dofs
-        v0, v1 = loop, np.roll(loop, -1)
-        dof0 = basis.nodal_dofs[:, v0]
-        dof1 = basis.nodal_dofs[:, v1]
-        if order2:
-            ekey = np.minimum(v0, v1).astype(np.int64) * nverts + np.maximum(v0, v1)
-            pos = np.searchsorted(keys, ekey)
-            if not np.all(keys[np.minimum(pos, len(keys) - 1)] == ekey):
-                raise ValueError(f"boundary '{name}' has edges that are not mesh facets")
-            dofm = basis.facet_dofs[:, korder[pos]]
-
-        # pieces of (column, edge) overlap, vectorised per column
-        for k in range(count):
-            lo, hi = s_k[k] - a, s_k[k] + a
-            for shift in (-length, 0.0, length):
-                e_lo = max(0, np.searchsorted(arc, lo + shift, side="right") - 1)
-                e_hi = min(len(poly), np.searchsorted(arc, hi + shift, side="left"))
-                for e in range(e_lo, e_hi):
-                    s0, s1 = max(arc[e], lo + shift), min(arc[e + 1], hi + shift)
-                    if s1 <= s0:
-                        continue
-                    sq = s0 + (s1 - s0) * gx
-                    r = (sq - shift - s_k[k]) / a
-                    dens = np.sqrt(np.clip(1.0 - r * r, 0.0, None)) * gw * (s1 - s0)
-                    xi = (sq - arc[e]) / seglen[e]
-                    if order2:
-                        shape = [(1 - xi) * (1 - 2 * xi), xi * (2 * xi - 1), 4 * xi * (1 - xi)]
-                        dofs = [dof0[:, e], dof1[:, e], dofm[:, e]]
-                    else:
-                        shape = [1 - xi, xi]
-                        dofs = [dof0[:, e], dof1[:, e]]
-                    for N, d in zip(shape, dofs):
-                        w = float(np.dot(N, dens))
-                        for c in range(ncomp):
-                            col = offset + ncomp * k + c
-                            dk = d_k[ncomp * k + c]
-                            rows.extend([d[0], d[1]])
-                            cols.extend([col, col])
-                            vals.extend([w * dk[0], w * dk[1]])
-        offset += ncomp * count
-
-    B = sp.csc_matrix((vals, (rows, cols)), shape=(basis.N, offset))
-    B.sum_duplicates()
-    # normalise every column to a unit force exactly (the quadrature of the density is ~1/ (π a/2))
-    dirs = np.vstack(directions)
-    res = np.asarray(B.T @ rigid_modes)
-    scale = np.einsum("ij,ij->i", res[:, :2], dirs)
-    B = (B @ sp.diags(1.0 / scale)).tocsc()
-    res = np.asarray(B.T @ rigid_modes)
-    return Interface(B, np.vstack(points), dirs, res, grids, widths)
+        offset += grid.components * grid.count
+    B = sp.hstack(blocks).tocsc()
+    return Interface(B, np.vstack(points), np.vstack(directions), np.asarray(B.T @ rigid_modes), grids, widths)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -393,12 +271,14 @@ class Compliance:
 def palmgren_law(length: float, contacts: int = 2):
     """Force–approach law of a roller line contact after Palmgren.
 
-    δ = contacts · 3.84e-5 · Q^0.9 / L^0.8  (δ mm, Q N, L mm), inverted to
+    δ = contacts · 3.84e-5 · Q^0.9 / L^0.8  (δ mm, Q N, L mm; Harris & Kotzalas, *Rolling Bearing
+    Analysis*, line contact, one roller–raceway contact each; see
+    :func:`rvfem.evaluation.palmgren_approach`), inverted to
     Q(δ) = (δ · L^0.8 / (contacts · 3.84e-5))^(1/0.9) for δ > 0, 0 otherwise.
 
     Returns a function ``law(delta) -> (Q, dQ/dδ)`` (arrays).
     """
-    c = contacts * PALMGREN_COEFF / length**0.8
+    c = contacts * PALMGREN_COEFFICIENT / length**0.8
     p = 1.0 / 0.9
 
     def law(delta):

@@ -176,7 +176,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     half = {"profile": FOOTPRINT_ELEMENTS * case.mesh.size_flank}
     for i in range(case.cranks.count):
         half[f"bore_{i}"] = FOOTPRINT_ELEMENTS * case.mesh.size_bore
-    iface = contact.build_interface(model.basis, boundaries, rigid,
+    iface = contact.build_interface(model, boundaries, rigid,
                                     {f"bore_{i}": centres[i] for i in range(len(centres))}, half)
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B)

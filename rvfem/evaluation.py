@@ -422,6 +422,10 @@ def hertz_peak_pressure(load_N: float, length_mm: float, half_width_mm: float) -
     return 2.0 * load_N / (math.pi * length_mm * half_width_mm)
 
 
+PALMGREN_COEFFICIENT = 3.84e-5
+"""Palmgren's line-contact approach coefficient, steel on steel: δ = 3.84e-5·Q^0.9/L^0.8 (mm, N)."""
+
+
 def palmgren_approach(load_N: float, length_mm: float) -> float:
     """Elastic approach of one steel roller-raceway line contact, mm (Palmgren).
 
@@ -432,7 +436,7 @@ def palmgren_approach(load_N: float, length_mm: float) -> float:
     """
     if load_N < 0 or length_mm <= 0:
         raise ValueError("palmgren_approach needs a non-negative load and a positive length")
-    return 3.84e-5 * load_N**0.9 / length_mm**0.8
+    return PALMGREN_COEFFICIENT * load_N**0.9 / length_mm**0.8
 
 
 def hertz_line_contact(

@@ -47,11 +47,11 @@ def squeezed_cylinder():
     rim = index[lines[0].astype(int)].reshape(-1, 2)
     model = fem.build_model(points, triangles, E, NU, L, order=1)
     factor = fem.factorize(model)
-    iface = contact.build_interface(model.basis, {"rim": rim}, fem.rigid_body_modes(model), {},
+    iface = contact.build_interface(model, {"rim": rim}, fem.rigid_body_modes(model), {},
                                     {"rim": 0.25 * H_CONTACT})
     grid = iface.grids["rim"]
     near = np.flatnonzero(np.abs(grid.polyline[:, 0]) < 0.9)      # candidate vertices
-    cols, w = grid.columns_at(grid.arc[near], -grid.polyline[near] / R)  # push towards the centre
+    cols, w = grid.columns_at(grid.chain.s[near], -grid.polyline[near] / R)  # push towards the centre
     n = len(near)
     W = sp.csc_matrix((w.ravel(), (cols.ravel(), np.repeat(np.arange(n), cols.shape[1]))),
                       shape=(iface.n_columns, n))
