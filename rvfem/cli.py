@@ -223,6 +223,119 @@ def _run_mesh(args: argparse.Namespace) -> int:
 
 
 # --------------------------------------------------------------------------------------------
+# rvfem run CASE -o DIR [--step DEG] [--bearing-model M] [--order N] [--overwrite] ...
+# --------------------------------------------------------------------------------------------
+
+
+def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("case", help="case file (TOML)")
+    parser.add_argument("-o", "--output", metavar="DIR",
+                        help="result folder (default: results/<case name>); must not exist or be empty "
+                             "unless --overwrite")
+    parser.add_argument("--step", type=float, metavar="DEG", help="crank-angle step in degrees (overrides "
+                        "analysis.angle_step_deg)")
+    parser.add_argument("--bearing-model", choices=("rollers", "rigid_bore"),
+                        help="crank-bearing model (overrides crank_bearing.model)")
+    parser.add_argument("--order", type=int, choices=(1, 2), help="element order (overrides analysis.element_order)")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing result folder (only once the new results are complete)")
+    parser.add_argument("--field-step", type=float, metavar="DEG",
+                        help="also keep stress fields (VTU frames) every DEG degrees; default: the case's "
+                             "saved angles and the angle of the largest bearing load")
+    parser.add_argument("--no-images", action="store_true", help="skip the PyVista stress and mesh images")
+    parser.add_argument("--cache-dir", default="meshes", help="directory of cached meshes (default: meshes)")
+
+
+class _RunProgress:
+    """Progress of ``rvfem run`` on stderr: a redrawn status line with a bar for the load cycle on a
+    terminal, plain log lines otherwise."""
+
+    BAR = 30
+
+    def __init__(self, stream: TextIO, tty: bool):
+        from .run import STAGES
+
+        self.stream, self.tty, self.stages = stream, tty, list(STAGES)
+        self.descriptions = STAGES
+        self.started: dict[str, float] = {}
+        self.last_draw = 0.0
+        self.last_tenth = -1
+        self.width = 0
+
+    def _line(self, text: str, final: bool = False) -> None:
+        if self.tty:
+            pad = max(0, self.width - len(text))
+            self.stream.write("\r" + text + " " * pad + ("\n" if final else ""))
+            self.width = 0 if final else len(text)
+        elif final:
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        import time
+
+        now = time.perf_counter()
+        index = self.stages.index(stage) + 1 if stage in self.stages else 0
+        head = f"rvfem run [{index}/{len(self.stages)}] {self.descriptions.get(stage, stage)}"
+        if done == 0:
+            self.started[stage] = now
+            self.last_tenth = -1
+            if self.tty:
+                self._line(head + " …")
+            elif stage == "cycle":
+                self._line(f"{head}: {total} crank angles", final=True)
+            return
+        elapsed = now - self.started.get(stage, now)
+        if done >= total:
+            self._line(f"{head}: done in {elapsed:.1f} s", final=True)
+            return
+        if stage != "cycle":
+            return
+        if self.tty:
+            if now - self.last_draw < 0.1:
+                return
+            self.last_draw = now
+            filled = int(self.BAR * done / total)
+            eta = elapsed / done * (total - done)
+            self._line(f"{head} [{'#' * filled}{'.' * (self.BAR - filled)}] {done}/{total}, "
+                       f"{elapsed:.1f} s, about {eta:.0f} s left")
+        else:
+            tenth = 10 * done // total
+            if tenth > self.last_tenth:
+                self.last_tenth = tenth
+                if tenth > 0:
+                    self._line(f"rvfem run: cycle {done}/{total} angles ({10 * tenth} %), {elapsed:.1f} s",
+                               final=True)
+
+    def abort(self) -> None:
+        """End a half-drawn status line (before an error message)."""
+        if self.tty and self.width:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.width = 0
+
+
+def _run_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .run import run_case, summary_text
+
+    case = load_case(args.case)
+    out_dir = Path(args.output) if args.output else Path("results") / case.name
+    progress = _RunProgress(sys.stderr, sys.stderr.isatty())
+    try:
+        result = run_case(case, out_dir, angle_step_deg=args.step, bearing_model=args.bearing_model,
+                          order=args.order, overwrite=args.overwrite, progress=progress,
+                          cache_dir=args.cache_dir, images=not args.no_images, field_step_deg=args.field_step)
+    except BaseException:
+        progress.abort()
+        raise
+    print(summary_text(result.summary))
+    print(f"  results: {result.out_dir}/ (summary.json, report.html; schema in docs/outputs.md)")
+    return EXIT_OK
+
+
+# --------------------------------------------------------------------------------------------
 # Registry and entry point
 # --------------------------------------------------------------------------------------------
 
@@ -232,6 +345,8 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
     Subcommand("rigid", "rigid handbook crank-bearing loads, rating, life and Hertz pressures",
                _add_rigid_arguments, _run_rigid),
     Subcommand("mesh", "mesh the disc (Gmsh, cached) and write a PNG preview", _add_mesh_arguments, _run_mesh),
+    Subcommand("run", "the main job: rigid and flexible load cycle, lives, stresses; tables, VTK, images "
+               "and a report in a result folder", _add_run_arguments, _run_run),
 )
 
 

@@ -26,3 +26,12 @@ class MeshError(RvfemError, RuntimeError):
 
 class ContactError(RvfemError, RuntimeError):
     """The contact problem has no solution or the active set does not settle."""
+
+
+class OutputError(RvfemError, RuntimeError):
+    """A result folder cannot be written: it exists already (and overwriting was not asked for), it
+    is a file, or the file system refuses."""
+
+
+class RenderError(RvfemError, RuntimeError):
+    """Off-screen rendering of the images is not possible on this machine."""

@@ -1,0 +1,177 @@
+"""Plots of a load cycle (matplotlib, Agg canvas: no display needed).
+
+Each function draws one figure into a PNG file and returns its path. Matplotlib is imported only
+inside the functions (``Figure`` with an Agg canvas, never :mod:`matplotlib.pyplot`, so no global
+backend is touched).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
+
+DPI = 120
+COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
+
+
+def _figure(size: tuple[float, float]):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=size)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save(fig, path: str | os.PathLike) -> Path:
+    path = Path(path)
+    fig.savefig(path, dpi=DPI)
+    return path
+
+
+def _degree_axis(ax) -> None:
+    ax.set_xlim(0.0, 360.0)
+    ax.set_xticks(np.arange(0, 361, 45))
+    ax.set_xlabel("crank angle θ [°]")
+    ax.grid(True, lw=0.4, alpha=0.6)
+
+
+def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.ndarray, rigid: np.ndarray, *,
+                       title: str = "") -> Path:
+    """Bearing load |F| over the crank angle, flexible (solid) and rigid handbook (dashed).
+
+    Parameters
+    ----------
+    path : path-like
+        PNG to write.
+    theta : ndarray (n,)
+        Crank angles, rad.
+    flexible, rigid : ndarray (n, N)
+        |F| of each bearing, N.
+    title : str
+    """
+    fig = _figure((10.0, 5.2))
+    ax = fig.subplots()
+    deg = np.degrees(theta)
+    order = np.argsort(deg)
+    for i in range(flexible.shape[1]):
+        c = COLOURS[i % len(COLOURS)]
+        ax.plot(deg[order], flexible[order, i], color=c, lw=1.8, label=f"bearing {i + 1}, flexible (FE)")
+        ax.plot(deg[order], rigid[order, i], color=c, lw=1.2, ls="--", label=f"bearing {i + 1}, rigid (handbook)")
+    _degree_axis(ax)
+    ax.set_ylabel("bearing load |F| [N]")
+    ax.set_ylim(bottom=0.0)
+    ax.set_title(title or "Crank-bearing loads over one crank revolution")
+    ax.legend(ncol=flexible.shape[1], fontsize=8, loc="lower center")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def roller_loads_plot(path: str | os.PathLike, roller_angles: np.ndarray, roller_loads: np.ndarray,
+                      bearing_forces: np.ndarray, *, theta_deg: float, title: str = "") -> Path:
+    """Roller load distribution of every bearing at one crank angle (polar bars).
+
+    Parameters
+    ----------
+    path : path-like
+    roller_angles : ndarray (N, Z)
+        Roller positions about each bore centre, rad (disc frame).
+    roller_loads : ndarray (N, Z)
+        N.
+    bearing_forces : ndarray (N, 2)
+        Force of each bearing on the disc, N (drawn as a line from the centre).
+    theta_deg : float
+        The crank angle, degrees (for the title).
+    title : str
+    """
+    n = roller_loads.shape[0]
+    fig = _figure((4.2 * n, 4.8))
+    axes = fig.subplots(1, n, subplot_kw={"projection": "polar"}, squeeze=False)[0]
+    qmax = float(np.max(roller_loads)) or 1.0
+    for i, ax in enumerate(axes):
+        z = roller_loads.shape[1]
+        ax.bar(roller_angles[i], roller_loads[i], width=2 * math.pi / z * 0.6, color=COLOURS[i % len(COLOURS)],
+               alpha=0.85)
+        f = bearing_forces[i]
+        # direction in which the bore presses on the rollers: opposite to the force on the disc
+        ax.annotate("", xy=(math.atan2(-f[1], -f[0]), 0.9 * qmax), xytext=(0, 0),
+                    arrowprops=dict(arrowstyle="->", color="black", lw=1.2))
+        ax.set_ylim(0, 1.05 * qmax)
+        ax.set_title(f"bearing {i + 1}: |F| = {np.hypot(*f):.0f} N\nQ_max = {roller_loads[i].max():.0f} N",
+                     fontsize=9)
+        ax.tick_params(labelsize=7)
+    fig.suptitle(title or f"Roller loads [N] at θ = {theta_deg:.1f}° (arrow: load of the bore on the rollers)",
+                 fontsize=10)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarray, classical: np.ndarray, *,
+                    theta_deg: float, title: str = "") -> Path:
+    """Pin forces at one crank angle: FE (bars) against the classical rigid distribution (line).
+
+    Parameters
+    ----------
+    path : path-like
+    pin_index : ndarray (Zp,)
+        Pin numbers (1-based) to label the x axis.
+    fe, classical : ndarray (Zp,)
+        Pin force magnitudes, N.
+    theta_deg : float
+    title : str
+    """
+    fig = _figure((10.0, 4.8))
+    ax = fig.subplots()
+    ax.bar(pin_index, fe, width=0.7, color="tab:blue", label="FE (flexible disc)")
+    ax.plot(pin_index, classical, "o-", color="tab:red", ms=3.5, lw=1.2,
+            label="classical rigid distribution (moment exact)")
+    ax.set_xlabel("pin number")
+    ax.set_ylabel("pin force [N]")
+    ax.set_xlim(pin_index.min() - 0.8, pin_index.max() + 0.8)
+    ax.grid(True, axis="y", lw=0.4, alpha=0.6)
+    ax.set_title(title or f"Pin forces at θ = {theta_deg:.1f}° (FE: {int(np.count_nonzero(fe > 0))} pins in "
+                          f"contact, classical: {int(np.count_nonzero(classical > 0))})")
+    ax.legend(fontsize=9)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def pins_in_contact_plot(path: str | os.PathLike, theta: np.ndarray, count: np.ndarray, total: int, *,
+                         classical: np.ndarray | None = None, title: str = "") -> Path:
+    """Number of pins in contact over the crank angle.
+
+    Parameters
+    ----------
+    path : path-like
+    theta : ndarray (n,)
+        Crank angles, rad.
+    count : ndarray (n,)
+        Pins in contact (FE).
+    total : int
+        Number of pins Zp.
+    classical : ndarray (n,), optional
+        Loaded pins of the classical rigid distribution.
+    title : str
+    """
+    fig = _figure((10.0, 3.8))
+    ax = fig.subplots()
+    deg = np.degrees(theta)
+    order = np.argsort(deg)
+    ax.step(deg[order], count[order], where="mid", color="tab:blue", lw=1.5, label="FE")
+    if classical is not None:
+        ax.step(deg[order], classical[order], where="mid", color="tab:red", lw=1.0, ls="--",
+                label="classical rigid distribution")
+    _degree_axis(ax)
+    ax.set_ylabel(f"pins in contact (of {total})")
+    lo = min(int(count.min()), int(classical.min()) if classical is not None else total)
+    hi = max(int(count.max()), int(classical.max()) if classical is not None else 0)
+    ax.set_ylim(lo - 1.5, hi + 1.5)
+    ax.set_title(title or "Pins in contact over one crank revolution")
+    ax.legend(fontsize=9)
+    fig.tight_layout()
+    return _save(fig, path)

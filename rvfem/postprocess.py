@@ -1,0 +1,315 @@
+"""Post-processing of a flexible load cycle: stress snapshots, the peak stress and where it is,
+Hertz pressures of the most loaded roller.
+
+Everything here is computed from the results of :func:`rvfem.cycle.load_cycle` (no new solve):
+the displacement fields it keeps (the case's saved angles and the angle of the largest bearing
+load) give the stresses; the roller loads give the Hertz pressures.
+
+Typical use::
+
+    snapshots = field_snapshots(system, cycle)
+    peak = peak_von_mises(snapshots, mesh)
+    hertz = roller_hertz(case, cycle)
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import evaluation, fem
+from .case import Case
+
+__all__ = [
+    "FieldSnapshot",
+    "PeakStress",
+    "RollerHertz",
+    "FEATURE_LABELS",
+    "feature_label",
+    "max_load_index",
+    "nearest_index",
+    "field_snapshots",
+    "peak_von_mises",
+    "roller_hertz",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class FieldSnapshot:
+    """Displacement and stresses of the disc at one crank angle, on the mesh vertices.
+
+    For P2 models the values are those at the mesh vertices (the linear mesh); the edge-midpoint
+    nodes are not kept.
+
+    Attributes
+    ----------
+    theta : float
+        Crank angle, rad.
+    index : int
+        Position of ``theta`` in the cycle's angle array.
+    displacement : ndarray (n_vertices, 2)
+        Displacement as solved (disc frame, includes the disc's rigid-body motion), mm.
+    deformation : ndarray (n_vertices, 2)
+        ``displacement`` minus its best-fitting rigid motion (nodal least squares), mm: what the
+        deformed-shape images magnify.
+    rigid_motion : ndarray (3,)
+        The removed rigid motion: translation x, y (mm) and rotation about the disc centre (rad).
+    stress : rvfem.fem.StressFields
+        Vertex (area-averaged) and element stresses, MPa.
+    """
+
+    theta: float
+    index: int
+    displacement: np.ndarray
+    deformation: np.ndarray
+    rigid_motion: np.ndarray
+    stress: fem.StressFields
+
+    @property
+    def theta_deg(self) -> float:
+        """Crank angle, degrees."""
+        return math.degrees(self.theta)
+
+
+@dataclass(frozen=True)
+class PeakStress:
+    """The largest von Mises stress over the kept fields and where it occurs.
+
+    Attributes
+    ----------
+    von_mises_MPa : float
+        Largest vertex (area-averaged) von Mises stress, MPa.
+    x_mm, y_mm : float
+        Position of that vertex in the disc frame, mm.
+    radius_mm : float
+        Its distance from the disc centre, mm.
+    theta_deg : float
+        Crank angle of the field, degrees.
+    feature : str
+        Mesh boundary nearest to the point (``profile``, ``bore_0``, ``hole_1``, ``central_hole``…).
+    feature_label : str
+        The same in words (``tooth profile``, ``bore of bearing 1``, ``lightening hole 2``…).
+    distance_to_feature_mm : float
+        Distance from the point to the nearest vertex of that boundary, mm (0 on the boundary).
+    """
+
+    von_mises_MPa: float
+    x_mm: float
+    y_mm: float
+    radius_mm: float
+    theta_deg: float
+    feature: str
+    feature_label: str
+    distance_to_feature_mm: float
+
+
+@dataclass(frozen=True)
+class RollerHertz:
+    """Hertz line contact of one roller on both raceways.
+
+    Attributes
+    ----------
+    source : str
+        ``"fe_rollers"`` (largest roller load of the FE cycle), ``"stribeck_rigid"`` (Q_max =
+        4.6·F_max/Z with the handbook F_max) or ``"stribeck_flexible"`` (the same with the FE
+        F_max).
+    roller_load_N : float
+        Q, N.
+    inner : rvfem.evaluation.HertzLineContact
+        Roller on the eccentric (convex raceway).
+    outer : rvfem.evaluation.HertzLineContact
+        Roller in the disc bore (concave raceway).
+    bearing : int or None
+        0-based bearing of that roller (FE only).
+    roller : int or None
+        0-based roller index (FE only).
+    theta_deg : float or None
+        Crank angle at which it carries Q (FE), or at which the bearing load is largest.
+    """
+
+    source: str
+    roller_load_N: float
+    inner: evaluation.HertzLineContact
+    outer: evaluation.HertzLineContact
+    bearing: int | None = None
+    roller: int | None = None
+    theta_deg: float | None = None
+
+
+FEATURE_LABELS = {
+    "profile": "tooth profile",
+    "central_hole": "central hole",
+}
+"""Readable names of the mesh boundaries (bores and holes are numbered, see :func:`feature_label`)."""
+
+
+def feature_label(name: str) -> str:
+    """Readable name of a mesh boundary: ``bore_0`` → ``bore of bearing 1``, ``hole_2`` →
+    ``lightening hole 3``, ``profile`` → ``tooth profile``."""
+    if name in FEATURE_LABELS:
+        return FEATURE_LABELS[name]
+    stem, _, number = name.rpartition("_")
+    if number.isdigit():
+        if stem == "bore":
+            return f"bore of bearing {int(number) + 1}"
+        if stem == "hole":
+            return f"lightening hole {int(number) + 1}"
+    return name
+
+
+def max_load_index(bearing_forces: np.ndarray) -> tuple[int, int]:
+    """Angle index and bearing index of the largest bearing load |F| of a cycle.
+
+    Parameters
+    ----------
+    bearing_forces : ndarray (n, N, 2)
+
+    Returns
+    -------
+    (int, int)
+    """
+    loads = np.linalg.norm(bearing_forces, axis=2)
+    k, i = np.unravel_index(int(np.argmax(loads)), loads.shape)
+    return int(k), int(i)
+
+
+def nearest_index(thetas: np.ndarray, theta: float) -> int:
+    """Index of the angle in ``thetas`` (rad) closest to ``theta`` (rad) on the circle."""
+    return int(np.argmin(np.abs(np.angle(np.exp(1j * (np.asarray(thetas) - theta))))))
+
+
+def field_snapshots(system, cycle) -> tuple[FieldSnapshot, ...]:
+    """Vertex displacements and stresses of every field a load cycle kept, ordered by angle.
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+    cycle : rvfem.cycle.CycleResult
+
+    Returns
+    -------
+    tuple of FieldSnapshot
+    """
+    model = system.model
+    vdofs = model.node_dofs[: model.n_vertices]
+    out = []
+    for theta in sorted(cycle.fields):
+        u = np.asarray(cycle.fields[theta], dtype=float)
+        u_def, motion = fem.remove_rigid_motion(model, u)
+        out.append(FieldSnapshot(
+            theta=float(theta),
+            index=nearest_index(cycle.theta, float(theta)),
+            displacement=u[vdofs],
+            deformation=u_def[vdofs],
+            rigid_motion=np.asarray(motion, dtype=float),
+            stress=fem.stress_fields(model, u),
+        ))
+    return tuple(out)
+
+
+def _distances(points: np.ndarray, boundary_points: np.ndarray) -> np.ndarray:
+    """Distance of every point to the nearest of ``boundary_points`` (k-d tree), mm."""
+    from scipy.spatial import cKDTree
+
+    return cKDTree(boundary_points).query(points)[0]
+
+
+def peak_von_mises(snapshots: tuple[FieldSnapshot, ...], points: np.ndarray,
+                   boundaries: dict[str, np.ndarray], *,
+                   exclude: dict[str, float] | None = None) -> PeakStress | None:
+    """The largest vertex von Mises stress over the snapshots and the boundary it lies nearest to.
+
+    Parameters
+    ----------
+    snapshots : tuple of FieldSnapshot
+        At least one.
+    points : ndarray (n_vertices, 2)
+        Mesh vertices, mm.
+    boundaries : dict
+        Mesh boundary name → edges (vertex index pairs), as :attr:`rvfem.mesh.DiscMesh.boundaries`.
+    exclude : dict, optional
+        Boundary name → band width (mm): vertices closer than that to the boundary are ignored
+        (e.g. the tooth profile and the bores, where the pin and roller forces are applied over
+        a footprint of a few elements and the local stress depends on that footprint).
+
+    Returns
+    -------
+    PeakStress or None
+        None only if ``exclude`` leaves no vertex.
+    """
+    if not snapshots:
+        raise ValueError("peak_von_mises needs at least one snapshot")
+    points = np.asarray(points, dtype=float)
+    mask = np.ones(len(points), dtype=bool)
+    for name, band in (exclude or {}).items():
+        if name in boundaries and band > 0:
+            mask &= _distances(points, points[np.asarray(boundaries[name])[:, 0]]) >= band
+    if not mask.any():
+        return None
+    candidates = np.flatnonzero(mask)
+    best = max(snapshots, key=lambda s: float(s.stress.nodal.von_mises[candidates].max()))
+    vertex = int(candidates[np.argmax(best.stress.nodal.von_mises[candidates])])
+    p = points[vertex]
+    feature, dist = "", math.inf
+    for name, edges in boundaries.items():
+        d = float(_distances(p[None, :], points[np.asarray(edges)[:, 0]])[0])
+        if d < dist:
+            feature, dist = name, d
+    return PeakStress(
+        von_mises_MPa=float(best.stress.nodal.von_mises[vertex]),
+        x_mm=float(p[0]),
+        y_mm=float(p[1]),
+        radius_mm=float(np.hypot(*p)),
+        theta_deg=best.theta_deg,
+        feature=feature,
+        feature_label=feature_label(feature),
+        distance_to_feature_mm=dist,
+    )
+
+
+def _contacts(case: Case, q: float) -> tuple[evaluation.HertzLineContact, evaluation.HertzLineContact]:
+    b = case.crank_bearing
+    common = dict(youngs_modulus_MPa=case.material.youngs_modulus, poissons_ratio=case.material.poissons_ratio)
+    r = 0.5 * b.roller_diameter
+    inner = evaluation.hertz_line_contact(q, b.roller_length, r, b.inner_raceway_radius, concave=False, **common)
+    outer = evaluation.hertz_line_contact(q, b.roller_length, r, b.bore_radius, concave=True, **common)
+    return inner, outer
+
+
+def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float | None = None
+                 ) -> dict[str, RollerHertz]:
+    """Hertz pressures of the most loaded roller, from the FE roller loads and from Stribeck.
+
+    Parameters
+    ----------
+    case : Case
+    cycle : rvfem.cycle.CycleResult
+    rigid_max_N : float
+        Largest handbook bearing load over the cycle, N.
+    rigid_max_at_deg : float, optional
+        Its crank angle, degrees.
+
+    Returns
+    -------
+    dict
+        ``"stribeck_rigid"`` and ``"stribeck_flexible"`` always (Q_max = 4.6·F_max/Z, Gao et al.'s
+        eq. 21, with the handbook and the FE bearing load), ``"fe_rollers"`` when the cycle has
+        discrete roller loads (bearing model ``rollers``).
+    """
+    z = case.crank_bearing.rollers
+    out = {}
+    if cycle.roller_loads is not None:
+        k, i, j = np.unravel_index(int(np.argmax(cycle.roller_loads)), cycle.roller_loads.shape)
+        q = float(cycle.roller_loads[k, i, j])
+        out["fe_rollers"] = RollerHertz("fe_rollers", q, *_contacts(case, q), bearing=int(i), roller=int(j),
+                                        theta_deg=math.degrees(float(cycle.theta[k])))
+    q = evaluation.stribeck_max_roller_load(rigid_max_N, z)
+    out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_contacts(case, q), theta_deg=rigid_max_at_deg)
+    k, i = max_load_index(cycle.bearing_forces)
+    f = float(np.linalg.norm(cycle.bearing_forces[k, i]))
+    q = evaluation.stribeck_max_roller_load(f, z)
+    out["stribeck_flexible"] = RollerHertz("stribeck_flexible", q, *_contacts(case, q), bearing=i,
+                                           theta_deg=math.degrees(float(cycle.theta[k])))
+    return out

@@ -1,0 +1,304 @@
+"""The HTML report of a run: one self-contained file (styles inline, images embedded as base64).
+
+It is written from the ``summary.json`` content, so the report and the JSON always show the same
+numbers, plus the case (its parameters) and the PNG files of the run.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+from .case import Case
+
+__all__ = ["assumptions", "write_report"]
+
+_CSS = """
+body { font-family: system-ui, -apple-system, 'Segoe UI', Roboto, sans-serif; margin: 2em auto; max-width: 1200px;
+       color: #222; line-height: 1.45; padding: 0 1em; }
+h1 { font-size: 1.6em; margin-bottom: 0.2em; } h2 { font-size: 1.25em; margin-top: 2em; border-bottom: 1px solid #ccc; }
+h3 { font-size: 1.05em; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.92em; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }
+th { background: #f2f2f2; } td.l, th.l { text-align: left; }
+tr.flex td { background: #f7fbff; }
+.meta { color: #555; font-size: 0.9em; }
+figure { margin: 1em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
+figcaption { font-size: 0.9em; color: #444; }
+.grid { display: grid; grid-template-columns: repeat(auto-fit, minmax(520px, 1fr)); gap: 1em; }
+ul li { margin: 0.2em 0; }
+code { background: #f4f4f4; padding: 0 0.2em; }
+"""
+
+
+def _e(x: Any) -> str:
+    return html.escape(str(x))
+
+
+def _num(v: Any, fmt: str = ".1f") -> str:
+    if v is None:
+        return "–"
+    if isinstance(v, float) and not math.isfinite(v):
+        return "–"
+    if isinstance(v, (int, float)):
+        return format(v, fmt)
+    return _e(v)
+
+
+def _img(path: Path, alt: str) -> str:
+    data = base64.b64encode(path.read_bytes()).decode("ascii")
+    return f'<img src="data:image/png;base64,{data}" alt="{_e(alt)}">'
+
+
+def _figure(root: Path, rel: str | None, caption: str) -> str:
+    if not rel or not (root / rel).is_file():
+        return ""
+    return f"<figure>{_img(root / rel, caption)}<figcaption>{_e(caption)}</figcaption></figure>"
+
+
+def _table(header: list[str], rows: list[list[Any]], left: int = 1, classes: list[str] | None = None) -> str:
+    out = ["<table><tr>" + "".join(f'<th class="{"l" if i < left else ""}">{_e(h)}</th>'
+                                  for i, h in enumerate(header)) + "</tr>"]
+    for r, row in enumerate(rows):
+        cls = f' class="{classes[r]}"' if classes and classes[r] else ""
+        out.append(f"<tr{cls}>" + "".join(f'<td class="{"l" if i < left else ""}">{c}</td>'
+                                          for i, c in enumerate(row)) + "</tr>")
+    out.append("</table>")
+    return "\n".join(out)
+
+
+def assumptions(summary: dict, case: Case) -> list[str]:
+    """The modelling assumptions of a run, as sentences (HTML-escaped text)."""
+    m = summary["model"]
+    b = case.crank_bearing
+    if m["bearing_model"] == "rollers":
+        law = ("Palmgren line-contact law δ = 3.84·10⁻⁵·Q^0.9/L^0.8 per raceway, both raceways"
+               if b.stiffness_law == "palmgren" else f"linear stiffness {b.linear_stiffness_N_per_mm:g} N/mm")
+        bearing = (f"Crank bearings: bearing model <b>rollers</b> — {b.rollers} discrete compression-only roller "
+                   f"springs per bearing along their radial lines ({_e(law)}), radial clearance "
+                   f"{b.radial_clearance:g} mm, rollers positioned by the cage angle at each θ, each roller force "
+                   "spread over a short footprint of the bore.")
+    else:
+        bearing = (f"Crank bearings: bearing model <b>rigid_bore</b> — each bore tied to a rigid ring with one "
+                   f"isotropic bearing spring of {b.rigid_bore_stiffness_N_per_mm:g} N/mm (no discrete rollers, "
+                   "so no FE roller loads; Hertz only from the Stribeck estimate).")
+    pin = ("rigid pins (Signorini contact: gap ≥ 0, force ≥ 0)" if m["pin_model"] == "rigid"
+           else "pins with Hertz line-contact compliance")
+    return [
+        f"2D plane-stress finite-element model of one cycloid disc (thickness {case.cycloid.thickness:g} mm, "
+        f"E = {case.material.youngs_modulus:g} MPa, ν = {case.material.poissons_ratio:g}), "
+        f"P{m['element_order']} triangles; the disc stiffness is factorised once and each crank angle is "
+        "solved on the condensed contact and roller unknowns.",
+        f"Torque convention: each of the {m['discs']} discs carries T_disc = T_out/{m['discs']} = "
+        f"{m['disc_torque_Nmm'] / 1000:g} N·m, applied as the moment of the pin forces about the <b>disc centre</b> "
+        "(the handbook's ΣP_x = T/(2·e·Zc)). About the reducer axis the moment differs by Zp/Zc "
+        f"({100 * (case.pins.count / case.cycloid.teeth - 1):.1f} % here).",
+        f"Pins: {pin}; no friction (friction is not modelled).",
+        bearing,
+        "Carrier: one rigid body that only rotates about the reducer axis; its rotation is the unknown conjugate to "
+        "the disc torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
+        "Rigid reference: the handbook model (Gao et al., eqs. 4-10; rigid disc, rigid bearings, equal load sharing, "
+        f"pin-force resultant ratio k_y = {m['handbook_k_y']:.3f}), evaluated at the same crank angles. The FE "
+        f"pin-force resultant ratio |P_y/P_x| comes out {m['fe_pin_resultant_ratio']:.3f} on average.",
+        f"Life: ISO 281 dynamic load rating C = {m['dynamic_load_rating_N']:.0f} N, equivalent load "
+        f"F_m = (mean F^p)^(1/p) with p = {m['equivalent_load_exponent']:.4g} over a uniformly sampled turn, "
+        f"L10h = 10⁶/(60·n_b)·(C/F_m)^(10/3), bearing speed n_b = {m['bearing_speed_rpm']:g} rpm; life ratio "
+        "= L_flex/L_rigid.",
+        f"Hertz: line contact of the most loaded roller on the eccentric (convex, inner) and in the bore (concave, "
+        f"outer), from the largest FE roller load and from Stribeck's Q_max = {summary['hertz']['stribeck_factor']:g}·F/Z "
+        "with the rigid (handbook) and the FE bearing load.",
+        "Stresses: vertex values are area-weighted averages of the adjacent element stresses. Pin and roller forces "
+        "are spread over a footprint of about 1.5 elements, so the stress right under a contact depends on the mesh "
+        "and is not the Hertz contact stress (see the Hertz table for that); the \"away from contacts\" peak "
+        f"ignores a band of {summary['stress']['away_from_contacts']['profile_band_mm']:.2g} mm along the profile and "
+        f"{summary['stress']['away_from_contacts']['bore_band_mm']:.2g} mm along the bores. Stress peaks are "
+        "searched over the kept fields only (the angles listed under Stress images)."
+        if summary["stress"].get("away_from_contacts") else
+        "Stresses: vertex values are area-weighted averages of the adjacent element stresses.",
+        "Images: deformation with the disc's rigid-body motion removed, magnified by the factor written on the "
+        "image; pins drawn at their nominal positions at that angle (dark: in contact).",
+    ]
+
+
+def _case_rows(case: Case) -> list[list[str]]:
+    c, p, k, b, mat, ld, an, ms = (case.cycloid, case.pins, case.cranks, case.crank_bearing, case.material,
+                                   case.loads, case.analysis, case.mesh)
+    rows = [
+        ["cycloid", f"Zc = {c.teeth}, e = {c.eccentricity:g} mm, b = {c.thickness:g} mm, central hole r = "
+                    f"{c.central_hole_radius:g} mm"],
+        ["profile modification", f"ΔRrp = {c.modification.equidistant:g} mm, ΔRp = {c.modification.shift:g} mm, "
+                                 f"rotation {c.modification.rotation_deg:g}°"],
+        ["pins", f"Zp = {p.count}, Rp = {p.circle_radius:g} mm, r_rp = {p.radius:g} mm, model {p.model}"],
+        ["cranks", f"N = {k.count} on r0 = {k.circle_radius:g} mm at {', '.join(f'{a:g}°' for a in k.angles_deg)}"],
+        ["crank bearing", f"Z = {b.rollers}, D_we = {b.roller_diameter:g} mm, L_we = {b.roller_length:g} mm, "
+                          f"D_m = {b.pitch_diameter:g} mm, bore r = {b.bore_radius:g} mm, clearance "
+                          f"{b.radial_clearance:g} mm, b_m = {b.b_m:g}, λ_ν = {b.lambda_nu:g}"],
+        ["material", f"{mat.name}: E = {mat.youngs_modulus:g} MPa, ν = {mat.poissons_ratio:g}"],
+        ["loads", f"T_out = {ld.torque_Nm:g} N·m, {ld.speed_rpm:g} rpm output, {ld.discs} discs"
+                  + (f", duty cycle of {len(ld.duty_cycle)} rows" if ld.duty_cycle else "")],
+        ["analysis", f"angle step {an.angle_step_deg:g}°, P{an.element_order}, p = {an.equivalent_load_exponent:.4g}, "
+                     f"saved angles {', '.join(f'{a:g}°' for a in an.saved_angles_deg)}"],
+        ["mesh sizes", f"flank {ms.size_flank:g} mm, bore {ms.size_bore:g} mm, interior {ms.size_interior:g} mm"],
+    ]
+    if case.fan_holes is not None:
+        f = case.fan_holes
+        span = f"span {f.span_deg:g}°" if f.span_deg is not None else f"ligament {f.ligament:g} mm"
+        rows.append(["fan holes", f"{f.count}, r = {f.inner_radius:g}…{f.outer_radius:g} mm, {span}, fillet "
+                                  f"{f.fillet_radius:g} mm"])
+    if case.round_holes is not None:
+        r = case.round_holes
+        rows.append(["round holes", f"{r.count} × r = {r.radius:g} mm on r = {r.circle_radius:g} mm"])
+    return [[_e(a), _e(v)] for a, v in rows]
+
+
+def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str | os.PathLike) -> Path:
+    """Write ``report.html``.
+
+    Parameters
+    ----------
+    path : path-like
+        The HTML file.
+    summary : dict
+        The ``summary.json`` content (numbers shown in the report).
+    case : Case
+        The case as analysed.
+    root : path-like
+        Folder the image paths in ``summary["images"]`` / ``summary["plots"]`` are relative to.
+
+    Returns
+    -------
+    Path
+    """
+    path, root = Path(path), Path(root)
+    c, m = summary["case"], summary["model"]
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>rvfem: {_e(c['name'])}</title>"
+             f"<style>{_CSS}</style></head><body>"]
+    parts.append(f"<h1>Crank-bearing loads with a flexible cycloid disc — {_e(c['name'])}</h1>")
+    meta = [f"rvfem {_e(summary['rvfem_version'])}"]
+    if c.get("file"):
+        meta.append(f"case file <code>{_e(c['file'])}</code> (sha256 {_e(c['sha256'][:16])}…"
+                    f"{'' if c['matches_file'] else ', modified'})")
+    if c["overrides"]:
+        meta.append("overrides: " + ", ".join(f"<code>{_e(k)} = {_e(v)}</code>" for k, v in c["overrides"].items()))
+    parts.append(f"<p class='meta'>{' · '.join(meta)}</p>")
+    if c.get("description"):
+        parts.append(f"<p>{_e(c['description'])}</p>")
+    parts.append(f"<p class='meta'>Model: bearing model <b>{_e(m['bearing_model'])}</b>, P{m['element_order']} "
+                 f"elements, {m['nodes']} nodes, {m['dofs']} dofs, {m['elements']} elements; {m['angles']} crank "
+                 f"angles (step {m['angle_step_deg']:g}°); wall time {summary['timings_s']['total']:.1f} s.</p>")
+
+    # -- results ---------------------------------------------------------------------------------
+    parts.append("<h2>Crank-bearing loads and lives: rigid handbook vs flexible disc</h2>")
+    rows, classes = [], []
+    for b in summary["bearings"]:
+        for key in ("rigid", "flexible"):
+            s = b[key]
+            rows.append([f"{b['bearing']}" if key == "rigid" else "", key, _num(s["max_load_N"], ".0f"),
+                         _num(s["max_at_deg"]), _num(s["min_load_N"], ".0f"), _num(s["min_at_deg"]),
+                         _num(s["equivalent_load_N"], ".0f"), _num(s["L10h_h"], ".0f"),
+                         _num(b["delta_max_percent"], "+.1f") + " %" if key == "flexible" else "",
+                         _num(b["delta_min_percent"], "+.1f") + " %" if key == "flexible" else "",
+                         _num(b["delta_equivalent_percent"], "+.1f") + " %" if key == "flexible" else "",
+                         _num(b["life_ratio"], ".3f") if key == "flexible" else ""])
+            classes.append("flex" if key == "flexible" else "")
+    parts.append(_table(["bearing", "model", "max N", "at °", "min N", "at °", "F_m N", "L10h h", "Δmax",
+                         "Δmin", "ΔF_m", "L_flex/L_rigid"], rows, left=2, classes=classes))
+    parts.append("<p class='meta'>Angles are crank angles θ (eccentric relative to the carrier). Deltas in % of "
+                 "the rigid value. The equal-share reference (FE pin resultant shared equally) is in summary.json.</p>")
+
+    at = summary["peak_von_mises_at"]
+    away = summary["stress"].get("away_from_contacts")
+    pins = summary["pins_in_contact"]
+    other = [
+        ["peak von Mises (vertex)", f"{summary['peak_von_mises_MPa']:.1f} MPa at ({at['x_mm']:.2f}, {at['y_mm']:.2f}) mm, "
+                                    f"{_e(at['feature_label'])}, θ = {at['theta_deg']:.1f}°"],
+        ["peak von Mises (element)", f"{summary['stress']['peak_element_von_mises_MPa']:.1f} MPa"],
+    ]
+    if away:
+        other.append(["peak von Mises away from contacts",
+                      f"{away['peak_von_mises_MPa']:.1f} MPa at ({away['at']['x_mm']:.2f}, {away['at']['y_mm']:.2f}) mm, "
+                      f"{away['at']['distance_to_feature_mm']:.2f} mm from the {_e(away['at']['feature_label'])}, "
+                      f"θ = {away['at']['theta_deg']:.1f}°"])
+    mx = summary["max_bearing_load"]
+    other += [
+        ["largest bearing load", f"{mx['flexible_N']:.0f} N, bearing {mx['bearing']}, θ = {mx['theta_deg']:.1f}°"],
+        ["pins in contact", f"{pins['min']}–{pins['max']} of {pins['of']} (mean {pins['mean']:.1f})"],
+        ["torsional stiffness (disc stage)", f"{summary['torsional_stiffness_Nm_per_arcmin']:.2f} N·m/arcmin"],
+        ["carrier rotation", f"{summary['carrier_rotation_arcmin']['mean']:.3f} arcmin (mean)"],
+        ["equilibrium residual (max)", f"{summary['equilibrium_residual']:.2e}"],
+        ["active-set iterations", f"max {summary['active_set_iterations']['max']}, mean "
+                                  f"{summary['active_set_iterations']['mean']:.1f}"],
+    ]
+    parts.append("<h2>Other results</h2>" + _table(["quantity", "value"], other, left=2))
+
+    h = summary["hertz"]
+    hrows = []
+    for key, label in (("fe_rollers", "FE roller loads (largest)"), ("stribeck_rigid", "Stribeck, rigid F_max"),
+                       ("stribeck_flexible", "Stribeck, FE F_max")):
+        e = h.get(key)
+        if not e:
+            continue
+        where = []
+        if e.get("bearing"):
+            where.append(f"bearing {e['bearing']}" + (f", roller {e['roller']}" if e.get("roller") else ""))
+        if e.get("theta_deg") is not None:
+            where.append(f"θ = {e['theta_deg']:.1f}°")
+        hrows.append([_e(label), _e(", ".join(where)), _num(e["roller_load_N"], ".0f"),
+                      _num(e["inner"]["peak_pressure_MPa"], ".0f"), _num(1000 * e["inner"]["half_width_mm"], ".1f"),
+                      _num(e["outer"]["peak_pressure_MPa"], ".0f"), _num(1000 * e["outer"]["half_width_mm"], ".1f")])
+    parts.append("<h2>Hertz pressure of the most loaded roller</h2>")
+    parts.append(_table(["source", "where", "Q N", "p_inner MPa", "b_inner µm", "p_outer MPa", "b_outer µm"],
+                        hrows, left=2))
+    if "duty_cycle" in summary:
+        d = summary["duty_cycle"]
+        parts.append("<h3>Duty cycle (Palmgren–Miner)</h3>" + _table(
+            ["model", "rated life h", "equivalent torque N·m", "equivalent speed rpm", "service life h"],
+            [[k, _num(d[k]["rated_life_h"], ".0f"), _num(d[k]["equivalent_torque_Nm"]),
+              _num(d[k]["equivalent_speed_rpm"], ".2f"), _num(d[k]["service_life_h"], ".0f")] for k in ("rigid", "flexible")],
+            left=1))
+
+    # -- plots and images ----------------------------------------------------------------------
+    pl = summary.get("plots", {})
+    parts.append("<h2>Plots</h2><div class='grid'>")
+    parts.append(_figure(root, pl.get("bearing_loads"), "Bearing load over the crank angle: flexible (solid) "
+                                                        "and rigid handbook (dashed)."))
+    parts.append(_figure(root, pl.get("pins_in_contact"), "Number of pins in contact over the crank angle."))
+    parts.append(_figure(root, pl.get("pin_forces"), "Pin forces at the angle of the largest bearing load: FE vs "
+                                                     "the classical rigid distribution."))
+    parts.append(_figure(root, pl.get("roller_loads"), "Roller loads at the angle of the largest bearing load."))
+    parts.append("</div>")
+    im = summary.get("images", {})
+    if im:
+        parts.append("<h2>Stress images</h2>")
+        for f in summary.get("fields", []):
+            if f.get("image"):
+                parts.append(_figure(root, f["image"], f"von Mises on the deformed disc at θ = {f['theta_deg']:.1f}° "
+                                                       f"(ParaView: {f['vtu']})."))
+        parts.append("<div class='grid'>")
+        parts.append(_figure(root, im.get("stress_peak_closeup"), "Close-up at the peak von Mises stress (ring)."))
+        parts.append(_figure(root, im.get("stress_away_from_contacts_closeup"),
+                             "Close-up at the peak von Mises stress away from the pin and roller contacts (ring)."))
+        parts.append("</div>")
+        parts.append(_figure(root, im.get("mesh"), "The mesh (linear triangles) and a close-up of the rim under bore 1."))
+
+    # -- case and assumptions ------------------------------------------------------------------
+    parts.append("<h2>Case parameters</h2>" + _table(["item", "value"], _case_rows(case), left=2))
+    parts.append("<h2>Assumptions</h2><ul>" + "".join(f"<li>{a}</li>" for a in assumptions(summary, case)) + "</ul>")
+    defaults = c.get("defaults_used") or {}
+    if defaults:
+        parts.append("<h3>Where the case file is silent (defaults used)</h3>" + _table(
+            ["key", "value"], [[f"<code>{_e(k)}</code>", _e(v)] for k, v in defaults.items()], left=2))
+    elif not c.get("matches_file"):
+        parts.append("<p class='meta'>The case was built or modified in code; case.json holds every value used.</p>")
+
+    t = summary["timings_s"]
+    parts.append("<h2>Files and timings</h2><p class='meta'>"
+                 + ", ".join(f"<code>{_e(f)}</code>" for f in summary["files"]) + "</p><p class='meta'>"
+                 + ", ".join(f"{_e(k)} {v:.2f} s" for k, v in t.items() if isinstance(v, (int, float))) + "</p>")
+    parts.append("</body></html>\n")
+    path.write_text("\n".join(p for p in parts if p), encoding="utf-8")
+    return path

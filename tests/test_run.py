@@ -1,0 +1,400 @@
+"""``rvfem run``: the result folder against the Python API, file formats, and nothing lost.
+
+Runs a coarse version of the default case (mesh sizes doubled, 20° crank-angle step, fields at 0°
+and at the largest bearing load) once through the command line and checks every output.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+
+from rvfem import cli, render
+from rvfem.case import file_sha256, load_case
+from rvfem.compare import rigid_vs_flexible
+from rvfem.cycle import build_system, load_cycle
+from rvfem.errors import OutputError, RenderError
+from rvfem.mesh import mesh_case
+from rvfem.run import IMAGE_SIZE, run_case
+from rvfem.vtkio import CELL_FIELDS, POINT_FIELDS
+
+from conftest import CaseText
+
+STEP_DEG = 20.0
+
+#: Documented keys of summary.json (docs/outputs.md).
+TOP_KEYS = {
+    "schema_version", "rvfem_version", "case", "model", "bearings", "max_bearing_load", "pins_in_contact",
+    "peak_von_mises_MPa", "peak_von_mises_at", "stress", "torsional_stiffness_Nm_per_arcmin",
+    "carrier_rotation_arcmin", "equilibrium_residual", "active_set_iterations", "hertz", "fields", "images",
+    "plots", "timings_s", "files",
+}
+CASE_KEYS = {"name", "description", "file", "sha256", "matches_file", "digest", "overrides", "defaults_used"}
+MODEL_KEYS = {
+    "bearing_model", "element_order", "pin_model", "nodes", "vertices", "dofs", "elements", "mesh_file",
+    "mesh_min_quality", "angle_step_deg", "angles", "output_torque_Nm", "discs", "disc_torque_Nmm",
+    "torque_convention", "radial_clearance_mm", "equivalent_load_exponent", "dynamic_load_rating_N",
+    "bearing_speed_rpm", "handbook_k_y", "fe_pin_resultant_ratio",
+}
+BEARING_KEYS = {"bearing", "crank_angle_deg", "rigid", "flexible", "equal_share", "delta_max_percent",
+                "delta_min_percent", "delta_equivalent_percent", "life_ratio"}
+STATS_KEYS = {"max_load_N", "max_at_deg", "min_load_N", "min_at_deg", "equivalent_load_N", "L10h_h"}
+HERTZ_KEYS = {"roller_load_N", "bearing", "roller", "theta_deg", "inner", "outer"}
+LOCATION_KEYS = {"x_mm", "y_mm", "radius_mm", "theta_deg", "feature", "feature_label", "distance_to_feature_mm"}
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("run")
+
+
+@pytest.fixture(scope="module")
+def coarse_case_file(workspace) -> Path:
+    """The default case with the mesh sizes doubled and a 20° step."""
+    text = (CaseText.shipped("rv40e_fanholes")
+            .set("mesh", "size_flank", "0.7").set("mesh", "size_bore", "0.8").set("mesh", "size_interior", "5.0")
+            .set("analysis", "angle_step_deg", str(STEP_DEG)).set("analysis", "saved_angles_deg", "[0.0]"))
+    return text.write(workspace, "coarse.toml")
+
+
+@pytest.fixture(scope="module")
+def cache_dir(workspace) -> Path:
+    return workspace / "meshes"
+
+
+@pytest.fixture(scope="module")
+def cli_run(workspace, coarse_case_file, cache_dir) -> Path:
+    """``rvfem run`` into a fresh folder (below a parent that does not exist yet)."""
+    out = workspace / "results" / "coarse"
+    code = cli.main(["run", str(coarse_case_file), "-o", str(out), "--cache-dir", str(cache_dir)])
+    assert code == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def summary(cli_run) -> dict:
+    return json.loads((cli_run / "summary.json").read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def api(coarse_case_file, cache_dir):
+    """The same analysis through the library functions, independently of rvfem.run."""
+    case = load_case(coarse_case_file)
+    system = build_system(case, mesh_case(case, cache_dir))
+    cycle = load_cycle(system)
+    return case, system, cycle, rigid_vs_flexible(case, cycle)
+
+
+# --------------------------------------------------------------------------------------------
+# summary.json
+# --------------------------------------------------------------------------------------------
+
+
+def test_summary_has_the_documented_keys(summary, coarse_case_file):
+    assert TOP_KEYS <= set(summary)
+    assert CASE_KEYS <= set(summary["case"])
+    assert MODEL_KEYS <= set(summary["model"])
+    assert summary["schema_version"] == 1
+    assert summary["case"]["sha256"] == file_sha256(coarse_case_file)
+    assert summary["case"]["matches_file"] is True and summary["case"]["overrides"] == {}
+    assert summary["model"]["angle_step_deg"] == pytest.approx(STEP_DEG)
+    assert summary["model"]["angles"] == 18
+    assert len(summary["bearings"]) == 3
+    for b in summary["bearings"]:
+        assert BEARING_KEYS <= set(b)
+        for model in ("rigid", "flexible", "equal_share"):
+            assert STATS_KEYS <= set(b[model])
+    assert {"min", "max", "mean", "of"} <= set(summary["pins_in_contact"])
+    assert LOCATION_KEYS <= set(summary["peak_von_mises_at"])
+    assert LOCATION_KEYS <= set(summary["stress"]["away_from_contacts"]["at"])
+    for key in ("fe_rollers", "stribeck_rigid", "stribeck_flexible"):
+        assert HERTZ_KEYS <= set(summary["hertz"][key])
+        assert summary["hertz"][key]["inner"]["peak_pressure_MPa"] > summary["hertz"][key]["outer"]["peak_pressure_MPa"]
+    assert summary["timings_s"]["total"] > summary["timings_s"]["cycle"] > 0
+    # case file defaults are listed (the coarse file does not set e.g. the element order)
+    assert summary["case"]["defaults_used"]["analysis.element_order"] == 1
+
+
+def test_summary_numbers_equal_the_python_api(summary, api):
+    case, system, cycle, comparison = api
+    m = summary["model"]
+    assert (m["nodes"], m["dofs"], m["elements"]) == (system.model.n_nodes, system.model.n_dofs,
+                                                      system.model.n_elements)
+    assert m["dynamic_load_rating_N"] == pytest.approx(comparison.rating_N, rel=1e-12)
+    for entry, bc in zip(summary["bearings"], comparison.bearings):
+        assert entry["bearing"] == bc.bearing + 1
+        for model in ("rigid", "flexible", "equal_share"):
+            s, ref = entry[model], getattr(bc, model)
+            assert s["max_load_N"] == pytest.approx(ref.max_N, rel=1e-9)
+            assert s["max_at_deg"] == pytest.approx(ref.max_at_deg, abs=1e-9)
+            assert s["min_load_N"] == pytest.approx(ref.min_N, rel=1e-9)
+            assert s["equivalent_load_N"] == pytest.approx(ref.equivalent_N, rel=1e-9)
+            assert s["L10h_h"] == pytest.approx(ref.L10h, rel=1e-9)
+        assert entry["delta_max_percent"] == pytest.approx(bc.delta_max_percent, rel=1e-7, abs=1e-9)
+        assert entry["delta_min_percent"] == pytest.approx(bc.delta_min_percent, rel=1e-7, abs=1e-9)
+        assert entry["life_ratio"] == pytest.approx(bc.life_ratio, rel=1e-9)
+    assert summary["pins_in_contact"]["min"] == int(cycle.pins_in_contact.min())
+    assert summary["pins_in_contact"]["max"] == int(cycle.pins_in_contact.max())
+    assert summary["torsional_stiffness_Nm_per_arcmin"] == pytest.approx(
+        cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm), rel=1e-9)
+    assert summary["equilibrium_residual"] < 1e-8
+    assert summary["hertz"]["fe_rollers"]["roller_load_N"] == pytest.approx(float(cycle.roller_loads.max()), rel=1e-9)
+    k = int(np.argmax(cycle.bearing_loads.max(axis=1)))
+    assert summary["max_bearing_load"]["theta_deg"] == pytest.approx(math.degrees(cycle.theta[k]))
+
+
+# --------------------------------------------------------------------------------------------
+# VTK
+# --------------------------------------------------------------------------------------------
+
+
+def _pvd_files(out: Path) -> list[tuple[float, Path]]:
+    root = ET.parse(out / "vtk" / "disc.pvd").getroot()
+    return [(float(d.get("timestep")), out / "vtk" / d.get("file")) for d in root.iter("DataSet")]
+
+
+def _von_mises(sxx, syy, sxy):
+    return np.sqrt(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2)
+
+
+def test_vtu_files_read_back_with_the_named_fields(cli_run, summary):
+    entries = _pvd_files(cli_run)
+    angles = [f["theta_deg"] for f in summary["fields"]]
+    assert [t for t, _ in entries] == pytest.approx(sorted(angles))
+    assert 0.0 in angles and summary["max_bearing_load"]["theta_deg"] in angles
+    for _, path in entries:
+        mesh = meshio.read(path)
+        assert mesh.points.shape == (summary["model"]["vertices"], 3)
+        assert mesh.cells[0].type == "triangle" and len(mesh.cells[0].data) == summary["model"]["elements"]
+        for name, comps in POINT_FIELDS.items():
+            a = mesh.point_data[name]
+            assert a.shape[0] == len(mesh.points) and (a.ndim == 1 if comps == 1 else a.shape[1] == comps)
+            assert np.all(np.isfinite(a))
+        for name in CELL_FIELDS:
+            assert mesh.cell_data[name][0].shape == (summary["model"]["elements"],)
+        pd, cd = mesh.point_data, {k: v[0] for k, v in mesh.cell_data.items()}
+        for data in (pd, cd):
+            vm = _von_mises(data["sxx_MPa"], data["syy_MPa"], data["sxy_MPa"])
+            np.testing.assert_allclose(data["von_mises_MPa"], vm, rtol=1e-10, atol=1e-9)
+            np.testing.assert_allclose(data["s1_MPa"] + data["s2_MPa"], data["sxx_MPa"] + data["syy_MPa"],
+                                       rtol=1e-10, atol=1e-9)
+        assert float(pd["von_mises_MPa"].max()) <= summary["peak_von_mises_MPa"] * (1 + 1e-12)
+    peak_file = next(p for t, p in entries if t == pytest.approx(summary["peak_von_mises_at"]["theta_deg"]))
+    mesh = meshio.read(peak_file)
+    i = int(np.argmax(mesh.point_data["von_mises_MPa"]))
+    assert mesh.point_data["von_mises_MPa"][i] == pytest.approx(summary["peak_von_mises_MPa"], rel=1e-12)
+    assert mesh.points[i, :2] == pytest.approx([summary["peak_von_mises_at"]["x_mm"],
+                                                summary["peak_von_mises_at"]["y_mm"]])
+
+
+# --------------------------------------------------------------------------------------------
+# Images, plots, report
+# --------------------------------------------------------------------------------------------
+
+
+def _check_png(path: Path, size: tuple[int, int] | None = None) -> None:
+    from PIL import Image
+
+    with Image.open(path) as im:
+        assert im.format == "PNG"
+        if size is not None:
+            assert im.size == size
+        rgb = np.asarray(im.convert("RGB"))
+    assert rgb.std() > 10.0
+    packed = (rgb[..., 0].astype(np.int64) << 16) | (rgb[..., 1].astype(np.int64) << 8) | rgb[..., 2]
+    colours = np.unique(packed)
+    assert len(colours) > 64, f"{path.name}: only {len(colours)} colours"
+
+
+def test_images_are_real_renders(cli_run, summary):
+    images = summary["images"]
+    stress = [f["image"] for f in summary["fields"]]
+    assert len(stress) == len(summary["fields"]) >= 2
+    assert {"mesh", "stress_peak_closeup", "stress_away_from_contacts_closeup"} <= set(images)
+    for rel in stress + [images["stress_peak_closeup"], images["stress_away_from_contacts_closeup"]]:
+        _check_png(cli_run / rel, IMAGE_SIZE)
+    _check_png(cli_run / images["mesh"])
+    # the stress image is mostly coloured by the colour map, not background
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(cli_run / stress[0]).convert("RGB")).astype(int)
+    coloured = (rgb.max(axis=2) - rgb.min(axis=2) > 20).mean()
+    assert coloured > 0.12
+
+
+def test_plots_exist(cli_run, summary):
+    assert set(summary["plots"]) == {"bearing_loads", "roller_loads", "pin_forces", "pins_in_contact"}
+    for rel in summary["plots"].values():
+        _check_png(cli_run / rel)
+
+
+def test_report_embeds_the_images(cli_run, summary):
+    html = (cli_run / "report.html").read_text(encoding="utf-8")
+    n_png = len(summary["images"]) + len(summary["plots"])
+    assert html.count('<img src="data:image/png;base64,') == n_png
+    assert "src=\"images/" not in html and "src=\"plots/" not in html
+    assert summary["case"]["name"] in html and "disc centre" in html
+    assert f"{summary['bearings'][0]['flexible']['max_load_N']:.0f}" in html
+
+
+def test_files_listed_exist(cli_run, summary):
+    listed = set(summary["files"])
+    on_disk = {p.relative_to(cli_run).as_posix() for p in cli_run.rglob("*") if p.is_file()}
+    assert listed == on_disk
+    assert not any(p.name.startswith(".") for p in cli_run.parent.iterdir())  # no temporary folders left
+
+
+# --------------------------------------------------------------------------------------------
+# CSV
+# --------------------------------------------------------------------------------------------
+
+
+def _read_csv(path: Path) -> list[dict]:
+    with path.open(newline="", encoding="utf-8") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_csv_tables_agree_with_summary(cli_run, summary):
+    rows = _read_csv(cli_run / "bearing_loads.csv")
+    assert len(rows) == summary["model"]["angles"]
+    theta = [float(r["theta_deg"]) for r in rows]
+    assert theta == pytest.approx(np.arange(0.0, 360.0, STEP_DEG))
+    for b in summary["bearings"]:
+        i = b["bearing"]
+        for model in ("flexible", "rigid"):
+            f = np.array([float(r[f"bearing{i}_{model}_F_N"]) for r in rows])
+            fx = np.array([float(r[f"bearing{i}_{model}_Fx_N"]) for r in rows])
+            fy = np.array([float(r[f"bearing{i}_{model}_Fy_N"]) for r in rows])
+            np.testing.assert_allclose(np.hypot(fx, fy), f, rtol=1e-8)
+            assert f.max() == pytest.approx(b[model]["max_load_N"], rel=1e-9)
+            assert theta[int(np.argmax(f))] == pytest.approx(b[model]["max_at_deg"])
+            assert f.min() == pytest.approx(b[model]["min_load_N"], rel=1e-9)
+
+    rollers = _read_csv(cli_run / "roller_loads.csv")
+    assert len(rollers) == 18 * 3 * 14
+    q = max(float(r["load_N"]) for r in rollers)
+    assert q == pytest.approx(summary["hertz"]["fe_rollers"]["roller_load_N"], rel=1e-9)
+
+    pins = _read_csv(cli_run / "pin_forces.csv")
+    assert len(pins) == 18 * 40
+    first = [r for r in pins if float(r["theta_deg"]) == 0.0]
+    assert math.hypot(float(first[0]["x_mm"]), float(first[0]["y_mm"]) + 0.0) == pytest.approx(64.0 - 1.3)
+    classical = np.array([float(r["classical_N"]) for r in first])
+    assert 18 <= np.count_nonzero(classical) <= 22
+
+    cycle = _read_csv(cli_run / "cycle.csv")
+    counts = [int(r["pins_in_contact"]) for r in cycle]
+    assert (min(counts), max(counts)) == (summary["pins_in_contact"]["min"], summary["pins_in_contact"]["max"])
+
+
+# --------------------------------------------------------------------------------------------
+# Nothing lost
+# --------------------------------------------------------------------------------------------
+
+
+def test_second_run_without_overwrite_fails_and_keeps_the_results(cli_run, coarse_case_file, cache_dir, capsys):
+    before = {p: p.read_bytes() for p in cli_run.rglob("*") if p.is_file()}
+    code = cli.main(["run", str(coarse_case_file), "-o", str(cli_run), "--cache-dir", str(cache_dir)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "exists and is not empty" in err and "--overwrite" in err and "Traceback" not in err
+    assert {p: p.read_bytes() for p in cli_run.rglob("*") if p.is_file()} == before
+
+
+def test_overwrite_replaces_and_options_override_the_case(cli_run, coarse_case_file, cache_dir, workspace, capsys):
+    import shutil
+
+    out = workspace / "overwritten"
+    shutil.copytree(cli_run, out)
+    code = cli.main(["run", str(coarse_case_file), "-o", str(out), "--cache-dir", str(cache_dir), "--overwrite",
+                     "--no-images", "--step", "30", "--bearing-model", "rigid_bore"])
+    stdout = capsys.readouterr().out
+    assert code == 0
+    s = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    assert s["model"]["angles"] == 12 and s["model"]["bearing_model"] == "rigid_bore"
+    assert s["case"]["overrides"] == {"analysis.angle_step_deg": 30.0, "crank_bearing.model": "rigid_bore"}
+    assert s["case"]["matches_file"] is False
+    assert s["hertz"]["fe_rollers"] is None and s["images"] == {}
+    assert not (out / "images").exists() and not (out / "roller_loads.csv").exists()
+    assert len(_read_csv(out / "bearing_loads.csv")) == 12
+    assert "rigid_bore" in stdout and "life ratio" in stdout
+    assert not any(p.name.startswith(".") for p in workspace.iterdir())
+
+
+class Interrupt:
+    """A progress callback that raises after a few crank angles."""
+
+    def __init__(self, exc: BaseException, after: int = 3):
+        self.exc, self.after, self.seen = exc, after, []
+
+    def __call__(self, stage, done, total):
+        self.seen.append((stage, done, total))
+        if stage == "cycle" and done >= self.after:
+            raise self.exc
+
+
+@pytest.mark.parametrize("exc", [KeyboardInterrupt(), RuntimeError("boom")])
+def test_interrupted_run_leaves_no_folder(coarse_case_file, cache_dir, tmp_path, exc):
+    out = tmp_path / "a" / "b" / "out"
+    cb = Interrupt(exc)
+    with pytest.raises(type(exc)):
+        run_case(coarse_case_file, out, progress=cb, cache_dir=cache_dir, images=False)
+    assert ("cycle", 3, 18) in cb.seen
+    assert list(tmp_path.iterdir()) == []          # no DIR, no temporary folder, no created parents
+
+
+def test_interrupted_overwrite_keeps_the_previous_results(coarse_case_file, cache_dir, tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "old.txt").write_text("previous results")
+    with pytest.raises(KeyboardInterrupt):
+        run_case(coarse_case_file, out, overwrite=True, progress=Interrupt(KeyboardInterrupt()),
+                 cache_dir=cache_dir, images=False)
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+    assert [p.name for p in out.iterdir()] == ["old.txt"]
+
+
+def test_cli_interrupt_exits_130(coarse_case_file, cache_dir, tmp_path, monkeypatch, capsys):
+    import rvfem.cycle
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(rvfem.cycle, "load_cycle", interrupted)
+    out = tmp_path / "out"
+    assert cli.main(["run", str(coarse_case_file), "-o", str(out), "--cache-dir", str(cache_dir),
+                     "--no-images"]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_existing_file_as_output_is_an_error(coarse_case_file, tmp_path):
+    target = tmp_path / "file"
+    target.write_text("x")
+    with pytest.raises(OutputError, match="not a folder"):
+        run_case(coarse_case_file, target, images=False)
+
+
+def test_impossible_rendering_is_a_clear_error(coarse_case_file, cache_dir, tmp_path, monkeypatch, capsys):
+    # a renderer that crashes its process, as VTK does without any usable OpenGL context
+    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render, "_probe_result", None)
+    with pytest.raises(RenderError, match="off-screen rendering is not available.*--no-images"):
+        render.check_rendering()
+    out = tmp_path / "out"
+    assert cli.main(["run", str(coarse_case_file), "-o", str(out), "--cache-dir", str(cache_dir)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "crashed" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_step_is_a_case_error(coarse_case_file, tmp_path, capsys):
+    assert cli.main(["run", str(coarse_case_file), "-o", str(tmp_path / "o"), "--step", "-5"]) == 2
+    assert "angle step" in capsys.readouterr().err
