@@ -41,6 +41,8 @@ DEFAULT_RENDER_WINDOW = "vtkEGLRenderWindow"
 """Render window used when the variable is not set (Linux): off-screen EGL, no X server."""
 
 COLORMAP = "turbo"
+ABOVE_COLOUR = "magenta"
+"""Colour of stresses above the colour range (the contact spots when the range is clipped)."""
 BACKGROUND = "white"
 
 _PROBE = r"""
@@ -177,7 +179,8 @@ class StressScene:
         Deformation to draw (magnified by ``magnification``), mm.
     magnification : float
     clim : (float, float)
-        Colour range, MPa (the same for all angles of a run).
+        Colour range, MPa (the same for all angles of a run). Values above it are drawn in
+        :data:`ABOVE_COLOUR` and the colour bar says so.
     pin_centres : ndarray (Zp, 2)
     pin_radius : float
     pin_loaded : ndarray (Zp,) of bool
@@ -262,6 +265,9 @@ def _bearing_arrows(pv, pl, scene: StressScene) -> None:
     if scene.rigid_forces is not None:
         key.append("grey arrows: handbook (rigid) forces")
     key += ["dark pins: in contact", "grey outline: undeformed disc"]
+    top = float(np.max(scene.von_mises))
+    if top > scene.clim[1] * (1 + 1e-9):
+        key.append(f"{ABOVE_COLOUR}: above {scene.clim[1]:.0f} MPa (contact spots, up to {top:.0f} MPa)")
     pl.add_text("\n".join(key), position="lower_right", font_size=10, color="black")
 
 
@@ -304,8 +310,10 @@ def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[fl
 
     pl = pv.Plotter(off_screen=True, window_size=list(window_size))
     pl.set_background(BACKGROUND)
+    clipped = float(np.max(scene.von_mises)) > scene.clim[1] * (1 + 1e-9)
     pl.add_mesh(disc, scalars="von Mises [MPa]", cmap=COLORMAP, clim=list(scene.clim), show_edges=show_edges,
                 edge_color="#303030", line_width=0.5, lighting=False,
+                above_color=ABOVE_COLOUR if clipped else None,
                 scalar_bar_args=dict(title="von Mises [MPa]", vertical=True, color="black", fmt="%.0f",
                                      n_labels=6, position_x=0.87, position_y=0.25, width=0.06, height=0.65,
                                      title_font_size=20, label_font_size=18))
@@ -324,7 +332,7 @@ def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[fl
         _bearing_arrows(pv, pl, scene)
     if marker is not None:
         ring = pv.Disc(center=(marker[0], marker[1], 3.0), inner=0.35, outer=0.5, c_res=32)
-        pl.add_mesh(ring, color="magenta", lighting=False)
+        pl.add_mesh(ring, color="black", lighting=False)
     pl.add_text(scene.title, position="upper_left", font_size=12, color="black")
 
     if focus is None:

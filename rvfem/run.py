@@ -591,7 +591,9 @@ def _run_stages(case: Case, info: _CaseInfo, thetas: np.ndarray, tmp: Path, stag
             max_def = max(float(np.max(np.hypot(*s.deformation.T))) for s in snapshots)
             magnification = render.nice_factor(DEFORMATION_DISPLAY_FRACTION * case.pins.circle_radius / max_def)
             f_ref = max(float(cycle.bearing_loads.max()), float(hb.magnitude.max()))
-            clim = (0.0, peak.von_mises_MPa)
+            # colour range up to the peak away from the contacts (the structural field stays readable);
+            # the contact spots above it are drawn in the "above" colour
+            clim = (0.0, (away or peak).von_mises_MPa)
             bores = bore_centres(case)
 
             def scene(snap, label):
@@ -625,7 +627,7 @@ def _run_stages(case: Case, info: _CaseInfo, thetas: np.ndarray, tmp: Path, stag
                 snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
                 path = tmp / "images" / f"{key}.png"
                 close = dataclasses.replace(
-                    scene(snap, ""), magnification=0.0,
+                    scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
                     title=f"{title}   crank angle {snap.theta_deg:.1f}°   close-up (undeformed): von Mises "
                           f"{pk.von_mises_MPa:.0f} MPa at the ring, {pk.feature_label}")
                 render.stress_image(path, close, focus=(pk.x_mm, pk.y_mm), half_height=half,
