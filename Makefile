@@ -8,7 +8,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 
 # The main job: arguments of the `rvfem` command that `make run` executes.
-MAIN_JOB ?= rigid cases/rv40e.toml
+MAIN_JOB ?= run cases/rv40e_fanholes.toml -o results/rv40e_fanholes --overwrite
 
 .PHONY: run test install install-dev help
 
