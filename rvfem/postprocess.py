@@ -278,8 +278,8 @@ def _contacts(case: Case, q: float) -> tuple[evaluation.HertzLineContact, evalua
     return inner, outer
 
 
-def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float | None = None
-                 ) -> dict[str, RollerHertz]:
+def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float | None = None,
+                 rigid_max_bearing: int | None = None) -> dict[str, RollerHertz]:
     """Hertz pressures of the most loaded roller, from the FE roller loads and from Stribeck.
 
     Parameters
@@ -290,6 +290,8 @@ def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float 
         Largest handbook bearing load over the cycle, N.
     rigid_max_at_deg : float, optional
         Its crank angle, degrees.
+    rigid_max_bearing : int, optional
+        Its bearing (0-based).
 
     Returns
     -------
@@ -306,7 +308,8 @@ def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float 
         out["fe_rollers"] = RollerHertz("fe_rollers", q, *_contacts(case, q), bearing=int(i), roller=int(j),
                                         theta_deg=math.degrees(float(cycle.theta[k])))
     q = evaluation.stribeck_max_roller_load(rigid_max_N, z)
-    out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_contacts(case, q), theta_deg=rigid_max_at_deg)
+    out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_contacts(case, q), bearing=rigid_max_bearing,
+                                        theta_deg=rigid_max_at_deg)
     k, i = max_load_index(cycle.bearing_forces)
     f = float(np.linalg.norm(cycle.bearing_forces[k, i]))
     q = evaluation.stribeck_max_roller_load(f, z)

@@ -60,6 +60,12 @@ def _figure(root: Path, rel: str | None, caption: str) -> str:
     return f"<figure>{_img(root / rel, caption)}<figcaption>{_e(caption)}</figcaption></figure>"
 
 
+def _where(at: dict) -> str:
+    d = at["distance_to_feature_mm"]
+    label = _e(at["feature_label"])
+    return f"on the {label}" if d < 1e-6 else f"{d:.2f} mm from the {label}"
+
+
 def _table(header: list[str], rows: list[list[Any]], left: int = 1, classes: list[str] | None = None) -> str:
     out = ["<table><tr>" + "".join(f'<th class="{"l" if i < left else ""}">{_e(h)}</th>'
                                   for i, h in enumerate(header)) + "</tr>"]
@@ -215,14 +221,13 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
     pins = summary["pins_in_contact"]
     other = [
         ["peak von Mises (vertex)", f"{summary['peak_von_mises_MPa']:.1f} MPa at ({at['x_mm']:.2f}, {at['y_mm']:.2f}) mm, "
-                                    f"{_e(at['feature_label'])}, θ = {at['theta_deg']:.1f}°"],
+                                    f"{_where(at)}, θ = {at['theta_deg']:.1f}°"],
         ["peak von Mises (element)", f"{summary['stress']['peak_element_von_mises_MPa']:.1f} MPa"],
     ]
     if away:
         other.append(["peak von Mises away from contacts",
                       f"{away['peak_von_mises_MPa']:.1f} MPa at ({away['at']['x_mm']:.2f}, {away['at']['y_mm']:.2f}) mm, "
-                      f"{away['at']['distance_to_feature_mm']:.2f} mm from the {_e(away['at']['feature_label'])}, "
-                      f"θ = {away['at']['theta_deg']:.1f}°"])
+                      f"{_where(away['at'])}, θ = {away['at']['theta_deg']:.1f}°"])
     mx = summary["max_bearing_load"]
     other += [
         ["largest bearing load", f"{mx['flexible_N']:.0f} N, bearing {mx['bearing']}, θ = {mx['theta_deg']:.1f}°"],

@@ -184,8 +184,8 @@ def _resolve_case(case: Case | str | os.PathLike, angle_step_deg: float | None, 
     overrides: dict[str, Any] = {}
     analysis, bearing = base.analysis, base.crank_bearing
     if angle_step_deg is not None:
-        if not (isinstance(angle_step_deg, (int, float)) and 0 < angle_step_deg <= 90):
-            raise CaseError(f"the angle step must be in (0°, 90°], got {angle_step_deg!r}")
+        if not (isinstance(angle_step_deg, (int, float)) and angle_step_deg > 0):
+            raise CaseError(f"the angle step must be positive, got {angle_step_deg!r}")
         analysis = dataclasses.replace(analysis, angle_step_deg=float(angle_step_deg))
         overrides["analysis.angle_step_deg"] = float(angle_step_deg)
     if order is not None:
@@ -198,7 +198,11 @@ def _resolve_case(case: Case | str | os.PathLike, angle_step_deg: float | None, 
             raise CaseError(f"the bearing model must be 'rollers' or 'rigid_bore', got {bearing_model!r}")
         bearing = dataclasses.replace(bearing, model=bearing_model)
         overrides["crank_bearing.model"] = bearing_model
-    effective = base.replace(analysis=analysis, crank_bearing=bearing) if overrides else base
+    try:
+        effective = base.replace(analysis=analysis, crank_bearing=bearing) if overrides else base
+    except CaseError as exc:
+        given = ", ".join(f"{k} = {v}" for k, v in overrides.items())
+        raise CaseError(f"the overrides ({given}) are not valid: {exc}") from None
     return effective, _CaseInfo(file_info[0], file_info[1], matches and not overrides, overrides, defaults)
 
 
@@ -531,8 +535,10 @@ def _run_stages(case: Case, info: _CaseInfo, thetas: np.ndarray, tmp: Path, stag
     band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
     away = postprocess.peak_von_mises(snapshots, mesh.points, mesh.boundaries, exclude=band)
     k_max, i_max = postprocess.max_load_index(cycle.bearing_forces)
-    rigid_max = max(comparison.bearings, key=lambda b: b.rigid.max_N).rigid
-    hertz = postprocess.roller_hertz(case, cycle, rigid_max.max_N, rigid_max.max_at_deg)
+    # the first bearing among equals (the handbook curves are exact shifts of each other)
+    rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
+    hertz = postprocess.roller_hertz(case, cycle, rigid_max.rigid.max_N, rigid_max.rigid.max_at_deg,
+                                     rigid_max.bearing)
     stiffness = cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm)
     stages.end("evaluation", t)
 

@@ -398,3 +398,18 @@ def test_impossible_rendering_is_a_clear_error(coarse_case_file, cache_dir, tmp_
 def test_bad_step_is_a_case_error(coarse_case_file, tmp_path, capsys):
     assert cli.main(["run", str(coarse_case_file), "-o", str(tmp_path / "o"), "--step", "-5"]) == 2
     assert "angle step" in capsys.readouterr().err
+
+
+def test_p2_fields_are_written_on_the_linear_mesh(coarse_case_file, cache_dir, tmp_path):
+    result = run_case(coarse_case_file, tmp_path / "p2", order=2, angle_step_deg=30.0, cache_dir=cache_dir,
+                      images=False)
+    s = result.summary
+    assert s["model"]["element_order"] == 2 and s["case"]["overrides"]["analysis.element_order"] == 2
+    assert s["model"]["nodes"] > s["model"]["vertices"]
+    mesh = meshio.read(tmp_path / "p2" / s["fields"][0]["vtu"])
+    assert mesh.points.shape == (s["model"]["vertices"], 3)
+    vertex_u = result.cycle.fields[min(result.cycle.fields)][result.system.model.node_dofs[: s["model"]["vertices"]]]
+    np.testing.assert_allclose(mesh.point_data["displacement_mm"][:, :2], vertex_u, rtol=1e-12, atol=1e-15)
+    pd = mesh.point_data
+    np.testing.assert_allclose(pd["von_mises_MPa"], _von_mises(pd["sxx_MPa"], pd["syy_MPa"], pd["sxy_MPa"]),
+                               rtol=1e-10, atol=1e-9)
