@@ -315,7 +315,8 @@ class Analysis:
     element_order : int
         1 (P1) or 2 (P2) triangles.
     friction : float
-        Coulomb friction coefficient at the pins.
+        Coulomb friction coefficient at the pins (force μ·λ along the known sliding direction,
+        the pin centre's velocity relative to the disc).
     max_active_set_iterations : int
         Bound of the contact active-set loop.
     saved_angles_deg : tuple of float

@@ -333,6 +333,10 @@ class ContactSet:
         m_c: approach per unit carrier rotation (mm/rad) = c_i × F̂_c for bearing contacts.
     laws : list of (slice, law)
         Force laws of the spring contacts.
+    W_load : sparse (n_cols, n_contacts) or None
+        Weights of the *load* of each contact if it differs from ``W`` (Coulomb friction at the
+        pins: the force on the disc is λ·(d + μ·s·t), normal plus friction along the known sliding
+        direction, while the gap is still measured along the normal d). None: same as ``W``.
     """
 
     W: sp.csc_matrix
@@ -341,6 +345,7 @@ class ContactSet:
     offset: np.ndarray
     lever: np.ndarray
     laws: list
+    W_load: sp.csc_matrix | None = None
 
 
 @dataclass(frozen=True)
@@ -426,33 +431,37 @@ def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, to
 
 def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_gap, names,
             rigid_dofs=(0, 1, 2), engage_all=False):
-    W = cset.W.tocsc()
+    W = cset.W.tocsc()                                # gaps/approaches are measured along W
+    WL = W if cset.W_load is None else cset.W_load.tocsc()   # loads act along W_load
     nc = W.shape[1]
-    Rc = np.asarray(W.T @ iface.resultants)          # (nc, 3): Fx, Fy, Mz per unit λ
-    Rfull = Rc.copy()
+    Rc = np.asarray(W.T @ iface.resultants)          # rigid motion → approach, per contact
+    RL = np.asarray(WL.T @ iface.resultants)         # (nc, 3): Fx, Fy, Mz on the disc per unit λ
+    Rfull = RL.copy()
     dropped = [k for k in range(3) if k not in rigid_dofs]
     Rc[:, dropped] = 0.0
+    RL[:, dropped] = 0.0
     carrier = torque is not None                     # without a carrier: no φ unknown
     torque = 0.0 if torque is None else torque
     sig = cset.signorini
     spring = ~sig
     r_typ = max(float(np.abs(cset.lever).max()), 1.0)
 
-    # compliance between the contacts, G = Wᵀ C W, on the columns the contacts touch; column j of
-    # G is valid once the interface columns of contact j are known (C is filled column-wise and
+    # compliance between the contacts, G = Wᵀ C W_load, on the columns the contacts touch; column
+    # j of G is valid once the load columns of contact j are known (C is filled column-wise and
     # symmetric, so the rows of every other contact come with it)
-    touched = np.unique(W.indices)
+    touched = np.unique(np.concatenate([W.indices, WL.indices]))
     Wsub = W[touched, :].toarray()
+    WLsub = WL[touched, :].toarray()
     cache = {"version": -1, "G": None}
 
-    nonzero = Wsub != 0
+    nonzero = WLsub != 0
 
     def G_cols(idx):
         if idx.size == 0:
             return np.zeros((nc, 0))
         compliance.ensure(touched[nonzero[:, idx].any(axis=1)])
         if cache["version"] != compliance.version:
-            cache["G"] = Wsub.T @ compliance.C[np.ix_(touched, touched)] @ Wsub
+            cache["G"] = Wsub.T @ compliance.C[np.ix_(touched, touched)] @ WLsub
             cache["version"] = compliance.version
         return cache["G"][:, idx]
 
@@ -474,7 +483,7 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
         active = sig & ((start.force > 0) | (cset.gap0 < -tol_gap))
     else:
         lam, a, phi = np.zeros(nc), np.zeros(3), 0.0
-        active = sig & (cset.gap0 <= tol_gap) & (Rc[:, 2] * torque <= 0)
+        active = sig & (cset.gap0 <= tol_gap) & (RL[:, 2] * torque <= 0)
     g_act = G_cols(np.flatnonzero(active)) if active.any() else None
     kappa = 1.0 / float(np.median(np.diag(g_act[active]))) if g_act is not None else 1e6
     scale_f = max(abs(torque) / r_typ, 1.0)
@@ -507,10 +516,10 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
         ii = np.flatnonzero(sig & ~active)
         r[ii] = lam[ii]
         Jm[ii, ii] = 1.0
-        r[nc:nc + 2] = Rc[:, :2].T @ lam
-        Jm[nc:nc + 2, :nc] = Rc[:, :2].T
-        r[nc + 2] = Rc[:, 2] @ lam / r_typ
-        Jm[nc + 2, :nc] = Rc[:, 2] / r_typ
+        r[nc:nc + 2] = RL[:, :2].T @ lam
+        Jm[nc:nc + 2, :nc] = RL[:, :2].T
+        r[nc + 2] = RL[:, 2] @ lam / r_typ
+        Jm[nc + 2, :nc] = RL[:, 2] / r_typ
         if carrier:
             r[nc + 3] = (cset.lever @ lam - torque) / r_typ
             Jm[nc + 3, :nc] = cset.lever / r_typ
@@ -554,7 +563,7 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
     # the spring laws to the tolerance above; it is not replaced by q(δ), which would trade the
     # former for the latter
     lam = np.where(sig & ~active, 0.0, lam)
-    Rc = Rfull
+    Rc = Rfull                                       # the loads' resultants, all three
     res_f = float(np.linalg.norm(Rc[:, :2].T @ lam))
     residual = {
         "force_N": res_f,

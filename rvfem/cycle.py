@@ -151,11 +151,6 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
         raise CaseError("pin model 'linear' needs a positive pin_stiffness_N_per_mm")
     if bearing_model not in ("rollers", "rigid_bore"):
         raise CaseError(f"bearing model must be 'rollers' or 'rigid_bore', got {bearing_model!r}")
-    if case.analysis.friction > 0:
-        raise CaseError(
-            f"{case.source}: 'analysis.friction' = {case.analysis.friction}: pin friction is not "
-            "modelled yet; set it to 0 (the frictionless result is what rvfem computes)"
-        )
     times = {}
     geometry = disc_geometry(case)
     t0 = time.perf_counter()
@@ -190,7 +185,7 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
 
     Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
     """
-    from .geometry import pin_profile_contacts
+    from .geometry import pin_centres, pin_profile_contacts
 
     case = system.case
     iface = system.interface
@@ -198,7 +193,19 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     pc = pin_profile_contacts(system.geometry, theta)
     zp = case.pins.count
     s = prof.arc_of(np.asarray(pc.point))
-    cols, wts = prof.columns_at(s, -np.asarray(pc.normal))   # pins push along the inward normal
+    inward = -np.asarray(pc.normal)
+    cols, wts = prof.columns_at(s, inward)   # pins push along the inward normal
+    mu = case.analysis.friction
+    pin_load = None
+    if mu > 0:
+        # Coulomb friction along the known sliding direction: the pin centre's velocity relative
+        # to the disc (the pins are taken as not rolling in their grooves); the friction force on
+        # the disc drags its surface along with the pin: μ·λ·sign(v·t)·t, t the profile tangent
+        h = 1e-6
+        vel = (pin_centres(case, theta + h) - pin_centres(case, theta - h)) / (2 * h)
+        tangent = np.stack([-inward[:, 1], inward[:, 0]], axis=1)
+        slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
+        _, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
     rows_w = [cols.ravel()]
     cols_w = [np.repeat(np.arange(zp), cols.shape[1])]
     vals_w = [wts.ravel()]
@@ -264,10 +271,15 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
 
     W = sp.csc_matrix((np.concatenate(vals_w), (np.concatenate(rows_w), np.concatenate(cols_w))),
                       shape=(iface.n_columns, n))
+    W_load = None
+    if pin_load is not None:
+        vals_w[0] = pin_load.ravel()
+        W_load = sp.csc_matrix((np.concatenate(vals_w), (np.concatenate(rows_w), np.concatenate(cols_w))),
+                               shape=(iface.n_columns, n))
     F = np.asarray(W.T @ iface.resultants[:, :2])     # force on the disc per unit λ
     cb = centres[np.asarray(bearing_of, dtype=int)]
     lever = np.concatenate([np.zeros(zp), cb[:, 0] * F[zp:, 1] - cb[:, 1] * F[zp:, 0]])
-    return ContactSet(W, signorini, gap0, offset, lever, laws), names
+    return ContactSet(W, signorini, gap0, offset, lever, laws, W_load), names
 
 
 @dataclass(frozen=True)
