@@ -103,7 +103,8 @@ def assumptions(summary: dict, case: Case) -> list[str]:
         f"{m['disc_torque_Nmm'] / 1000:g} N·m, applied as the moment of the pin forces about the <b>disc centre</b> "
         "(the handbook's ΣP_x = T/(2·e·Zc)). About the reducer axis the moment differs by Zp/Zc "
         f"({100 * (case.pins.count / case.cycloid.teeth - 1):.1f} % here).",
-        f"Pins: {pin}; no friction (friction is not modelled).",
+        f"Pins: {pin}; " + (f"Coulomb friction μ = {case.analysis.friction:g} along the sliding direction."
+                             if case.analysis.friction > 0 else "no friction (μ = 0)."),
         bearing,
         "Carrier: one rigid body that only rotates about the reducer axis; its rotation is the unknown conjugate to "
         "the disc torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
