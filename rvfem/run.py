@@ -704,6 +704,7 @@ def _run_stages(case: Case, info: _CaseInfo, thetas: np.ndarray, tmp: Path, stag
                 "bearing_model": b.model,
                 "element_order": model.order,
                 "pin_model": system.pin_model,
+                "pin_friction": case.analysis.friction,
                 "nodes": model.n_nodes,
                 "vertices": model.n_vertices,
                 "dofs": model.n_dofs,

@@ -38,7 +38,7 @@ TOP_KEYS = {
 }
 CASE_KEYS = {"name", "description", "file", "sha256", "matches_file", "digest", "overrides", "defaults_used"}
 MODEL_KEYS = {
-    "bearing_model", "element_order", "pin_model", "nodes", "vertices", "dofs", "elements", "mesh_file",
+    "bearing_model", "element_order", "pin_model", "pin_friction", "nodes", "vertices", "dofs", "elements", "mesh_file",
     "mesh_min_quality", "angle_step_deg", "angles", "output_torque_Nm", "discs", "disc_torque_Nmm",
     "torque_convention", "radial_clearance_mm", "equivalent_load_exponent", "dynamic_load_rating_N",
     "bearing_speed_rpm", "handbook_k_y", "fe_pin_resultant_ratio",
