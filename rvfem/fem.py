@@ -67,6 +67,7 @@ import scipy.sparse.linalg as spla
 from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector, MeshTri, asm
 from skfem.models.elasticity import linear_elasticity
 
+from ._arrays import readonly as _readonly
 from .errors import MeshError
 
 __all__ = [
@@ -105,10 +106,6 @@ logger = logging.getLogger(__name__)
 # --------------------------------------------------------------------------------------------
 
 
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.setflags(write=False)
-    return a
 
 
 @dataclass(frozen=True, eq=False)

@@ -73,6 +73,7 @@ from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial import cKDTree
 
 from .case import Case
+from ._arrays import readonly as _readonly
 from .errors import GeometryError
 
 __all__ = [
@@ -119,10 +120,6 @@ def _c2xy(z) -> np.ndarray:
     return np.ascontiguousarray(np.stack([z.real, z.imag], axis=-1))
 
 
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a)
-    a.setflags(write=False)
-    return a
 
 
 # ------------------------------------------------------------------------------------------------

@@ -55,6 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .case import Case
+from ._arrays import readonly
 from .errors import CaseError
 
 __all__ = [
@@ -218,10 +219,6 @@ class PinForces:
 # --------------------------------------------------------------------------------------------
 
 
-def _frozen(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=float)
-    a.setflags(write=False)
-    return a
 
 
 def load_cycle_angles(step_deg: float) -> np.ndarray:
@@ -353,13 +350,13 @@ def handbook_bearing_loads(case: Case, theta=None) -> RigidLoads:
     fx = -f_t * sa - f_r * ca
     fy = f_t * ca - f_r * sa
     return RigidLoads(
-        theta=_frozen(th),
-        crank_angles=_frozen(alpha),
-        fx=_frozen(fx),
-        fy=_frozen(fy),
-        magnitude=_frozen(np.hypot(f_t, f_r)),
-        tangential=_frozen(f_t),
-        radial=_frozen(f_r),
+        theta=readonly(th, dtype=float),
+        crank_angles=readonly(alpha, dtype=float),
+        fx=readonly(fx, dtype=float),
+        fy=readonly(fy, dtype=float),
+        magnitude=readonly(np.hypot(f_t, f_r), dtype=float),
+        tangential=readonly(f_t, dtype=float),
+        radial=readonly(f_r, dtype=float),
         components=comp,
     )
 
@@ -529,13 +526,13 @@ def classical_pin_forces(case: Case, theta=None, *, exact_moment: bool = False) 
     dy = e * zc * uy - y
     dist = np.hypot(dx, dy)  # = Rp·√(1 + K1² − 2K1 cos φ)
     return PinForces(
-        theta=_frozen(th),
-        pin_angle=_frozen(psi),
-        phi=_frozen(phi),
-        x=_frozen(x),
-        y=_frozen(y),
-        magnitude=_frozen(magnitude),
-        fx=_frozen(magnitude * dx / dist),
-        fy=_frozen(magnitude * dy / dist),
-        f_max=_frozen(f_max),
+        theta=readonly(th, dtype=float),
+        pin_angle=readonly(psi, dtype=float),
+        phi=readonly(phi, dtype=float),
+        x=readonly(x, dtype=float),
+        y=readonly(y, dtype=float),
+        magnitude=readonly(magnitude, dtype=float),
+        fx=readonly(magnitude * dx / dist, dtype=float),
+        fy=readonly(magnitude * dy / dist, dtype=float),
+        f_max=readonly(f_max, dtype=float),
     )
