@@ -77,7 +77,9 @@ class FootprintGrid:
     offset : int
         Index of the grid's first column among all columns of the interface.
     chain : rvfem.fem.BoundaryChain
-        The boundary loop; column k sits at its vertex k (arc length ``chain.s[k]``).
+        The boundary loop.
+    stride : int
+        Columns sit at every ``stride``-th vertex of the chain (arc lengths ``chain.s[::stride]``).
     centre : ndarray (2,) or None
         Bore centre for bore grids (one column per vertex, pushing radially away from it), None
         for the profile (two columns per vertex, unit forces in x and y, so that a contact force
@@ -88,6 +90,7 @@ class FootprintGrid:
     offset: int
     chain: object
     centre: np.ndarray | None = None
+    stride: int = 1
 
     @property
     def components(self) -> int:
@@ -95,14 +98,19 @@ class FootprintGrid:
         return 1 if self.centre is not None else 2
 
     @property
+    def arcs(self) -> np.ndarray:
+        """Arc lengths of the column positions, mm, with the loop length appended."""
+        return np.append(self.chain.s[:-1][::self.stride], self.chain.s[-1])
+
+    @property
     def count(self) -> int:
-        """Number of vertices."""
-        return len(self.chain.vertices) - 1
+        """Number of column positions."""
+        return len(self.arcs) - 1
 
     @property
     def polyline(self) -> np.ndarray:
-        """Vertex coordinates in loop order, (count, 2), mm."""
-        return self.chain.points[:-1]
+        """Column positions (vertices) in loop order, (count, 2), mm."""
+        return self.chain.points[:-1][::self.stride]
 
     def arc_of(self, points: np.ndarray) -> np.ndarray:
         """Arc length of the boundary point closest to each of ``points``, mm."""
@@ -119,7 +127,7 @@ class FootprintGrid:
         -------
         cols, weights : ndarray (m, 2) radial or (m, 4) x/y
         """
-        arc = self.chain.s
+        arc = self.arcs
         s = np.mod(np.asarray(s, dtype=float), arc[-1])
         i = np.clip(np.searchsorted(arc, s, side="right") - 1, 0, self.count - 1)
         t = (s - arc[i]) / (arc[i + 1] - arc[i])
@@ -160,7 +168,8 @@ class Interface:
 
 
 def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.ndarray,
-                    bore_centres: dict[str, np.ndarray], half_width: dict[str, float]) -> Interface:
+                    bore_centres: dict[str, np.ndarray], half_width: dict[str, float],
+                    stride: dict[str, int] | None = None) -> Interface:
     """Build the footprint columns and the load operator B on the named boundaries.
 
     Column k of a boundary sits at its k-th vertex; its unit force is spread over the arc
@@ -182,6 +191,9 @@ def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
         normals is off by several degrees near the inflection points of coarse profiles).
     half_width : dict name → float
         Footprint half-width a per boundary, mm.
+    stride : dict name → int, optional
+        Columns at every stride-th vertex (default 1). With a half-width above the column spacing
+        the footprints still overlap, and fewer columns mean fewer back-substitutions.
     """
     from . import fem
 
@@ -193,10 +205,11 @@ def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
             raise ValueError(f"boundary '{name}' is not one closed loop")
         chain = chains[0]
         centre = bore_centres.get(name)
-        grid = FootprintGrid(name, offset, chain, None if centre is None else np.asarray(centre, float))
+        grid = FootprintGrid(name, offset, chain, None if centre is None else np.asarray(centre, float),
+                             (stride or {}).get(name, 1))
         grids[name] = grid
         widths[name] = a = float(half_width[name])
-        weights = fem.footprint_weights(model, chain, chain.s[:-1], a)
+        weights = fem.footprint_weights(model, chain, grid.arcs[:-1], a)
         if grid.components == 1:
             d_k = grid.polyline - grid.centre
             d_k /= np.linalg.norm(d_k, axis=1)[:, None]

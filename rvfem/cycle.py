@@ -117,7 +117,7 @@ class DiscSystem:
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
                  stiffness_scale: float = 1.0, pin_model: str | None = None,
                  bearing_stiffness_scale: float = 1.0,
-                 pin_stiffness_N_per_mm: float | None = None) -> DiscSystem:
+                 pin_stiffness_N_per_mm: float | None = None, column_stride: int = 1) -> DiscSystem:
     """Assemble and factorise the disc and build its footprint interface.
 
     Parameters
@@ -138,6 +138,12 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
         ``pin_stiffness_N_per_mm``.
     bearing_stiffness_scale : float
         Multiplies the ``rigid_bore`` bearing stiffness (for the rigid-limit checks).
+    pin_stiffness_N_per_mm : float, optional
+        Stiffness of the ``"linear"`` pin model, N/mm.
+    column_stride : int
+        Interface columns at every stride-th boundary vertex. 1 (default) is the accurate
+        choice; 2 halves the back-substitutions (default fan-hole case: cycle 8.5 → 6.0 s) at the
+        price of 0.6 % of the maximum bearing load and 5 % on single pin forces.
     """
     from . import fem
     from .geometry import disc_geometry
@@ -172,7 +178,8 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     for i in range(case.cranks.count):
         half[f"bore_{i}"] = FOOTPRINT_ELEMENTS * case.mesh.size_bore
     iface = contact.build_interface(model, boundaries, rigid,
-                                    {f"bore_{i}": centres[i] for i in range(len(centres))}, half)
+                                    {f"bore_{i}": centres[i] for i in range(len(centres))}, half,
+                                    {name: column_stride for name in boundaries})
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
