@@ -34,8 +34,8 @@ the rigid pins) on this small dense system.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
-import math
 import os
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -434,8 +434,7 @@ def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, to
         start = None
     if start is None and cset.laws and torque is not None:
         ks = _nominal_stiffness(cset, torque)
-        linear = ContactSet(cset.W, cset.signorini, cset.gap0, cset.offset, cset.lever,
-                            [(idx, linear_law(ks)) for idx, _ in cset.laws])
+        linear = dataclasses.replace(cset, laws=[(idx, linear_law(ks)) for idx, _ in cset.laws])
         start = _newton(linear, iface, compliance, torque, None, max_iterations, label, tol_gap,
                         names, rigid_dofs, engage_all=True)
     return _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_gap, names,

@@ -233,7 +233,6 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     centres = bore_centres(case)
     b = case.crank_bearing
     n = zp
-    lever_parts = [np.zeros(zp)]
     bearing_of = []
     if system.bearing_model == "rollers":
         psi = roller_angles(case, theta)

@@ -282,7 +282,6 @@ def build_model(
     stiffness = asm(linear_elasticity(lam * thickness, mu * thickness), basis).tocsr()
     stiffness.sort_indices()
 
-    n_vertices = mesh.p.shape[1]
     edges = np.ascontiguousarray(mesh.facets.T.astype(np.int64))
     if order == 1:
         node_coords = mesh.p.T.copy()

@@ -46,7 +46,7 @@ import numpy as np
 
 from . import __version__
 from .case import Case, case_to_dict, file_sha256, load_case
-from .errors import CaseError, OutputError, RvfemError
+from .errors import CaseError, OutputError
 
 log = logging.getLogger(__name__)
 
