@@ -333,12 +333,17 @@ class Analysis:
 
 @dataclass(frozen=True)
 class MeshSettings:
-    """Target element sizes (mm) and the thinnest wall the geometry check accepts."""
+    """Target element sizes (mm) and the thinnest wall the geometry check accepts.
+
+    ``size_hole`` is the size on the central hole and the lightening holes (their fillets carry
+    the structural stress peaks); None means twice ``size_bore``, capped by ``size_interior``.
+    """
 
     size_flank: float = 0.4
     size_bore: float = 0.4
     size_interior: float = 2.5
     min_wall: float = 1.0
+    size_hole: float | None = None
 
 
 @dataclass(frozen=True)
@@ -702,9 +707,10 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
         size_bore=t.get("size_bore", "float", 0.4),
         size_interior=t.get("size_interior", "float", 2.5),
         min_wall=t.get("min_wall", "float", 1.0),
+        size_hole=t.get("size_hole", "float", None),
     )
     t.finish()
-    for key in ("size_flank", "size_bore", "size_interior", "min_wall"):
+    for key in ("size_flank", "size_bore", "size_interior", "min_wall", "size_hole"):
         _positive(t, key, getattr(mesh, key))
 
     top.finish()

@@ -10,8 +10,8 @@ we create are the tags we group, and nothing has to be re-identified afterwards.
 Mesh: linear triangles (the FE stage builds P2 on top), Frontal-Delaunay, sizes from a background
 field only (``Mesh.MeshSizeExtendFromBoundary = 0``, ``Mesh.MeshSizeFromPoints = 0``,
 ``Mesh.MeshSizeFromCurvature = 0``): ``size_flank`` on the profile, ``size_bore`` on the bores,
-``HOLE_SIZE_FACTOR·size_bore`` (capped by ``size_interior``) on the central hole and the lightening
-holes, each held over a band and then growing linearly (``SIZE_GROWTH`` mm per mm) to
+``size_hole`` (default ``HOLE_SIZE_FACTOR·size_bore``, capped by ``size_interior``) on the central
+hole and the lightening holes, each held over a band and then growing linearly (``SIZE_GROWTH`` mm per mm) to
 ``size_interior``.
 
 Physical groups: curves ``profile``, ``central_hole``, ``bore_0`` …, ``hole_0`` … (fan holes
@@ -192,7 +192,7 @@ def mesh_key(case: Case) -> str:
         "bore_radius": d["crank_bearing"]["bore_radius"],
         "fan_holes": d.get("fan_holes"),
         "round_holes": d.get("round_holes"),
-        "mesh": {k: d["mesh"][k] for k in ("size_flank", "size_bore", "size_interior")},
+        "mesh": {k: d["mesh"].get(k) for k in ("size_flank", "size_bore", "size_interior", "size_hole")},
         "mesher": MESHER_VERSION,
         "spline_points": SPLINE_POINTS_PER_SEGMENT,
         "gmsh": gmsh.__version__,
@@ -286,7 +286,7 @@ def _build_model(g, geom: DiscGeometry) -> dict[str, list[int]]:
 
     ms = geom.case.mesh
     hmax = ms.size_interior
-    h_hole = min(hmax, HOLE_SIZE_FACTOR * ms.size_bore)
+    h_hole = ms.size_hole if ms.size_hole is not None else min(hmax, HOLE_SIZE_FACTOR * ms.size_bore)
     seg_len = max(_polyline_length(spl[j]) for j in range(zc))
     fields = [_threshold(g, profile_curves, ms.size_flank, hmax,
                          max(20, int(math.ceil(4 * seg_len / ms.size_flank))))]
