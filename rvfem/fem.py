@@ -96,6 +96,7 @@ __all__ = [
     "StressState",
     "StressFields",
     "stress_fields",
+    "nodal_stress_operator",
 ]
 
 logger = logging.getLogger(__name__)
@@ -1186,6 +1187,44 @@ class StressFields:
 
     nodal: StressState
     element: StressState
+
+
+def nodal_stress_operator(model: FEModel) -> sp.csr_matrix:
+    """The linear map from displacements to the vertex stresses of :func:`stress_fields`.
+
+    ``S @ u`` stacks (σxx, σyy, σxy) at the mesh vertices — area-averaged element values, exactly
+    as ``stress_fields(model, u).nodal`` — for many fields at the cost of one sparse product each
+    (the load cycle's stress envelope uses it at every crank angle).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+        ``(3·n_vertices, n_dofs)``, MPa/mm; rows ``[0, nv)`` σxx, ``[nv, 2nv)`` σyy, ``[2nv, 3nv)`` σxy.
+    """
+    lam, mu = plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
+    basis = model._stress_basis
+    t = model.mesh.t
+    p = model.mesh.p
+    area = 0.5 * np.abs(
+        (p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+        - (p[1, t[1]] - p[1, t[0]]) * (p[0, t[2]] - p[0, t[0]])
+    )
+    nv = model.n_vertices
+    denom = np.bincount(t.ravel(), weights=np.tile(area, 3), minlength=nv)
+    rows, cols, vals = [], [], []
+    for i, (field_i,) in enumerate(basis.basis):
+        g = field_i.grad[:, :, :, :3]                       # (2, 2, n_elements, 3 vertices)
+        exx, eyy, exy = g[0, 0], g[1, 1], 0.5 * (g[0, 1] + g[1, 0])
+        comps = (lam * (exx + eyy) + 2 * mu * exx, lam * (exx + eyy) + 2 * mu * eyy, 2 * mu * exy)
+        dof = basis.element_dofs[i]
+        for c, sc in enumerate(comps):                      # sc: (n_elements, 3)
+            for k in range(3):
+                v = t[k]
+                rows.append(c * nv + v)
+                cols.append(dof)
+                vals.append(sc[:, k] * area / denom[v])
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(3 * nv, model.n_dofs))
 
 
 def stress_fields(model: FEModel, u: np.ndarray) -> StressFields:

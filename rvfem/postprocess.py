@@ -24,6 +24,7 @@ from .case import Case
 
 __all__ = [
     "FieldSnapshot",
+    "StressEnvelope",
     "PeakStress",
     "RollerHertz",
     "FEATURE_LABELS",
@@ -31,6 +32,7 @@ __all__ = [
     "max_load_index",
     "nearest_index",
     "field_snapshots",
+    "stress_envelope",
     "peak_von_mises",
     "roller_hertz",
 ]
@@ -75,7 +77,7 @@ class FieldSnapshot:
 
 @dataclass(frozen=True)
 class PeakStress:
-    """The largest von Mises stress over the kept fields and where it occurs.
+    """The largest von Mises stress (over the cycle, or the kept fields) and where it occurs.
 
     Attributes
     ----------
@@ -180,23 +182,33 @@ def nearest_index(thetas: np.ndarray, theta: float) -> int:
     return int(np.argmin(np.abs(np.angle(np.exp(1j * (np.asarray(thetas) - theta))))))
 
 
-def field_snapshots(system, cycle) -> tuple[FieldSnapshot, ...]:
+def field_snapshots(system, cycle, extra_angles=()) -> tuple[FieldSnapshot, ...]:
     """Vertex displacements and stresses of every field a load cycle kept, ordered by angle.
 
     Parameters
     ----------
     system : rvfem.cycle.DiscSystem
     cycle : rvfem.cycle.CycleResult
+    extra_angles : iterable of float, optional
+        Further solved crank angles (rad, nearest of ``cycle.theta``) whose fields the cycle did
+        not keep, e.g. where the stress envelope peaks; rebuilt from the cycle's own solutions.
 
     Returns
     -------
     tuple of FieldSnapshot
     """
+    from .cycle import displacement
+
     model = system.model
     vdofs = model.node_dofs[: model.n_vertices]
+    fields = dict(cycle.fields)
+    for theta in extra_angles:
+        k = nearest_index(cycle.theta, float(theta))
+        if not any(math.isclose(cycle.theta[k], t, abs_tol=1e-12) for t in fields):
+            fields[float(cycle.theta[k])] = displacement(system, cycle.solutions[k])
     out = []
-    for theta in sorted(cycle.fields):
-        u = np.asarray(cycle.fields[theta], dtype=float)
+    for theta in sorted(fields):
+        u = np.asarray(fields[theta], dtype=float)
         u_def, motion = fem.remove_rigid_motion(model, u)
         out.append(FieldSnapshot(
             theta=float(theta),
@@ -216,15 +228,48 @@ def _distances(points: np.ndarray, boundary_points: np.ndarray) -> np.ndarray:
     return cKDTree(boundary_points).query(points)[0]
 
 
-def peak_von_mises(snapshots: tuple[FieldSnapshot, ...], points: np.ndarray,
+@dataclass(frozen=True, eq=False)
+class StressEnvelope:
+    """Largest vertex von Mises stress of every vertex over a set of crank angles.
+
+    Attributes
+    ----------
+    von_mises : ndarray (n_vertices,)
+        MPa.
+    theta : ndarray (n_vertices,)
+        Crank angle at which each vertex reaches it, rad.
+    """
+
+    von_mises: np.ndarray
+    theta: np.ndarray
+
+
+def stress_envelope(source) -> StressEnvelope:
+    """The envelope of a load cycle computed with ``stress_envelope=True`` (every solved angle),
+    or of a tuple of :class:`FieldSnapshot` (the kept angles only)."""
+    if isinstance(source, StressEnvelope):
+        return source
+    if getattr(source, "von_mises_envelope", None) is not None:
+        return StressEnvelope(np.asarray(source.von_mises_envelope), np.asarray(source.von_mises_envelope_theta))
+    snapshots = tuple(source)
+    if not snapshots:
+        raise ValueError("peak_von_mises needs at least one snapshot")
+    vm = np.stack([s.stress.nodal.von_mises for s in snapshots])
+    k = np.argmax(vm, axis=0)
+    cols = np.arange(vm.shape[1])
+    return StressEnvelope(vm[k, cols], np.array([s.theta for s in snapshots])[k])
+
+
+def peak_von_mises(source, points: np.ndarray,
                    boundaries: dict[str, np.ndarray], *,
                    exclude: dict[str, float] | None = None) -> PeakStress | None:
-    """The largest vertex von Mises stress over the snapshots and the boundary it lies nearest to.
+    """The largest vertex von Mises stress and the boundary it lies nearest to.
 
     Parameters
     ----------
-    snapshots : tuple of FieldSnapshot
-        At least one.
+    source : StressEnvelope, rvfem.cycle.CycleResult or tuple of FieldSnapshot
+        Where to search: a cycle solved with ``stress_envelope=True`` covers every solved angle;
+        snapshots cover the kept angles only (at least one).
     points : ndarray (n_vertices, 2)
         Mesh vertices, mm.
     boundaries : dict
@@ -239,8 +284,7 @@ def peak_von_mises(snapshots: tuple[FieldSnapshot, ...], points: np.ndarray,
     PeakStress or None
         None only if ``exclude`` leaves no vertex.
     """
-    if not snapshots:
-        raise ValueError("peak_von_mises needs at least one snapshot")
+    env = stress_envelope(source)
     points = np.asarray(points, dtype=float)
     mask = np.ones(len(points), dtype=bool)
     for name, band in (exclude or {}).items():
@@ -249,8 +293,7 @@ def peak_von_mises(snapshots: tuple[FieldSnapshot, ...], points: np.ndarray,
     if not mask.any():
         return None
     candidates = np.flatnonzero(mask)
-    best = max(snapshots, key=lambda s: float(s.stress.nodal.von_mises[candidates].max()))
-    vertex = int(candidates[np.argmax(best.stress.nodal.von_mises[candidates])])
+    vertex = int(candidates[np.argmax(env.von_mises[candidates])])
     p = points[vertex]
     feature, dist = "", math.inf
     for name, edges in boundaries.items():
@@ -258,11 +301,11 @@ def peak_von_mises(snapshots: tuple[FieldSnapshot, ...], points: np.ndarray,
         if d < dist:
             feature, dist = name, d
     return PeakStress(
-        von_mises_MPa=float(best.stress.nodal.von_mises[vertex]),
+        von_mises_MPa=float(env.von_mises[vertex]),
         x_mm=float(p[0]),
         y_mm=float(p[1]),
         radius_mm=float(np.hypot(*p)),
-        theta_deg=best.theta_deg,
+        theta_deg=float(np.degrees(env.theta[vertex])),
         feature=feature,
         feature_label=feature_label(feature),
         distance_to_feature_mm=dist,

@@ -523,17 +523,19 @@ def _run_stages(case: Case, info: _CaseInfo, thetas: np.ndarray, tmp: Path, stag
         if i < total:
             stages.tick("cycle", i, total)
 
-    cycle = load_cycle(system, thetas, progress=report, saved_angles_deg=saved)
+    cycle = load_cycle(system, thetas, progress=report, saved_angles_deg=saved, stress_envelope=True)
     stages.end("cycle", t, n)
 
     # -- evaluation ----------------------------------------------------------------------------
     t = stages.start("evaluation")
     comparison = compare.rigid_vs_flexible(case, cycle)
-    snapshots = postprocess.field_snapshots(system, cycle)
-    peak = postprocess.peak_von_mises(snapshots, mesh.points, mesh.boundaries)
+    # peaks over every solved angle (the cycle's stress envelope); their fields are kept too
+    peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
     band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
     band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
-    away = postprocess.peak_von_mises(snapshots, mesh.points, mesh.boundaries, exclude=band)
+    away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
+    snapshots = postprocess.field_snapshots(
+        system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
     k_max, i_max = postprocess.max_load_index(cycle.bearing_forces)
     # the first bearing among equals (the handbook curves are exact shifts of each other)
     rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))

@@ -668,3 +668,18 @@ def test_line_loads_and_tractions(order):
     apothem = 9.0 * math.cos(math.pi / 20)
     assert np.allclose(res[:2], 0.0, atol=1e-10)
     assert res[2] == pytest.approx(tau * THICK * apothem * rim.length, rel=1e-13)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_nodal_stress_operator_equals_stress_fields(order):
+    """The linear operator behind the load cycle's stress envelope reproduces stress_fields."""
+    from skfem import MeshTri
+
+    mesh = MeshTri.init_circle(3)
+    model = fem.build_model(mesh.p.T, mesh.t.T, 2.0e5, 0.3, 2.0, order=order)
+    u = np.random.default_rng(1).normal(size=model.n_dofs)
+    nodal = fem.stress_fields(model, u).nodal
+    nv = model.n_vertices
+    s = fem.nodal_stress_operator(model) @ u
+    for k, comp in enumerate((nodal.sxx, nodal.syy, nodal.sxy)):
+        assert np.allclose(s[k * nv:(k + 1) * nv], comp, rtol=1e-12, atol=1e-12 * np.abs(comp).max())
