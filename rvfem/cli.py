@@ -258,6 +258,7 @@ class _RunProgress:
         self.stream, self.tty, self.stages = stream, tty, list(STAGES)
         self.descriptions = STAGES
         self.started: dict[str, float] = {}
+        self.first_tick: dict[str, tuple[float, int]] = {}  # (time, angles done) of the first tick
         self.last_draw = 0.0
         self.last_tenth = -1
         self.width = 0
@@ -279,6 +280,7 @@ class _RunProgress:
         head = f"rvfem run [{index}/{len(self.stages)}] {self.descriptions.get(stage, stage)}"
         if done == 0:
             self.started[stage] = now
+            self.first_tick.pop(stage, None)
             self.last_tenth = -1
             if self.tty:
                 self._line(head + " …")
@@ -292,13 +294,18 @@ class _RunProgress:
         if stage != "cycle":
             return
         if self.tty:
+            self.first_tick.setdefault(stage, (now, done))
             if now - self.last_draw < 0.1:
                 return
             self.last_draw = now
             filled = int(self.BAR * done / total)
-            eta = elapsed / done * (total - done)
+            # the first angle also computes the interface compliance the whole cycle reuses:
+            # estimate the rate from the angles after it
+            t_first, d_first = self.first_tick.setdefault(stage, (now, done))
+            rate = (now - t_first) / (done - d_first) if done > d_first else None
+            left = "" if rate is None else f", about {rate * (total - done):.0f} s left"
             self._line(f"{head} [{'#' * filled}{'.' * (self.BAR - filled)}] {done}/{total}, "
-                       f"{elapsed:.1f} s, about {eta:.0f} s left")
+                       f"{elapsed:.1f} s{left}")
         else:
             tenth = 10 * done // total
             if tenth > self.last_tenth:
