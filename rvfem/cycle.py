@@ -30,6 +30,7 @@ from . import contact
 from .case import Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
 from .errors import CaseError
+from .geometry import crank_centres as bore_centres  # centres c_i of the crank bores, (N, 2), mm
 
 log = logging.getLogger(__name__)
 
@@ -52,12 +53,6 @@ FOOTPRINT_ELEMENTS = 1.5
 profile, mesh.size_bore at the bores). The Hertz half-widths of these contacts (≈0.1 mm) are below
 one element at the default sizes, so the footprint spreads each force over a few elements; the
 bearing loads do not depend on it (global equilibrium), only the stress right under a contact."""
-
-
-def bore_centres(case: Case) -> np.ndarray:
-    """Centres c_i of the crank bores in the disc frame, (N, 2), mm."""
-    a = np.radians(case.cranks.angles_deg)
-    return case.cranks.circle_radius * np.stack([np.cos(a), np.sin(a)], axis=1)
 
 
 def roller_angles(case: Case, theta: float) -> np.ndarray:

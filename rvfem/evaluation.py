@@ -45,6 +45,7 @@ __all__ = [
     "hertz_line_contact",
     "stribeck_max_roller_load",
     "crank_bearing_hertz",
+    "roller_raceway_contacts",
     "life_ratio",
     "ROLLER_LIFE_EXPONENT",
     "STRIBECK_FACTOR",
@@ -536,10 +537,30 @@ def crank_bearing_hertz(
     (inner, outer) : tuple of HertzLineContact
     """
     q = stribeck_max_roller_load(bearing_load_N, bearing.rollers, stribeck_factor)
+    return roller_raceway_contacts(bearing, q, youngs_modulus_MPa=youngs_modulus_MPa,
+                                   poissons_ratio=poissons_ratio)
+
+
+def roller_raceway_contacts(
+    bearing: CrankBearing,
+    roller_load_N: float,
+    *,
+    youngs_modulus_MPa: float = 206000.0,
+    poissons_ratio: float = 0.3,
+) -> tuple[HertzLineContact, HertzLineContact]:
+    """Hertz contacts of one roller carrying ``roller_load_N`` (N) with its two raceways.
+
+    Inner raceway: the eccentric, radius (D_m − D_we)/2, convex; outer raceway: the disc bore,
+    radius ``bearing.bore_radius``, concave; contact length L_we (:func:`hertz_line_contact`).
+
+    Returns
+    -------
+    (inner, outer) : tuple of HertzLineContact
+    """
     r_roller = 0.5 * bearing.roller_diameter
     common = dict(youngs_modulus_MPa=youngs_modulus_MPa, poissons_ratio=poissons_ratio)
-    inner = hertz_line_contact(q, bearing.roller_length, r_roller, bearing.inner_raceway_radius,
+    inner = hertz_line_contact(roller_load_N, bearing.roller_length, r_roller, bearing.inner_raceway_radius,
                                concave=False, **common)
-    outer = hertz_line_contact(q, bearing.roller_length, r_roller, bearing.bore_radius,
+    outer = hertz_line_contact(roller_load_N, bearing.roller_length, r_roller, bearing.bore_radius,
                                concave=True, **common)
     return inner, outer

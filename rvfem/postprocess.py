@@ -313,12 +313,8 @@ def peak_von_mises(source, points: np.ndarray,
 
 
 def _contacts(case: Case, q: float) -> tuple[evaluation.HertzLineContact, evaluation.HertzLineContact]:
-    b = case.crank_bearing
-    common = dict(youngs_modulus_MPa=case.material.youngs_modulus, poissons_ratio=case.material.poissons_ratio)
-    r = 0.5 * b.roller_diameter
-    inner = evaluation.hertz_line_contact(q, b.roller_length, r, b.inner_raceway_radius, concave=False, **common)
-    outer = evaluation.hertz_line_contact(q, b.roller_length, r, b.bore_radius, concave=True, **common)
-    return inner, outer
+    return evaluation.roller_raceway_contacts(case.crank_bearing, q, youngs_modulus_MPa=case.material.youngs_modulus,
+                                              poissons_ratio=case.material.poissons_ratio)
 
 
 def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float | None = None,
