@@ -27,9 +27,10 @@ import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Sequence
 
 from .errors import CaseError
+from .registry import bearing_model_names, pin_model_names
 
 __all__ = [
     "Case",
@@ -47,6 +48,8 @@ __all__ = [
     "Analysis",
     "MeshSettings",
     "load_case",
+    "parse_override",
+    "apply_overrides",
     "case_from_dict",
     "case_to_dict",
 ]
@@ -363,6 +366,7 @@ class Case:
     round_holes: RoundHoles | None = None
     description: str = ""
     source: str = field(default="<code>", compare=False)
+    overrides: tuple[str, ...] = field(default=(), compare=False)
 
     @property
     def short_amplitude_coefficient(self) -> float:
@@ -533,7 +537,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
         count=t.get("count", "int"),
         circle_radius=t.get("circle_radius", "float"),
         radius=t.get("radius", "float"),
-        model=t.get("model", "str", "rigid", choices=("rigid", "hertz")),
+        model=t.get("model", "str", "rigid", choices=pin_model_names()),
     )
     t.finish()
     for key in ("count", "circle_radius", "radius"):
@@ -579,7 +583,7 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
         radial_clearance=t.get("radial_clearance", "float", 0.0),
         b_m=t.get("b_m", "float", 1.1),
         lambda_nu=t.get("lambda_nu", "float", 0.83),
-        model=t.get("model", "str", "rollers", choices=("rollers", "rigid_bore")),
+        model=t.get("model", "str", "rollers", choices=bearing_model_names()),
         stiffness_law=t.get("stiffness_law", "str", "palmgren", choices=("palmgren", "linear")),
         linear_stiffness_N_per_mm=t.get("linear_stiffness_N_per_mm", "float", None),
         rigid_bore_stiffness_N_per_mm=t.get("rigid_bore_stiffness_N_per_mm", "float", 7.0e5),
@@ -731,8 +735,55 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     )
 
 
-def load_case(path: str | Path) -> Case:
-    """Read and validate a TOML case file.
+def parse_override(text: str) -> tuple[tuple[str, ...], Any]:
+    """Split an override ``KEY=VALUE`` into the dotted key's parts and the value.
+
+    The value is a TOML literal (``4.5``, ``"rigid_bore"``, ``[1.0, 2.0]``, ``true``); a bare word
+    that is not a TOML literal is taken as a string (``crank_bearing.model=rigid_bore``).
+    """
+    key, sep, value = text.partition("=")
+    key = key.strip()
+    if not sep or not key or any(not part.strip() for part in key.split(".")):
+        raise CaseError(f"override {text!r}: expected KEY=VALUE with a dotted key of the case format, "
+                        "e.g. fan_holes.ligament=4.0")
+    value = value.strip()
+    try:
+        parsed = tomllib.loads(f"v = {value}")["v"]
+    except tomllib.TOMLDecodeError:
+        if not value or any(c in value for c in "[]{}\"\'=,"):
+            raise CaseError(f"override {text!r}: {value!r} is not a TOML value") from None
+        parsed = value
+    return tuple(part.strip() for part in key.split(".")), parsed
+
+
+def apply_overrides(data: dict, overrides: Sequence[str]) -> dict:
+    """A copy of the parsed case ``data`` with the ``KEY=VALUE`` overrides applied (not validated:
+    :func:`case_from_dict` validates the result like a file, unknown keys included)."""
+    import copy
+
+    data = copy.deepcopy(data)
+    for text in overrides:
+        parts, value = parse_override(text)
+        table = data
+        for depth, part in enumerate(parts[:-1]):
+            nxt = table.setdefault(part, {})
+            if not isinstance(nxt, dict):
+                raise CaseError(f"override {text!r}: {'.'.join(parts[:depth + 1])} is not a table")
+            table = nxt
+        table[parts[-1]] = value
+    return data
+
+
+def load_case(path: str | Path, overrides: Sequence[str] = ()) -> Case:
+    """Read and validate a TOML case file, optionally with overrides.
+
+    Parameters
+    ----------
+    path : path
+    overrides : sequence of str
+        ``KEY=VALUE`` strings (see :func:`parse_override`), applied to the file's data before
+        validation, so an override is checked exactly like the file (an unknown key gets a
+        "did you mean"). They are recorded in :attr:`Case.overrides`.
 
     Raises
     ------
@@ -749,7 +800,11 @@ def load_case(path: str | Path) -> Case:
         data = tomllib.loads(text.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise CaseError(f"{path}: not a valid TOML file ({exc})") from None
-    return case_from_dict(data, source=str(path))
+    overrides = tuple(overrides)
+    if not overrides:
+        return case_from_dict(data, source=str(path))
+    case = case_from_dict(apply_overrides(data, overrides), source=f"{path} (with overrides)")
+    return dataclasses.replace(case, overrides=overrides)
 
 
 def case_to_dict(case: Case) -> dict:
@@ -758,7 +813,7 @@ def case_to_dict(case: Case) -> dict:
     def clean(obj: Any) -> Any:
         if dataclasses.is_dataclass(obj):
             return {f.name: clean(getattr(obj, f.name)) for f in dataclasses.fields(obj)
-                    if getattr(obj, f.name) is not None and f.name != "source"}
+                    if getattr(obj, f.name) is not None and f.name not in ("source", "overrides")}
         if isinstance(obj, tuple):
             return [clean(v) for v in obj]
         return obj

@@ -1,0 +1,71 @@
+"""Registries of the pluggable crank-bearing and pin models.
+
+A model is one class (see :mod:`rvfem.models` for the protocol and the built-in models). The case
+reader, the command line and the report all take the list of valid names from here, so that a new
+model is one class registered with :func:`register_bearing_model` / :func:`register_pin_model`
+(from any module, a test module included) plus its case keys.
+
+The built-in names are known without importing the (heavier) model module; their classes are
+imported on first use.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+__all__ = [
+    "register_bearing_model",
+    "register_pin_model",
+    "bearing_model_names",
+    "pin_model_names",
+    "bearing_model",
+    "pin_model",
+]
+
+_BUILTIN_BEARINGS = {"rollers": "RollerBearing", "rigid_bore": "RigidBoreBearing"}
+_BUILTIN_PINS = {"rigid": "RigidPins", "hertz": "PalmgrenPins", "linear": "LinearPins"}
+_BEARINGS: dict[str, type] = {}
+_PINS: dict[str, type] = {}
+
+
+def register_bearing_model(cls: type) -> type:
+    """Class decorator: make ``cls`` available as ``crank_bearing.model = cls.name``."""
+    _BEARINGS[cls.name] = cls
+    return cls
+
+
+def register_pin_model(cls: type) -> type:
+    """Class decorator: make ``cls`` available as ``pins.model = cls.name``."""
+    _PINS[cls.name] = cls
+    return cls
+
+
+def bearing_model_names() -> tuple[str, ...]:
+    """Valid values of ``crank_bearing.model``."""
+    return tuple(dict.fromkeys([*_BUILTIN_BEARINGS, *_BEARINGS]))
+
+
+def pin_model_names(*, case_file: bool = True) -> tuple[str, ...]:
+    """Valid values of ``pins.model`` (``case_file=False`` adds the validation-only models)."""
+    names = [n for n in (*_BUILTIN_PINS, *_PINS) if case_file is False or n != "linear"]
+    return tuple(dict.fromkeys(names))
+
+
+def _resolve(name: str, registered: dict, builtin: dict, kind: str) -> type:
+    if name not in registered and name in builtin:
+        models = importlib.import_module(".models", __package__)
+        registered.setdefault(name, getattr(models, builtin[name]))
+    try:
+        return registered[name]
+    except KeyError:
+        raise KeyError(f"unknown {kind} model {name!r}; known: {', '.join([*builtin, *registered])}") from None
+
+
+def bearing_model(name: str) -> type:
+    """The class of bearing model ``name``."""
+    return _resolve(name, _BEARINGS, _BUILTIN_BEARINGS, "bearing")
+
+
+def pin_model(name: str) -> type:
+    """The class of pin model ``name``."""
+    return _resolve(name, _PINS, _BUILTIN_PINS, "pin")
