@@ -59,6 +59,8 @@ __all__ = [
     "palmgren_law",
     "linear_law",
     "solve_contact",
+    "solve_bodies",
+    "Body",
 ]
 
 # ------------------------------------------------------------------------------------------------
@@ -392,11 +394,23 @@ class AngleSolution:
     residual: dict = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class Body:
+    """One elastic body of a contact solve: its contacts at this crank angle, its footprint
+    interface and its (lazily filled) column compliance. Two discs of the same mesh may share one
+    :class:`Compliance`."""
+
+    cset: ContactSet
+    interface: Interface
+    compliance: Compliance
+
+
 def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, torque: float, *,
                   start: AngleSolution | None = None, max_iterations: int = 50, label: str = "",
                   tol_gap: float = 1e-9, names: list[str] | None = None,
                   rigid_dofs: tuple[int, ...] = (0, 1, 2)) -> AngleSolution:
-    """Solve the contact problem of one crank angle (semismooth Newton / primal–dual active set).
+    """Solve the contact problem of one body at one crank angle (semismooth Newton / primal–dual
+    active set).
 
     Parameters
     ----------
@@ -429,61 +443,122 @@ def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, to
         If the active set does not settle within ``max_iterations``; names the contacts that keep
         flipping.
     """
-    nc = cset.W.shape[1]
-    if start is not None and start.force.shape != (nc,):
+    return solve_bodies([Body(cset, iface, compliance)], torque,
+                        start=None if start is None else [start], max_iterations=max_iterations,
+                        label=label, tol_gap=tol_gap, names=names, rigid_dofs=rigid_dofs)[0]
+
+
+def solve_bodies(bodies: list[Body], torque: float | None, *, coupling: np.ndarray | None = None,
+                 start: list[AngleSolution] | None = None, max_iterations: int = 50, label: str = "",
+                 tol_gap: float = 1e-9, names: list[str] | None = None,
+                 rigid_dofs: tuple[int, ...] = (0, 1, 2)) -> list[AngleSolution]:
+    """Solve the contacts of several bodies that share one carrier rotation.
+
+    Each body has its own contacts and rigid-body motion (and is in equilibrium on its own); the
+    carrier rotation φ is common and its equation is Σ_bodies Σ_c m_c·λ_c = ``torque`` (the total
+    torque: for the two discs of a reducer stage, T_out; each disc's share is an output). The
+    optional ``coupling`` matrix H adds an approach −H·λ to every contact: the eccentrics of a
+    crankshaft move under the forces of all the discs it carries (see :mod:`rvfem.reducer`).
+
+    Parameters
+    ----------
+    bodies : list of Body
+    torque : float or None
+        Total torque on the carrier, N·mm (None: no carrier unknown).
+    coupling : ndarray (n_contacts, n_contacts), optional
+        Symmetric positive semidefinite compliance added between the contacts of all bodies
+        (contacts numbered body after body), mm/N.
+    start : list of AngleSolution, optional
+        Warm start, one per body.
+    max_iterations, label, tol_gap, names, rigid_dofs
+        As in :func:`solve_contact` (``names`` lists the contacts of all bodies in order).
+
+    Returns
+    -------
+    list of AngleSolution
+        One per body; ``residual["torque_Nmm"]`` is the body's share of the torque.
+    """
+    sizes = [b.cset.W.shape[1] for b in bodies]
+    if start is not None and [s.force.shape for s in start] != [(n,) for n in sizes]:
         start = None
-    if start is None and cset.laws and torque is not None:
-        ks = _nominal_stiffness(cset, torque)
-        linear = dataclasses.replace(cset, laws=[(idx, linear_law(ks)) for idx, _ in cset.laws])
-        start = _newton(linear, iface, compliance, torque, None, max_iterations, label, tol_gap,
-                        names, rigid_dofs, engage_all=True)
-    return _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_gap, names,
-                   rigid_dofs)
+    if start is None and torque is not None and any(b.cset.laws for b in bodies):
+        linear = [dataclasses.replace(b, cset=dataclasses.replace(
+            b.cset, laws=[(idx, linear_law(ks)) for idx, ks in _secant_stiffnesses(b, torque / len(bodies))]))
+            for b in bodies]
+        start = _newton(linear, torque, coupling, None, max_iterations, label, tol_gap, names, rigid_dofs,
+                        engage_all=True)
+    return _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, names, rigid_dofs)
 
 
-def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_gap, names,
+def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, names,
             rigid_dofs=(0, 1, 2), engage_all=False):
-    W = cset.W.tocsc()                                # gaps/approaches are measured along W
-    WL = W if cset.W_load is None else cset.W_load.tocsc()   # loads act along W_load
-    nc = W.shape[1]
-    Rc = np.asarray(W.T @ iface.resultants)          # rigid motion → approach, per contact
-    RL = np.asarray(WL.T @ iface.resultants)         # (nc, 3): Fx, Fy, Mz on the disc per unit λ
-    Rfull = RL.copy()
+    nb = len(bodies)
+    csets = [b.cset for b in bodies]
+    sizes = [c.W.shape[1] for c in csets]
+    offs = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    nc = int(offs[-1])
+    nr = 3 * nb                                      # rigid-motion unknowns, 3 per body
     dropped = [k for k in range(3) if k not in rigid_dofs]
-    Rc[:, dropped] = 0.0
-    RL[:, dropped] = 0.0
+    Rc = np.zeros((nc, nr))                          # rigid motion → approach, per contact
+    RL = np.zeros((nc, nr))                          # Fx, Fy, Mz on its body per unit λ
+    Rfull = np.zeros((nc, 3))
+    subs = []
+    for k, (b, c) in enumerate(zip(bodies, csets)):
+        W = c.W.tocsc()                              # gaps/approaches are measured along W
+        WL = W if c.W_load is None else c.W_load.tocsc()   # loads act along W_load
+        rows = slice(offs[k], offs[k + 1])
+        Rc[rows, 3 * k:3 * k + 3] = np.asarray(W.T @ b.interface.resultants)
+        RL[rows, 3 * k:3 * k + 3] = np.asarray(WL.T @ b.interface.resultants)
+        Rfull[rows] = RL[rows, 3 * k:3 * k + 3]
+        for d in dropped:
+            Rc[rows, 3 * k + d] = 0.0
+            RL[rows, 3 * k + d] = 0.0
+        # compliance between the contacts, G = Wᵀ C W_load, on the columns the contacts touch;
+        # column j of G is valid once the load columns of contact j are known (C is filled
+        # column-wise and symmetric, so the rows of every other contact come with it)
+        touched = np.unique(np.concatenate([W.indices, WL.indices]))
+        WLsub = WL[touched, :].toarray()
+        subs.append((touched, W[touched, :].toarray(), WLsub, WLsub != 0))
+    moment = RL[:, 2::3].sum(axis=1)                 # Mz of each contact on its own body
     carrier = torque is not None                     # without a carrier: no φ unknown
     torque = 0.0 if torque is None else torque
-    sig = cset.signorini
+    sig = np.concatenate([c.signorini for c in csets])
+    gap0 = np.concatenate([c.gap0 for c in csets])
+    offset = np.concatenate([c.offset for c in csets])
+    lever = np.concatenate([c.lever for c in csets])
+    laws = [(offs[k] + np.asarray(idx, dtype=int), law) for k, c in enumerate(csets) for idx, law in c.laws]
     spring = ~sig
-    r_typ = max(float(np.abs(cset.lever).max()), 1.0)
-
-    # compliance between the contacts, G = Wᵀ C W_load, on the columns the contacts touch; column
-    # j of G is valid once the load columns of contact j are known (C is filled column-wise and
-    # symmetric, so the rows of every other contact come with it)
-    touched = np.unique(np.concatenate([W.indices, WL.indices]))
-    Wsub = W[touched, :].toarray()
-    WLsub = WL[touched, :].toarray()
-    cache = {"version": -1, "G": None}
-
-    nonzero = WLsub != 0
+    r_typ = max(float(np.abs(lever).max()), 1.0)
+    cache = {"versions": None, "G": None}
 
     def G_cols(idx):
         if idx.size == 0:
             return np.zeros((nc, 0))
-        compliance.ensure(touched[nonzero[:, idx].any(axis=1)])
-        if cache["version"] != compliance.version:
-            cache["G"] = Wsub.T @ compliance.C[np.ix_(touched, touched)] @ WLsub
-            cache["version"] = compliance.version
+        for k, (b, (touched, _, _, nonzero)) in enumerate(zip(bodies, subs)):
+            local = idx[(idx >= offs[k]) & (idx < offs[k + 1])] - offs[k]
+            if local.size:
+                b.compliance.ensure(touched[nonzero[:, local].any(axis=1)])
+        versions = tuple(b.compliance.version for b in bodies)
+        if cache["versions"] != versions:
+            if nb == 1:
+                touched, Wsub, WLsub, _ = subs[0]
+                G = Wsub.T @ bodies[0].compliance.C[np.ix_(touched, touched)] @ WLsub
+            else:
+                G = np.zeros((nc, nc))
+                for k, (b, (touched, Wsub, WLsub, _)) in enumerate(zip(bodies, subs)):
+                    G[offs[k]:offs[k + 1], offs[k]:offs[k + 1]] = \
+                        Wsub.T @ b.compliance.C[np.ix_(touched, touched)] @ WLsub
+            cache["G"] = G if coupling is None else G + coupling
+            cache["versions"] = versions
         return cache["G"][:, idx]
 
     def state(lam, a, phi):
         nz = np.flatnonzero(lam != 0)
         v = G_cols(nz) @ lam[nz] + Rc @ a
-        delta = cset.offset + cset.lever * phi - v
+        delta = offset + lever * phi - v
         q = np.zeros(nc)
         dq = np.zeros(nc)
-        for idx, law in cset.laws:
+        for idx, law in laws:
             q[idx], dq[idx] = law(delta[idx])
         return v, delta, q, dq
 
@@ -491,52 +566,57 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
     # the touching pins whose force on the disc opposes the bearings' torque (the others can only
     # be loaded by a reversed torque). The active-set loop corrects either guess.
     if start is not None:
-        lam, a, phi = start.force.copy(), start.rigid.copy(), start.carrier_rotation
-        active = sig & ((start.force > 0) | (cset.gap0 < -tol_gap))
+        lam = np.concatenate([s.force for s in start])
+        a = np.concatenate([s.rigid for s in start])
+        phi = start[0].carrier_rotation
+        active = sig & ((lam > 0) | (gap0 < -tol_gap))
     else:
-        lam, a, phi = np.zeros(nc), np.zeros(3), 0.0
-        active = sig & (cset.gap0 <= tol_gap) & (RL[:, 2] * torque <= 0)
+        lam, a, phi = np.zeros(nc), np.zeros(nr), 0.0
+        active = sig & (gap0 <= tol_gap) & (moment * torque <= 0)
     g_act = G_cols(np.flatnonzero(active)) if active.any() else None
     kappa = 1.0 / float(np.median(np.diag(g_act[active]))) if g_act is not None else 1e6
     scale_f = max(abs(torque) / r_typ, 1.0)
-    colscale = np.concatenate([np.ones(nc), [1 / kappa, 1 / kappa, 1 / (kappa * r_typ), 1 / (kappa * r_typ)]])
+    colscale = np.concatenate([np.ones(nc), np.tile([1 / kappa, 1 / kappa, 1 / (kappa * r_typ)], nb),
+                               [1 / (kappa * r_typ)]])
     history = []
+    spring_history = []
+    n = nc + nr + 1 if carrier else nc + nr
+    eq = slice(nc, nc + nr)
+    row_scale = np.tile([1.0, 1.0, 1.0 / r_typ], nb)
 
     v, delta, q, dq = state(lam, a, phi)
     for it in range(1, max_iterations + 1):
         if engage_all and it == 1:
             # first linear solve: every spring engaged so that the system is stable
-            for idx, law in cset.laws:
+            for idx, law in laws:
                 q[idx] = law(np.abs(delta[idx]))[0] * np.sign(delta[idx])
                 dq[idx] = law(np.ones(np.size(delta[idx])))[1]
         J = np.flatnonzero(active | (spring & (dq > 0)) | (lam != 0))
         Gj = G_cols(J)
-        n = nc + 4 if carrier else nc + 3
         Jm = np.zeros((n, n))
         r = np.zeros(n)
         si = np.flatnonzero(spring)
         r[si] = lam[si] - q[si]
         Jm[si, si] = 1.0
         Jm[np.ix_(si, J)] += dq[si, None] * Gj[si]
-        Jm[si, nc:nc + 3] = dq[si, None] * Rc[si]
+        Jm[si, eq] = dq[si, None] * Rc[si]
         if carrier:
-            Jm[si, nc + 3] = -dq[si] * cset.lever[si]
+            Jm[si, nc + nr] = -dq[si] * lever[si]
         ai = np.flatnonzero(active)
-        r[ai] = kappa * (cset.gap0[ai] + v[ai])
+        r[ai] = kappa * (gap0[ai] + v[ai])
         Jm[np.ix_(ai, J)] = kappa * Gj[ai]
-        Jm[ai, nc:nc + 3] = kappa * Rc[ai]
+        Jm[ai, eq] = kappa * Rc[ai]
         ii = np.flatnonzero(sig & ~active)
         r[ii] = lam[ii]
         Jm[ii, ii] = 1.0
-        r[nc:nc + 2] = RL[:, :2].T @ lam
-        Jm[nc:nc + 2, :nc] = RL[:, :2].T
-        r[nc + 2] = RL[:, 2] @ lam / r_typ
-        Jm[nc + 2, :nc] = RL[:, 2] / r_typ
+        r[eq] = (RL.T @ lam) * row_scale
+        Jm[eq, :nc] = RL.T * row_scale[:, None]
         if carrier:
-            r[nc + 3] = (cset.lever @ lam - torque) / r_typ
-            Jm[nc + 3, :nc] = cset.lever / r_typ
-        for k in dropped:
-            Jm[nc + k, nc + k] = 1.0
+            r[nc + nr] = (lever @ lam - torque) / r_typ
+            Jm[nc + nr, :nc] = lever / r_typ
+        for k in range(nb):
+            for d in dropped:
+                Jm[nc + 3 * k + d, nc + 3 * k + d] = 1.0
         cscale = colscale[:n]
         try:
             y = np.linalg.solve(Jm * cscale[None, :], -r)
@@ -545,14 +625,15 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
         step = y * cscale
         lam = lam + step[:nc]
         lam[ii] = 0.0
-        a = a + step[nc:nc + 3]
+        a = a + step[eq]
         if carrier:
-            phi = phi + step[nc + 3]
+            phi = phi + step[nc + nr]
 
         v, delta, q, dq = state(lam, a, phi)
-        gap = cset.gap0 + v
+        gap = gap0 + v
         new_active = sig & ((lam - kappa * gap) > 0)
         history.append(new_active)
+        spring_history.append(spring & (dq > 0))
         spring_res = float(np.abs(lam[spring] - q[spring]).max()) if spring.any() else 0.0
         gap_res = float(np.abs(gap[active]).max()) if active.any() else 0.0
         settled = np.array_equal(new_active, active)
@@ -563,10 +644,15 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
         changes = np.zeros(nc, dtype=int)
         for h0, h1 in zip(history[:-1], history[1:]):
             changes += h0 != h1
+        for h0, h1 in zip(spring_history[:-1], spring_history[1:]):
+            changes += h0 != h1
         flipping = [names[i] if names else str(i) for i in np.flatnonzero(changes)]
+        worst = np.argsort(-np.abs(lam - q) * spring)[:5]
+        unsettled = [names[i] if names else str(i) for i in worst if spring[i] and abs(lam[i] - q[i]) > 1e-8 * scale_f]
         raise ContactError(
             f"contact active set did not settle {label}within {max_iterations} iterations"
             + (f"; contacts that keep flipping: {', '.join(flipping)}" if flipping else "")
+            + (f"; springs whose force law is not met: {', '.join(unsettled)}" if unsettled else "")
             + ". Check the profile modifications and clearances or refine the angle step "
             "(analysis.max_active_set_iterations raises the bound)."
         )
@@ -575,32 +661,56 @@ def _newton(cset, iface, compliance, torque, start, max_iterations, label, tol_g
     # the spring laws to the tolerance above; it is not replaced by q(δ), which would trade the
     # former for the latter
     lam = np.where(sig & ~active, 0.0, lam)
-    Rc = Rfull                                       # the loads' resultants, all three
-    res_f = float(np.linalg.norm(Rc[:, :2].T @ lam))
-    residual = {
-        "force_N": res_f,
-        "moment_Nmm": float(abs(Rc[:, 2] @ lam)),
-        "carrier_Nmm": float(abs(cset.lever @ lam - torque)),
-        "relative": res_f / max(float(np.abs(lam).sum()), 1e-30),
-    }
-    gap_out = np.where(sig, cset.gap0 + v, -delta)
-    return AngleSolution(lam, Rc[:, :2] * lam[:, None], gap_out, a, float(phi), it, residual)
+    gap_out = np.where(sig, gap0 + v, -delta)
+    carrier_res = float(abs(lever @ lam - torque))
+    out = []
+    for k in range(nb):
+        rows = slice(offs[k], offs[k + 1])
+        lk, Rk = lam[rows], Rfull[rows]
+        res_f = float(np.linalg.norm(Rk[:, :2].T @ lk))
+        residual = {
+            "force_N": res_f,
+            "moment_Nmm": float(abs(Rk[:, 2] @ lk)),
+            "carrier_Nmm": carrier_res,
+            "relative": res_f / max(float(np.abs(lk).sum()), 1e-30),
+            "torque_Nmm": float(lever[rows] @ lk),
+        }
+        out.append(AngleSolution(lk, Rk[:, :2] * lk[:, None], gap_out[rows], a[3 * k:3 * k + 3], float(phi),
+                                 it, residual))
+    return out
 
 
-def _nominal_stiffness(cset: ContactSet, torque: float) -> float:
-    """A secant spring stiffness (N/mm) for the first, linearised solve of a cycle."""
+def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, float]]:
+    """A secant stiffness (N/mm) per spring group for the first, linearised solve of a cycle.
+
+    Each group gets the secant of its own law at a force of the order it will carry: a bearing
+    contact (with a carrier lever) about a quarter of T/r (r its lever arm); a pin about the mean
+    force of the loaded half of the pins, T/(½·Σ|m_j|) with m_j the moment of a unit pin force
+    about the disc centre. One secant for every group (the bearings') would give a compliant pin
+    the stiffness of a bearing, a thousand times too stiff, and the first Newton steps then
+    oscillate between contact states without settling.
+    """
+    cset = body.cset
+    WL = cset.W if cset.W_load is None else cset.W_load
+    moments = np.abs(np.asarray(WL.T @ body.interface.resultants[:, 2]))
+    out = []
     for idx, law in cset.laws:
-        # secant through an estimated roller load of the order of the bearing loads
         lever = np.abs(cset.lever[idx]).max() if np.size(idx) else 0.0
         if lever > 0:
             q_ref = abs(torque) / lever / 4.0
-            # invert the law numerically: find δ with q(δ) = q_ref
-            lo, hi = 0.0, 1.0
-            for _ in range(80):
-                mid = 0.5 * (lo + hi)
-                if law(np.array([mid]))[0][0] < q_ref:
-                    lo = mid
-                else:
-                    hi = mid
-            return q_ref / max(hi, 1e-15)
-    return 1e5
+        else:
+            q_ref = abs(torque) / max(0.5 * float(moments[idx].sum()), 1e-30)
+        out.append((idx, _secant(law, q_ref)))
+    return out
+
+
+def _secant(law, q_ref: float) -> float:
+    """Secant stiffness q_ref/δ of a force law at the force q_ref (bisection for δ in (0, 1] mm)."""
+    lo, hi = 0.0, 1.0
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if law(np.array([mid]))[0][0] < q_ref:
+            lo = mid
+        else:
+            hi = mid
+    return q_ref / max(hi, 1e-15)

@@ -26,11 +26,14 @@ import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import threadpool_limits
 
-from . import contact
+from . import contact, registry
 from .case import Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
 from .errors import CaseError
-from .geometry import crank_centres as bore_centres  # centres c_i of the crank bores, (N, 2), mm
+from .geometry import crank_centres
+from .models import roller_angles
+
+bore_centres = crank_centres  # kept for the callers of rvfem 0.1 (to be removed)
 
 log = logging.getLogger(__name__)
 
@@ -43,7 +46,6 @@ __all__ = [
     "solve_angle",
     "load_cycle",
     "displacement",
-    "bore_centres",
     "roller_angles",
 ]
 
@@ -53,23 +55,6 @@ FOOTPRINT_ELEMENTS = 1.5
 profile, mesh.size_bore at the bores). The Hertz half-widths of these contacts (≈0.1 mm) are below
 one element at the default sizes, so the footprint spreads each force over a few elements; the
 bearing loads do not depend on it (global equilibrium), only the stress right under a contact."""
-
-
-def roller_angles(case: Case, theta: float) -> np.ndarray:
-    """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad.
-
-    Measured about each bore centre from the disc's x axis. The eccentric turns by θ relative to
-    the disc (the disc only translates relative to the carrier), so the cage turns by
-    θ·(1 − γ)/2 with γ = D_we/D_m (outer ring fixed). The cages of the N bearings are phased by
-    Δ_i·(1 + γ)/2 for a crank at Δ_i from the first, which makes the N bearings equivalent by the
-    disc's N-fold symmetry (their load curves are then exact 360°/N shifts when Zc is divisible
-    by N). Rollers of one bearing are 2π/Z apart.
-    """
-    b = case.crank_bearing
-    gamma = b.roller_diameter / b.pitch_diameter
-    alpha = np.radians(case.cranks.angles_deg)
-    cage = theta * (1.0 - gamma) / 2.0 + (alpha - alpha[0]) * (1.0 + gamma) / 2.0
-    return cage[:, None] + 2.0 * np.pi * np.arange(b.rollers)[None, :] / b.rollers
 
 
 @dataclass(frozen=True)
@@ -87,8 +72,10 @@ class DiscSystem:
     solve : callable
         K_s⁻¹ applied to a right-hand side.
     rigid_modes : ndarray (n_dofs, 3)
-    bearing_model : str
-        ``"rollers"`` or ``"rigid_bore"``.
+    bearing_model, pin_model : str
+        Names of the crank-bearing and pin models (:mod:`rvfem.registry`).
+    bearings, pins : rvfem.models.BearingModel, rvfem.models.PinModel
+        The model objects.
     setup_seconds : dict
         Wall times of assembly, factorisation and interface build.
     """
@@ -107,6 +94,8 @@ class DiscSystem:
     bearing_stiffness_scale: float = 1.0
     pin_stiffness_N_per_mm: float | None = None
     setup_seconds: dict = field(default_factory=dict)
+    bearings: object = None
+    pins: object = None
 
 
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
@@ -146,12 +135,11 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     order = order or case.analysis.element_order
     bearing_model = bearing_model or case.crank_bearing.model
     pin_model = pin_model or case.pins.model
-    if pin_model not in ("rigid", "hertz", "linear"):
-        raise CaseError(f"pin model must be 'rigid', 'hertz' or 'linear', got {pin_model!r}")
-    if pin_model == "linear" and not (pin_stiffness_N_per_mm and pin_stiffness_N_per_mm > 0):
-        raise CaseError("pin model 'linear' needs a positive pin_stiffness_N_per_mm")
-    if bearing_model not in ("rollers", "rigid_bore"):
-        raise CaseError(f"bearing model must be 'rollers' or 'rigid_bore', got {bearing_model!r}")
+    try:
+        pins = registry.pin_model(pin_model)(case, pin_stiffness_N_per_mm)
+        bearings = registry.bearing_model(bearing_model)(case, bearing_stiffness_scale)
+    except KeyError as exc:
+        raise CaseError(exc.args[0]) from None
     times = {}
     geometry = disc_geometry(case)
     t0 = time.perf_counter()
@@ -166,7 +154,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     rigid = fem.rigid_body_modes(model)  # about the disc centre (the origin)
 
     t0 = time.perf_counter()
-    centres = bore_centres(case)
+    centres = crank_centres(case)
     names = ["profile"] + [f"bore_{i}" for i in range(case.cranks.count)]
     boundaries = {n: mesh.boundaries[n] for n in names}
     half = {"profile": FOOTPRINT_ELEMENTS * case.mesh.size_flank}
@@ -179,26 +167,32 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     compliance = Compliance(factor.solve, iface.B)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
                       stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
-                      pin_stiffness_N_per_mm, times)
+                      pin_stiffness_N_per_mm, times, bearings, pins)
 
 
-def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
-    """The contacts of crank angle θ (rad): every pin, then the bearing contacts.
+def pin_contacts(system: DiscSystem, theta: float):
+    """The pin contacts of crank angle θ (rad) as a :class:`rvfem.models.ContactGroup`.
 
-    Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
+    Each pin pushes along the inward normal of the profile at its closest point; the gap is the
+    exact one of the (modified, pitch-error) profile. With friction (``analysis.friction`` = μ)
+    the load on the disc is λ·(d + μ·s·t) along the known sliding direction, while the gap is
+    still measured along the normal d.
     """
     from .geometry import pin_centres, pin_profile_contacts
+    from .models import ContactGroup
 
     case = system.case
-    iface = system.interface
-    prof = iface.grids["profile"]
+    prof = system.interface.grids["profile"]
     pc = pin_profile_contacts(system.geometry, theta)
     zp = case.pins.count
     s = prof.arc_of(np.asarray(pc.point))
     inward = -np.asarray(pc.normal)
     cols, wts = prof.columns_at(s, inward)   # pins push along the inward normal
+    shape = (system.interface.n_columns, zp)
+    index = (cols.ravel(), np.repeat(np.arange(zp), cols.shape[1]))
+    W = sp.csc_matrix((wts.ravel(), index), shape=shape)
+    W_load = None
     mu = case.analysis.friction
-    pin_load = None
     if mu > 0:
         # Coulomb friction along the known sliding direction: the pin centre's velocity relative
         # to the disc (the pins are taken as not rolling in their grooves); the friction force on
@@ -208,79 +202,38 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
         tangent = np.stack([-inward[:, 1], inward[:, 0]], axis=1)
         slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
         _, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
-    rows_w = [cols.ravel()]
-    cols_w = [np.repeat(np.arange(zp), cols.shape[1])]
-    vals_w = [wts.ravel()]
-    gap0 = np.zeros(zp)
-    offset = np.zeros(zp)
-    signorini = np.zeros(zp, dtype=bool)
-    names = [f"pin {j}" for j in range(zp)]
-    laws = []
-    if system.pin_model == "rigid":
-        signorini[:] = True
-        gap0[:] = pc.gap
-    else:
-        offset[:] = -np.asarray(pc.gap)
-        law = (contact.palmgren_law(case.cycloid.thickness, contacts=1) if system.pin_model == "hertz"
-               else contact.linear_law(system.pin_stiffness_N_per_mm))
-        laws.append((np.arange(zp), law))
+        W_load = sp.csc_matrix((pin_load.ravel(), index), shape=shape)
+    law = system.pins.law()
+    rigid = law is None
+    return ContactGroup(
+        W=W, signorini=np.full(zp, rigid), gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
+        offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
+        laws=[] if rigid else [(np.arange(zp), law)], names=[f"pin {j}" for j in range(zp)],
+        bearing=np.full(zp, -1), W_load=W_load)
 
-    centres = bore_centres(case)
-    b = case.crank_bearing
-    n = zp
-    bearing_of = []
-    if system.bearing_model == "rollers":
-        psi = roller_angles(case, theta)
-        law = (contact.palmgren_law(b.roller_length, contacts=2) if b.stiffness_law == "palmgren"
-               else contact.linear_law(b.linear_stiffness_N_per_mm))
-        idx = []
-        for i, c in enumerate(centres):
-            grid = iface.grids[f"bore_{i}"]
-            pts = c + b.bore_radius * np.stack([np.cos(psi[i]), np.sin(psi[i])], axis=1)
-            cc, ww = grid.columns_at(grid.arc_of(pts))
-            z = len(psi[i])
-            rows_w.append(cc.ravel())
-            cols_w.append(np.repeat(np.arange(n, n + z), 2))
-            vals_w.append(ww.ravel())
-            names += [f"bearing {i} roller {k}" for k in range(z)]
-            idx.append(np.arange(n, n + z))
-            bearing_of += [i] * z
-            n += z
-        nb = n - zp
-        laws.append((np.concatenate(idx), law))
-        gap0 = np.concatenate([gap0, np.zeros(nb)])
-        offset = np.concatenate([offset, np.full(nb, -0.5 * b.radial_clearance)])
-        signorini = np.concatenate([signorini, np.zeros(nb, dtype=bool)])
-    else:
-        k_b = b.rigid_bore_stiffness_N_per_mm * system.bearing_stiffness_scale
-        for i, c in enumerate(centres):
-            grid = iface.grids[f"bore_{i}"]
-            ang = np.arctan2(*(iface.points[grid.offset:grid.offset + grid.count] - c).T[::-1])
-            colsb = grid.offset + np.arange(grid.count)
-            for comp, w in (("x", np.cos(ang)), ("y", np.sin(ang))):
-                rows_w.append(colsb)
-                cols_w.append(np.full(grid.count, n))
-                vals_w.append(2.0 / grid.count * w)
-                names.append(f"bearing {i} {comp}")
-                bearing_of.append(i)
-                n += 1
-        nb = n - zp
-        laws.append((np.arange(zp, n), contact.linear_law(k_b, bilateral=True)))
-        gap0 = np.concatenate([gap0, np.zeros(nb)])
-        offset = np.concatenate([offset, np.zeros(nb)])
-        signorini = np.concatenate([signorini, np.zeros(nb, dtype=bool)])
 
-    W = sp.csc_matrix((np.concatenate(vals_w), (np.concatenate(rows_w), np.concatenate(cols_w))),
-                      shape=(iface.n_columns, n))
+def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
+    """The contacts of crank angle θ (rad): every pin (the pin model's), then the bearing contacts
+    (the bearing model's).
+
+    Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
+    """
+    pins = pin_contacts(system, theta)
+    centres = crank_centres(system.case)
+    bearings = system.bearings.contacts(system.interface, centres, theta)
+    zp = pins.size
+    W = sp.hstack([pins.W, bearings.W]).tocsc()
     W_load = None
-    if pin_load is not None:
-        vals_w[0] = pin_load.ravel()
-        W_load = sp.csc_matrix((np.concatenate(vals_w), (np.concatenate(rows_w), np.concatenate(cols_w))),
-                               shape=(iface.n_columns, n))
-    F = np.asarray(W.T @ iface.resultants[:, :2])     # force on the disc per unit λ
-    cb = centres[np.asarray(bearing_of, dtype=int)]
-    lever = np.concatenate([np.zeros(zp), cb[:, 0] * F[zp:, 1] - cb[:, 1] * F[zp:, 0]])
-    return ContactSet(W, signorini, gap0, offset, lever, laws, W_load), names
+    if pins.W_load is not None:
+        W_load = sp.hstack([pins.W_load, bearings.W]).tocsc()
+    laws = [(idx, law) for idx, law in pins.laws] + [(zp + idx, law) for idx, law in bearings.laws]
+    F = np.asarray(bearings.W.T @ system.interface.resultants[:, :2])     # force on the disc per unit λ
+    cb = centres[bearings.bearing]
+    lever = np.concatenate([np.zeros(zp), cb[:, 0] * F[:, 1] - cb[:, 1] * F[:, 0]])
+    cset = ContactSet(W, np.concatenate([pins.signorini, bearings.signorini]),
+                      np.concatenate([pins.gap0, bearings.gap0]),
+                      np.concatenate([pins.offset, bearings.offset]), lever, laws, W_load)
+    return cset, pins.names + bearings.names
 
 
 @dataclass(frozen=True)
@@ -340,17 +293,13 @@ def solve_angle(system: DiscSystem, theta: float, start: AngleResult | None = No
         max_iterations=case.analysis.max_active_set_iterations,
         label=f"at crank angle {math.degrees(theta):.2f}° ", names=names,
     )
-    zp = case.pins.count
-    n = case.cranks.count
-    if system.bearing_model == "rollers":
-        z = case.crank_bearing.rollers
-        vec = sol.vectors[zp:].reshape(n, z, 2)
-        bearing = vec.sum(axis=1)
-        rollers = sol.force[zp:].reshape(n, z)
-        angles = roller_angles(case, theta)
-    else:
-        bearing = sol.vectors[zp:].reshape(n, 2, 2).sum(axis=1)
-        rollers = angles = None
+    return angle_result(system, theta, sol, cset)
+
+
+def angle_result(system: DiscSystem, theta: float, sol: AngleSolution, cset: ContactSet) -> AngleResult:
+    """Unpack a solved contact problem into pin and bearing loads (the bearing model's)."""
+    zp = system.case.pins.count
+    bearing, rollers, angles = system.bearings.bearing_forces(sol.vectors[zp:], sol.force[zp:], theta)
     return AngleResult(theta, bearing, rollers, angles, sol.force[:zp], sol.vectors[:zp],
                        sol.gap[:zp], sol.carrier_rotation, sol, cset)
 

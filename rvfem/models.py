@@ -1,0 +1,290 @@
+"""Pluggable crank-bearing and pin models.
+
+A crank-bearing model says how a bearing's load enters the disc at a crank angle: which footprint
+columns of the bore it loads, with which force law, and how the solved contact forces add up to
+the bearing force (and roller loads, where the model has rollers). A pin model says how a pin acts
+on the tooth flank: as a rigid body (a Signorini contact) or through a force–approach law.
+
+Both are plain classes behind the small protocols :class:`BearingModel` and :class:`PinModel`,
+registered by name in :mod:`rvfem.registry`; the case reader, the command line and the report take
+the names and the sentences they print from there. Adding a bearing model is one class with the
+methods below, decorated with :func:`rvfem.registry.register_bearing_model`, plus its case keys.
+
+The contact laws are functions ``law(delta) -> (Q, dQ/dδ)`` of the approach δ (mm) returning the
+force (N) and its derivative (N/mm), see :func:`rvfem.contact.palmgren_law`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar, Protocol
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import contact
+from .errors import CaseError
+from .registry import register_bearing_model, register_pin_model
+
+__all__ = [
+    "ContactGroup",
+    "BearingModel",
+    "PinModel",
+    "RollerBearing",
+    "RigidBoreBearing",
+    "RigidPins",
+    "PalmgrenPins",
+    "LinearPins",
+    "roller_angles",
+]
+
+
+@dataclass(frozen=True)
+class ContactGroup:
+    """The contacts that one model adds at one crank angle (m contacts).
+
+    Attributes
+    ----------
+    W : scipy.sparse.csc_matrix (n_columns, m)
+        Weights of each contact on the disc's interface columns (approach measured along them).
+    signorini : ndarray bool (m,)
+        True for rigid contacts (gap ≥ 0 ⟂ λ ≥ 0).
+    gap0 : ndarray (m,)
+        Initial gap of the Signorini contacts, mm (0 for springs).
+    offset : ndarray (m,)
+        Constant part of a spring's approach, mm.
+    laws : list of (ndarray of local indices, law)
+        Force laws of the spring contacts.
+    names : list of str
+        One name per contact, for messages (``bearing 1 roller 3``).
+    bearing : ndarray int (m,)
+        Index of the crank bearing each contact belongs to, −1 for pins.
+    W_load : scipy.sparse.csc_matrix or None
+        Weights of the contact *loads* where they differ from ``W`` (pin friction).
+    """
+
+    W: sp.csc_matrix
+    signorini: np.ndarray
+    gap0: np.ndarray
+    offset: np.ndarray
+    laws: list
+    names: list
+    bearing: np.ndarray
+    W_load: sp.csc_matrix | None = None
+
+    @property
+    def size(self) -> int:
+        return self.W.shape[1]
+
+
+def _group(n_columns: int, rows, cols, vals, m: int, **kw) -> ContactGroup:
+    W = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n_columns, m))
+    return ContactGroup(W=W, **kw)
+
+
+class BearingModel(Protocol):
+    """What a crank-bearing model provides (one instance per analysed case).
+
+    ``name`` is the value of ``crank_bearing.model``; the constructor takes the case and the
+    stiffness scale of the rigid-limit checks (1 in an ordinary analysis).
+    """
+
+    name: ClassVar[str]
+
+    def __init__(self, case, stiffness_scale: float = 1.0) -> None: ...
+
+    def describe(self) -> str:
+        """One sentence for the report's assumptions."""
+
+    def contacts(self, interface, centres: np.ndarray, theta: float) -> ContactGroup:
+        """The bearing contacts at crank angle θ (rad); ``centres`` are the bore centres (N, 2)."""
+
+    def bearing_forces(self, vectors: np.ndarray, forces: np.ndarray, theta: float
+                       ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+        """Bearing forces on the disc (N, 2), roller loads (N, Z) and roller angles (N, Z), rad
+        (None without rollers), from the solved forces of this group's contacts."""
+
+
+class PinModel(Protocol):
+    """What a pin model provides: rigid (Signorini) or a force–approach law per pin."""
+
+    name: ClassVar[str]
+    rigid: ClassVar[bool]
+
+    def __init__(self, case, stiffness_N_per_mm: float | None = None) -> None: ...
+
+    def describe(self) -> str:
+        """One sentence for the report's assumptions."""
+
+    def law(self):
+        """The pins' force–approach law (None for rigid pins)."""
+
+
+def roller_angles(case, theta: float) -> np.ndarray:
+    """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad.
+
+    Measured about each bore centre from the disc's x axis. The eccentric turns by θ relative to
+    the disc (the disc only translates relative to the carrier), so the cage turns by
+    θ·(1 − γ)/2 with γ = D_we/D_m (outer ring fixed). The cages of the N bearings are phased by
+    Δ_i·(1 + γ)/2 for a crank at Δ_i from the first, which makes the N bearings equivalent by the
+    disc's N-fold symmetry (their load curves are then exact 360°/N shifts when Zc is divisible
+    by N). Rollers of one bearing are 2π/Z apart.
+    """
+    b = case.crank_bearing
+    gamma = b.roller_diameter / b.pitch_diameter
+    alpha = np.radians(case.cranks.angles_deg)
+    cage = theta * (1.0 - gamma) / 2.0 + (alpha - alpha[0]) * (1.0 + gamma) / 2.0
+    return cage[:, None] + 2.0 * np.pi * np.arange(b.rollers)[None, :] / b.rollers
+
+
+@register_bearing_model
+class RollerBearing:
+    """Discrete rollers: each a compression-only spring along its radial line.
+
+    The approach of a roller is the radial relative displacement of eccentric and bore minus half
+    the radial clearance; its law is Palmgren's line contact for both raceways (Harris & Kotzalas,
+    *Rolling Bearing Analysis*) or a linear stiffness. Rollers sit at their cage positions
+    (:func:`roller_angles`); each roller's force is shared by the two nearest bore columns.
+    """
+
+    name = "rollers"
+
+    def __init__(self, case, stiffness_scale: float = 1.0):
+        self.case = case
+        b = case.crank_bearing
+        if b.stiffness_law == "palmgren":
+            self._law = contact.palmgren_law(b.roller_length, contacts=2)
+        else:
+            self._law = contact.linear_law(b.linear_stiffness_N_per_mm)
+
+    def describe(self) -> str:
+        b = self.case.crank_bearing
+        law = ("Palmgren line contact on both raceways" if b.stiffness_law == "palmgren"
+               else f"a linear stiffness of {b.linear_stiffness_N_per_mm:g} N/mm")
+        return (f"crank bearings: {b.rollers} discrete rollers per bearing at their cage positions, "
+                f"each a compression-only spring ({law}), radial clearance {b.radial_clearance:g} mm")
+
+    def contacts(self, interface, centres, theta):
+        b = self.case.crank_bearing
+        psi = roller_angles(self.case, theta)
+        rows, cols, vals, names, bearing = [], [], [], [], []
+        n = 0
+        for i, c in enumerate(centres):
+            grid = interface.grids[f"bore_{i}"]
+            pts = c + b.bore_radius * np.stack([np.cos(psi[i]), np.sin(psi[i])], axis=1)
+            cc, ww = grid.columns_at(grid.arc_of(pts))
+            z = len(psi[i])
+            rows.append(cc.ravel())
+            cols.append(np.repeat(np.arange(n, n + z), 2))
+            vals.append(ww.ravel())
+            names += [f"bearing {i} roller {k}" for k in range(z)]
+            bearing += [i] * z
+            n += z
+        return _group(interface.n_columns, rows, cols, vals, n, signorini=np.zeros(n, dtype=bool),
+                      gap0=np.zeros(n), offset=np.full(n, -0.5 * b.radial_clearance),
+                      laws=[(np.arange(n), self._law)], names=names, bearing=np.asarray(bearing))
+
+    def bearing_forces(self, vectors, forces, theta):
+        n, z = self.case.cranks.count, self.case.crank_bearing.rollers
+        return (vectors.reshape(n, z, 2).sum(axis=1), forces.reshape(n, z),
+                roller_angles(self.case, theta))
+
+
+@register_bearing_model
+class RigidBoreBearing:
+    """The bore tied to a rigid ring by a radial pressure ∝ cos, with one isotropic spring.
+
+    Each bearing is two bilateral springs (x and y) of stiffness
+    ``crank_bearing.rigid_bore_stiffness_N_per_mm``; the force enters the bore as a radial
+    pressure proportional to the cosine of the angle to the force (a deformable remote point that
+    does not stiffen the bore).
+    """
+
+    name = "rigid_bore"
+
+    def __init__(self, case, stiffness_scale: float = 1.0):
+        self.case = case
+        self.stiffness = case.crank_bearing.rigid_bore_stiffness_N_per_mm * stiffness_scale
+
+    def describe(self) -> str:
+        return ("crank bearings: each bore tied to a rigid ring by a radial pressure ∝ cos, with one "
+                f"isotropic bearing spring of {self.stiffness:.3g} N/mm")
+
+    def contacts(self, interface, centres, theta):
+        rows, cols, vals, names, bearing = [], [], [], [], []
+        n = 0
+        for i, c in enumerate(centres):
+            grid = interface.grids[f"bore_{i}"]
+            ang = np.arctan2(*(interface.points[grid.offset:grid.offset + grid.count] - c).T[::-1])
+            colsb = grid.offset + np.arange(grid.count)
+            for comp, w in (("x", np.cos(ang)), ("y", np.sin(ang))):
+                rows.append(colsb)
+                cols.append(np.full(grid.count, n))
+                vals.append(2.0 / grid.count * w)
+                names.append(f"bearing {i} {comp}")
+                bearing.append(i)
+                n += 1
+        return _group(interface.n_columns, rows, cols, vals, n, signorini=np.zeros(n, dtype=bool),
+                      gap0=np.zeros(n), offset=np.zeros(n),
+                      laws=[(np.arange(n), contact.linear_law(self.stiffness, bilateral=True))],
+                      names=names, bearing=np.asarray(bearing))
+
+    def bearing_forces(self, vectors, forces, theta):
+        n = self.case.cranks.count
+        return vectors.reshape(n, 2, 2).sum(axis=1), None, None
+
+
+@register_pin_model
+class RigidPins:
+    """Rigid pins: Signorini contact (gap ≥ 0, force ≥ 0, no force across a gap) with the flank."""
+
+    name = "rigid"
+    rigid = True
+
+    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+        self.case = case
+
+    def describe(self) -> str:
+        return "rigid pins (Signorini contact: gap ≥ 0, force ≥ 0)"
+
+    def law(self):
+        return None
+
+
+@register_pin_model
+class PalmgrenPins:
+    """Compliant pins: Palmgren's line-contact approach of one pin–flank contact over the disc
+    width, δ = 3.84e-5·Q^0.9/b^0.8 (Harris & Kotzalas, *Rolling Bearing Analysis*)."""
+
+    name = "hertz"
+    rigid = False
+
+    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+        self.case = case
+
+    def describe(self) -> str:
+        return "compliant pins: Palmgren line-contact approach of each pin–flank contact"
+
+    def law(self):
+        return contact.palmgren_law(self.case.cycloid.thickness, contacts=1)
+
+
+@register_pin_model
+class LinearPins:
+    """Linear pin springs Q = k·δ (compression only): the classical textbook assumption that the
+    pin deflections are proportional to the forces (a validation device of the rigid limit)."""
+
+    name = "linear"
+    rigid = False
+
+    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+        if not (stiffness_N_per_mm and stiffness_N_per_mm > 0):
+            raise CaseError("pin model 'linear' needs a positive pin stiffness (N/mm)")
+        self.case = case
+        self.stiffness = float(stiffness_N_per_mm)
+
+    def describe(self) -> str:
+        return f"linear pin springs of {self.stiffness:g} N/mm (the classical pin-force assumption)"
+
+    def law(self):
+        return contact.linear_law(self.stiffness)
