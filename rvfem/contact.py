@@ -361,6 +361,7 @@ class ContactSet:
     lever: np.ndarray
     laws: list
     W_load: sp.csc_matrix | None = None
+    bearing: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

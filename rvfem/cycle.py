@@ -232,7 +232,8 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     lever = np.concatenate([np.zeros(zp), cb[:, 0] * F[:, 1] - cb[:, 1] * F[:, 0]])
     cset = ContactSet(W, np.concatenate([pins.signorini, bearings.signorini]),
                       np.concatenate([pins.gap0, bearings.gap0]),
-                      np.concatenate([pins.offset, bearings.offset]), lever, laws, W_load)
+                      np.concatenate([pins.offset, bearings.offset]), lever, laws, W_load,
+                      np.concatenate([pins.bearing, bearings.bearing]))
     return cset, pins.names + bearings.names
 
 
@@ -339,6 +340,15 @@ class CycleResult:
     solutions : tuple of AngleResult
         The full solution of every angle (any displacement field can be rebuilt exactly from it
         with :func:`displacement`).
+    stage : str
+        The reducer-stage model (:meth:`rvfem.reducer.ReducerStage.describe`).
+    disc_torque_Nmm : ndarray (n, discs) or None
+        Each disc's share of the carrier torque (two discs sharing the carrier), N·mm; None for
+        one disc with T/discs.
+    disc_bearing_forces : ndarray (n, discs, N, 2) or None
+        Bearing forces on disc A (at θ) and disc B (at θ + 180°), carrier frame, N.
+    eccentric_displacement : ndarray (n, discs, N, 2) or None
+        Eccentric displacements relative to the carrier (crankshaft deflection), mm.
     """
 
     theta: np.ndarray
@@ -355,6 +365,10 @@ class CycleResult:
     von_mises_envelope: np.ndarray | None = None
     von_mises_envelope_theta: np.ndarray | None = None
     solutions: tuple = field(default=(), repr=False)
+    stage: str = "one disc carrying T/discs (the handbook's equal share); crank support rigid: upper bound of the flexibility effect"
+    disc_torque_Nmm: np.ndarray | None = None
+    disc_bearing_forces: np.ndarray | None = None
+    eccentric_displacement: np.ndarray | None = None
 
     @property
     def bearing_loads(self) -> np.ndarray:
@@ -390,14 +404,16 @@ def likely_columns(system: DiscSystem, sets: list[ContactSet]) -> np.ndarray:
 
 
 def cycle_angles(case: Case) -> np.ndarray:
-    """Crank angles of a full revolution at the case's step (endpoint excluded), rad."""
-    n = int(round(360.0 / case.analysis.angle_step_deg))
-    return np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    """Crank angles of a full revolution at the case's step (endpoint excluded), rad
+    (:func:`rvfem.rigid.load_cycle_angles`)."""
+    from .rigid import load_cycle_angles
+
+    return load_cycle_angles(case.analysis.angle_step_deg)
 
 
 def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress=None,
                saved_angles_deg: tuple[float, ...] | None = None,
-               stress_envelope: bool = False) -> CycleResult:
+               stress_envelope: bool = False, stage="case") -> CycleResult:
     """Solve every crank angle of a revolution, warm-starting each from the previous one.
 
     Parameters
@@ -406,48 +422,49 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
     thetas : ndarray, optional
         Crank angles, rad; default a full revolution at ``case.analysis.angle_step_deg``.
     progress : callable, optional
-        Called as ``progress(i, n)`` after each angle (the CLI draws its progress bar with it).
+        Called as ``progress(i, n)`` after each solve (the CLI draws its progress bar with it).
     saved_angles_deg : tuple, optional
         Angles whose displacement fields are kept; default ``case.analysis.saved_angles_deg``
         (the nearest solved angle is used) plus the angle of the maximum bearing load.
     stress_envelope : bool
         Also track the largest vertex von Mises stress of every vertex over all angles: one
         back-substitution and one sparse product per angle (about 5 ms on the default case).
+    stage : rvfem.reducer.ReducerStage, None or "case"
+        The reducer-stage model: "case" (default) builds it from the case (two discs sharing the
+        carrier for ``loads.discs = 2`` unless ``loads.torque_split = "equal"``; crankshafts from
+        ``[crank_support]``); None is one disc with T/discs on rigid eccentrics.
     """
+    from . import reducer
+
     case = system.case
     thetas = cycle_angles(case) if thetas is None else np.asarray(thetas, dtype=float)
+    if isinstance(stage, str):
+        stage = reducer.default_stage(system)
     t0 = time.perf_counter()
-    results: list[AngleResult] = []
-    prev = None
     # the per-angle systems are small (~100 unknowns): threaded BLAS only adds overhead there
     # (measured 7x slower on two cores), so the cycle runs BLAS single-threaded
-    t_envelope = 0.0
-    envelope = envelope_theta = None
-    if stress_envelope:
-        from .fem import nodal_stress_operator
-
-        stress_op = nodal_stress_operator(system.model)
-        nv = system.model.n_vertices
-        envelope = np.full(nv, -np.inf)
-        envelope_theta = np.zeros(nv)
+    extras = {}
     with threadpool_limits(limits=1, user_api="blas"):
-        sets = [contact_set(system, float(th)) for th in thetas]
-        system.compliance.ensure(likely_columns(system, [c for c, _ in sets]))
-        t_prefetch = time.perf_counter() - t0
-        for i, th in enumerate(thetas):
-            prev = solve_angle(system, float(th), prev, contacts=sets[i])
-            results.append(prev)
-            if stress_envelope:
-                t1 = time.perf_counter()
-                sxx, syy, sxy = (stress_op @ displacement(system, prev)).reshape(3, nv)
-                vm = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
-                higher = vm > envelope
-                envelope[higher] = vm[higher]
-                envelope_theta[higher] = th
-                t_envelope += time.perf_counter() - t1
-            if progress is not None:
-                progress(i + 1, len(thetas))
-    t_cycle = time.perf_counter() - t0 - t_envelope
+        if stage is None:
+            results: list[AngleResult] = []
+            prev = None
+            sets = [contact_set(system, float(th)) for th in thetas]
+            system.compliance.ensure(likely_columns(system, [c for c, _ in sets]))
+            t_prefetch = time.perf_counter() - t0
+            for i, th in enumerate(thetas):
+                prev = solve_angle(system, float(th), prev, contacts=sets[i])
+                results.append(prev)
+                if progress is not None:
+                    progress(i + 1, len(thetas))
+        else:
+            results, extras = reducer.solve_stage_cycle(stage, thetas, progress)
+            t_prefetch = 0.0
+        t_cycle = time.perf_counter() - t0
+        t1 = time.perf_counter()
+        envelope = envelope_theta = None
+        if stress_envelope:
+            envelope, envelope_theta = _von_mises_envelope(system, results)
+        t_envelope = time.perf_counter() - t1
 
     bf = np.stack([r.bearing_forces for r in results])
     loads = np.linalg.norm(bf, axis=2)
@@ -473,8 +490,28 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
         timings={"cycle": t_cycle, "prefetch": t_prefetch, "fields": t_fields,
                  "stress_envelope": t_envelope,
                  "columns_solved": system.compliance.columns_solved,
-                 "column_solve": system.compliance.solve_seconds},
+                 "column_solve": system.compliance.solve_seconds,
+                 "pair_solves": extras.pop("pair_solves", len(thetas))},
         von_mises_envelope=envelope,
         von_mises_envelope_theta=envelope_theta,
         solutions=tuple(results),
+        **extras,
     )
+
+
+def _von_mises_envelope(system: DiscSystem, results: list[AngleResult]) -> tuple[np.ndarray, np.ndarray]:
+    """Largest vertex von Mises stress of every vertex over the solved angles (MPa) and the angle
+    at which it occurs (rad)."""
+    from .fem import nodal_stress_operator
+
+    stress_op = nodal_stress_operator(system.model)
+    nv = system.model.n_vertices
+    envelope = np.full(nv, -np.inf)
+    envelope_theta = np.zeros(nv)
+    for r in results:
+        sxx, syy, sxy = (stress_op @ displacement(system, r)).reshape(3, nv)
+        vm = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+        higher = vm > envelope
+        envelope[higher] = vm[higher]
+        envelope_theta[higher] = r.theta
+    return envelope, envelope_theta

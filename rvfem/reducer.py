@@ -1,0 +1,456 @@
+"""The reducer stage: two discs on one carrier, crankshafts as beams.
+
+A two-disc RV reducer is not one disc on rigid eccentrics with half the torque. Disc B runs 180°
+behind disc A and the two discs share
+
+1. the **carrier**: one rotation φ, so the output torque divides between the discs by their
+   stiffness at each crank angle (T_A + T_B = T_out, not T_out/2 each), and
+2. every **crankshaft**: a beam on two support bearings in the carrier's end plates carrying both
+   discs' eccentrics. The eccentric of crank i under disc k moves by
+   w_k,i = −Σ_k' f_kk' · F_k',i (F the bearing force on disc k', so −F acts on the eccentric),
+   the same 2×2 influence matrix f (mm/N) in x and y (a round shaft on radially isotropic
+   bearings). The part of the two discs' forces that is common on a crank (the torque-carrying
+   tangential force) sees the soft path through the support bearings; the part that is opposite
+   (the rotating pin-force components, ≈ 180° apart) sees the much stiffer bending between them.
+
+Both couplings enter the condensed contact problem of :func:`rvfem.contact.solve_bodies`: the
+discs are two bodies with their own contacts and rigid motions, one carrier unknown, and the
+crankshafts add the compliance H[c, c'] = f_kk' · (d_c · d_c') between bearing contacts c, c' of
+the same crank (d the unit force direction on the disc, in the carrier frame).
+
+**Disc B.** Disc B is the same part and mesh as disc A, but it cannot sit in the same orientation:
+seen from disc B the pin ring is the one disc A would see at θ + 180° turned by half a pin pitch,
+which is disc A's view at θ + 180° − β turned as a whole by β = π/Zc (for a one-tooth difference;
+β = (2π − π·(Zp − Zc))/Zc in general, 0 for an even tooth difference). So disc B's teeth sit half a
+tooth pitch from disc A's against the bores and holes. Two ways to model it:
+
+* ``"same_as_first"`` (default): disc B is disc A at θ + 180° (same mesh, same compliance). This
+  misplaces disc B's teeth by β against its bores and holes; in exchange one pair solve gives
+  both discs' states (disc A at θ and at θ + 180°), so 180° of pair solves make the full cycle.
+* ``"half_pitch"``: disc B is a second model whose bores and holes are turned by −β against the
+  teeth, solved at θ + 180° − β and turned back by β: the exact geometry, at the price of a second
+  mesh, factorisation and compliance and 360° of pair solves.
+
+The difference between the two on the shipped RV-40E pair is measured in
+``benchmarks/bench_reducer.py`` (see docs/theory.md).
+
+**Torque convention.** As for one disc (docs/theory.md), each disc's torque is the moment of its
+pin forces about its own centre, and the carrier rotation turns each disc's eccentric centres about
+the disc centre; the handbook's ΣP_x·e·Zc = T/2 per disc is the equal split of this total.
+
+**Crankshaft influence coefficients** (:func:`beam_influence`): a beam of span L between two elastic
+supports with compliances c₁, c₂ (support bearing plus carrier in series), loaded at the eccentric
+positions z_k. Bending (Roark's *Formulas for Stress and Strain*, simply supported beam with an
+intermediate point load), shear (Timoshenko beam, shear coefficient κ = 6(1 + ν)/(7 + 6ν) of a
+solid circular section after Cowper) and the rigid-body motion of the beam on its supports add up.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contact import AngleSolution, Body, solve_bodies
+from .errors import CaseError
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "beam_influence",
+    "crankshaft_influence",
+    "second_disc_phase",
+    "ReducerStage",
+    "PairResult",
+    "build_stage",
+    "default_stage",
+    "solve_pair",
+    "solve_stage_cycle",
+    "SECOND_DISC_MODELS",
+]
+
+SECOND_DISC_MODELS = ("same_as_first", "half_pitch")
+
+
+# ------------------------------------------------------------------------------------------------
+# Crankshaft as a beam
+# ------------------------------------------------------------------------------------------------
+
+
+def beam_influence(span: float, positions, bending_stiffness: float, shear_stiffness: float | None = None,
+                   support_compliance: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """Influence matrix of a beam on two elastic supports: deflection at z_i per unit load at z_j.
+
+    Parameters
+    ----------
+    span : float
+        L, distance between the two supports, mm.
+    positions : sequence of float
+        Load positions z measured from support 1, each in (0, L), mm.
+    bending_stiffness : float
+        EI, N·mm² (``inf`` for a rigid shaft).
+    shear_stiffness : float, optional
+        κ·G·A, N (None or ``inf``: no shear deflection).
+    support_compliance : (float, float)
+        Radial compliance of support 1 and support 2, mm/N (0: rigid).
+
+    Returns
+    -------
+    ndarray (n, n)
+        f_ij, mm/N, symmetric (Maxwell–Betti).
+
+    Notes
+    -----
+    For a unit load at b (from support 1) and a point x ≤ b, with L the span:
+
+    * bending, simply supported (Roark's *Formulas for Stress and Strain*, beam table, simple
+      supports, intermediate load): y = (L − b)·x·(L² − (L − b)² − x²) / (6·L·EI); for x ≥ b the
+      mirror image (x → L − x, b → L − b). At mid-span for a central load this is L³/(48·EI).
+    * shear (Timoshenko): y = (L − b)·x / (L·κGA) for x ≤ b and b·(L − x) / (L·κGA) for x ≥ b
+      (L/(4·κGA) at the centre for a central load).
+    * supports: the reactions R₁ = (L − b)/L, R₂ = b/L deflect the supports by c₁R₁ and c₂R₂, and
+      the beam follows the line between them: y = c₁R₁·(L − x)/L + c₂R₂·x/L.
+    """
+    L = float(span)
+    z = np.asarray(positions, dtype=float)
+    if not (L > 0 and np.all((z > 0) & (z < L))):
+        raise ValueError("the load positions must lie strictly between the supports")
+    c1, c2 = (float(c) for c in support_compliance)
+    x = z[:, None]
+    b = z[None, :]
+    lo = np.minimum(x, b)                      # the point nearer support 1 ...
+    hi = np.maximum(x, b)                      # ... and the one nearer support 2
+    f = np.zeros((len(z), len(z)))
+    if np.isfinite(bending_stiffness):
+        f += (L - hi) * lo * (L * L - (L - hi) ** 2 - lo * lo) / (6.0 * L * bending_stiffness)
+    if shear_stiffness is not None and np.isfinite(shear_stiffness):
+        f += (L - hi) * lo / (L * shear_stiffness)
+    f += c1 * (L - x) * (L - b) / L**2 + c2 * x * b / L**2
+    return f
+
+
+def crankshaft_influence(case) -> np.ndarray | None:
+    """The crankshaft influence matrix of a case (mm/N, one row per disc), None for rigid support.
+
+    From ``[crank_support]``: the direct ``influence_mm_per_N``, or a beam of ``span`` with the
+    eccentrics at ``eccentric_positions``, EI from ``bending_stiffness_Nmm2`` or from
+    ``journal_diameter`` (EI = E·π·d⁴/64; shear κGA with G = E/(2(1 + ν)), A = π·d²/4 and
+    κ = 6(1 + ν)/(7 + 6ν) when ``shear`` is on), on supports of compliance
+    1/k_support + 1/k_carrier per side.
+    """
+    cs = getattr(case, "crank_support", None)
+    if cs is None:
+        return None
+    if cs.influence_mm_per_N is not None:
+        return np.asarray(cs.influence_mm_per_N, dtype=float)
+    E, nu = cs.youngs_modulus, cs.poissons_ratio
+    shear = None
+    if cs.bending_stiffness_Nmm2 is not None:
+        EI = float(cs.bending_stiffness_Nmm2)
+    else:
+        d = cs.journal_diameter
+        EI = E * math.pi * d**4 / 64.0
+        if cs.shear:
+            kappa = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+            shear = kappa * E / (2.0 * (1.0 + nu)) * math.pi * d * d / 4.0
+    ks = cs.support_stiffness_pair
+    kc = cs.carrier_stiffness_pair
+    compliance = tuple(1.0 / ks[i] + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    return beam_influence(cs.span, cs.eccentric_positions, EI, shear, compliance)
+
+
+def second_disc_phase(case) -> float:
+    """β, rad: disc B seen from its bores is disc A at θ + π − β turned by β (module docstring).
+
+    From Rp·u(2πj/Zp + θ·d/Zp) − e·u(θ) (d = Zp − Zc): disc B at crank angle θ sees the pins of
+    crank angle θ + π with the ring turned back by π·d/Zp; a rotation β of the whole picture with
+    β·Zc ≡ −π·d (mod 2π) absorbs it. The smallest non-negative solution is returned.
+    """
+    zp, zc = case.pins.count, case.cycloid.teeth
+    d = zp - zc
+    return float(np.mod((2.0 * math.pi - math.pi * d) / zc, 2.0 * math.pi / zc))
+
+
+# ------------------------------------------------------------------------------------------------
+# The stage and one pair of discs
+# ------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReducerStage:
+    """Everything of a reducer stage that does not change with the crank angle.
+
+    Attributes
+    ----------
+    first : rvfem.cycle.DiscSystem
+        Disc A.
+    second : rvfem.cycle.DiscSystem or None
+        Disc B's model; None for a single disc, ``first`` itself for ``"same_as_first"``.
+    second_phase : float
+        β, rad: disc B is solved at θ + π − β and its results turned by β (0 for
+        ``"same_as_first"``).
+    influence : ndarray (discs, discs) or None
+        Crankshaft influence matrix, mm/N (None: rigid eccentrics).
+    torque_Nmm : float
+        Torque on the carrier from the discs modelled here, N·mm: T_out for two discs, T_out/discs
+        for one disc (the handbook's equal share).
+    """
+
+    first: object
+    second: object | None
+    second_phase: float
+    influence: np.ndarray | None
+    torque_Nmm: float
+
+    @property
+    def discs(self) -> int:
+        return 1 if self.second is None else 2
+
+    @property
+    def mirrored_pairs(self) -> bool:
+        """True when the pair at θ + π is the pair at θ with the discs swapped (disc B is disc A
+        at θ + π and the crankshaft is symmetric), so that 180° of pairs make a cycle."""
+        if self.second is not self.first or self.second_phase != 0.0:
+            return False
+        f = self.influence
+        return f is None or bool(np.isclose(f[0, 0], f[1, 1], rtol=1e-12, atol=0.0))
+
+    def describe(self) -> str:
+        """What the stage model is, for the report and the screen."""
+        if self.discs == 1:
+            disc = "one disc carrying T/discs (the handbook's equal share)"
+        else:
+            disc = ("two discs sharing one carrier (the torque divides by their stiffness); disc B "
+                    + ("modelled as disc A at θ + 180°" if self.second is self.first and self.second_phase == 0
+                       else "with its teeth half a pitch from disc A's against the bores and holes"))
+        crank = ("crank support rigid: upper bound of the flexibility effect" if self.influence is None
+                 else "crankshafts as beams on elastic support bearings")
+        return f"{disc}; {crank}"
+
+
+def _rotation(beta: float) -> np.ndarray:
+    c, s = math.cos(beta), math.sin(beta)
+    return np.array([[c, -s], [s, c]])
+
+
+def build_stage(system, *, discs: int | None = None, second=None, second_disc: str = "same_as_first",
+                influence: np.ndarray | None | str = "case") -> ReducerStage:
+    """The reducer stage of a disc model.
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+        Disc A.
+    discs : {1, 2}, optional
+        1: one disc with the equal torque share T_out/discs; 2: both discs on one carrier.
+        Default from the case (``loads.discs`` and ``loads.torque_split``).
+    second : rvfem.cycle.DiscSystem, optional
+        Disc B's model for ``second_disc = "half_pitch"``: the case with its cranks and holes turned
+        by −β (:func:`half_pitch_case`), meshed and built like disc A.
+    second_disc : {"same_as_first", "half_pitch"}
+    influence : ndarray, None or "case"
+        Crankshaft influence matrix (mm/N); None for rigid eccentrics; "case" from
+        ``[crank_support]``.
+    """
+    case = system.case
+    if discs is None:
+        split = getattr(case.loads, "torque_split", "stiffness")
+        discs = 2 if (case.loads.discs == 2 and split == "stiffness") else 1
+    if influence == "case":
+        influence = crankshaft_influence(case)
+    torque = case.loads.torque_Nm * 1000.0
+    if discs == 1:
+        f = None if influence is None else np.asarray(influence, dtype=float)[:1, :1]
+        return ReducerStage(system, None, 0.0, f, torque / case.loads.discs)
+    if discs != 2:
+        raise CaseError(f"a reducer stage has one or two discs, got {discs}")
+    if case.loads.discs != 2:
+        raise CaseError("two discs sharing the carrier need loads.discs = 2")
+    if second_disc not in SECOND_DISC_MODELS:
+        raise CaseError(f"second disc model must be one of {', '.join(SECOND_DISC_MODELS)}, got {second_disc!r}")
+    f = None if influence is None else np.asarray(influence, dtype=float)
+    if f is not None and f.shape != (2, 2):
+        raise CaseError("the crankshaft influence matrix of two discs must be 2×2")
+    if second_disc == "same_as_first":
+        return ReducerStage(system, system, 0.0, f, torque)
+    if second is None:
+        raise CaseError("second_disc = 'half_pitch' needs the second disc's model (see half_pitch_case)")
+    return ReducerStage(system, second, second_disc_phase(case), f, torque)
+
+
+def half_pitch_case(case):
+    """Disc B's case for the exact model: cranks (and the holes that follow them) turned by −β.
+
+    Holes placed by an explicit ``angle_offset_deg`` are turned too; everything else is unchanged.
+    Solved at θ + π − β and turned back by β, this is disc B with its teeth half a tooth pitch from
+    disc A's against the bores and holes.
+    """
+    import dataclasses
+
+    beta = math.degrees(second_disc_phase(case))
+    cranks = dataclasses.replace(case.cranks, angles_deg=tuple(a - beta for a in case.cranks.angles_deg))
+    changes = {"cranks": cranks}
+    for table in ("fan_holes", "round_holes"):
+        holes = getattr(case, table)
+        if holes is not None and holes.angle_offset_deg is not None:
+            changes[table] = dataclasses.replace(holes, angle_offset_deg=holes.angle_offset_deg - beta)
+    return dataclasses.replace(case, **changes)
+
+
+@dataclass(frozen=True)
+class PairResult:
+    """One crank angle of the stage.
+
+    Attributes
+    ----------
+    results : tuple of rvfem.cycle.AngleResult
+        Disc A at θ (and disc B, in its own model's frame and crank angle).
+    bearing_forces : ndarray (discs, N, 2)
+        Bearing forces on each disc in the carrier frame, N.
+    torque_Nmm : ndarray (discs,)
+        Each disc's share of the carrier torque, N·mm.
+    eccentric_displacement : ndarray (discs, N, 2)
+        Displacement of each eccentric relative to the carrier (crankshaft deflection), mm.
+    """
+
+    results: tuple
+    bearing_forces: np.ndarray
+    torque_Nmm: np.ndarray
+    eccentric_displacement: np.ndarray
+
+
+def _bodies(stage: ReducerStage, theta: float):
+    from .cycle import contact_set
+
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    thetas = [theta] if stage.second is None else [theta, theta + math.pi - stage.second_phase]
+    phases = [0.0, stage.second_phase][:len(systems)]
+    sets = [contact_set(s, th) for s, th in zip(systems, thetas)]
+    return systems, thetas, phases, sets
+
+
+def _directions(system, cset) -> np.ndarray:
+    """Unit force on the disc per unit λ of each contact, (n_contacts, 2), disc frame."""
+    WL = cset.W if cset.W_load is None else cset.W_load
+    return np.asarray(WL.T @ system.interface.resultants[:, :2])
+
+
+def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | None:
+    """H[c, c'] = f_kk' · (d_c · d_c') for the bearing contacts c (disc k), c' (disc k') of the
+    same crank, d in the carrier frame (mm/N); None for rigid eccentrics."""
+    if stage.influence is None:
+        return None
+    zp = stage.first.case.pins.count
+    dirs, crank, disc = [], [], []
+    for k, (s, beta, (cset, names)) in enumerate(zip(systems, phases, sets)):
+        d = _directions(s, cset) @ _rotation(beta).T
+        b = np.full(len(names), -1)
+        b[zp:] = cset.bearing[zp:]
+        dirs.append(d)
+        crank.append(b)
+        disc.append(np.full(len(names), k))
+    d = np.vstack(dirs)
+    crank = np.concatenate(crank)
+    disc = np.concatenate(disc)
+    same = (crank[:, None] == crank[None, :]) & (crank[:, None] >= 0)
+    f = stage.influence[disc[:, None], disc[None, :]]
+    return np.where(same, f * (d @ d.T), 0.0)
+
+
+def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None) -> PairResult:
+    """Solve the stage at crank angle θ (rad): disc A at θ with disc B at θ + 180°."""
+    from .cycle import angle_result
+
+    systems, thetas, phases, sets = _bodies(stage, theta)
+    case = stage.first.case
+    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
+    H = coupling_matrix(stage, systems, phases, sets)
+    sols = solve_bodies(
+        [Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.torque_Nmm,
+        coupling=H, start=None if start is None else [r.solution for r in start.results],
+        max_iterations=case.analysis.max_active_set_iterations,
+        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names)
+    results = tuple(angle_result(s, th, sol, c) for s, th, sol, (c, _) in zip(systems, thetas, sols, sets))
+    forces = np.stack([r.bearing_forces @ _rotation(beta).T for r, beta in zip(results, phases)])
+    torque = np.array([sol.residual["torque_Nmm"] for sol in sols])
+    w = np.zeros_like(forces)
+    if stage.influence is not None:
+        w = -np.einsum("kl,lnj->knj", stage.influence, forces)
+    return PairResult(results, forces, torque, w)
+
+
+def default_stage(system) -> ReducerStage | None:
+    """The stage the case asks for, or None when it is rvfem 0.1's single disc on rigid
+    eccentrics with T/discs (solved by :func:`rvfem.cycle.load_cycle` directly)."""
+    stage = build_stage(system)
+    if stage.discs == 1 and stage.influence is None:
+        return None
+    return stage
+
+
+# ------------------------------------------------------------------------------------------------
+# A full cycle
+# ------------------------------------------------------------------------------------------------
+
+
+def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
+    """Solve the stage at every crank angle, warm-starting from the previous one.
+
+    With :attr:`ReducerStage.mirrored_pairs` and an even number of uniformly spaced angles, only
+    the first half of the angles is solved: the pair at θ + 180° is the pair at θ with the discs
+    swapped.
+
+    Returns
+    -------
+    results : list of rvfem.cycle.AngleResult
+        Disc A at every θ.
+    extras : dict
+        ``disc_torque_Nmm`` (n, discs), ``disc_bearing_forces`` (n, discs, N, 2) in the carrier
+        frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
+        stage's description).
+    """
+    thetas = np.asarray(thetas, dtype=float)
+    n = len(thetas)
+    half = n // 2
+    uniform = n % 2 == 0 and np.allclose(np.mod(thetas[half:] - thetas[:half], 2 * math.pi), math.pi,
+                                         atol=1e-12)
+    mirrored = stage.discs == 2 and stage.mirrored_pairs and uniform
+    solve_at = thetas[:half] if mirrored else thetas
+    from .cycle import contact_set, likely_columns
+
+    t0 = time.perf_counter()
+    systems = [stage.first] if stage.second is None or stage.second is stage.first else [stage.first, stage.second]
+    for s in systems:
+        sets = [contact_set(s, float(th)) for th in thetas]
+        s.compliance.ensure(likely_columns(s, [c for c, _ in sets]))
+    log.info("stage compliance prefetch %.2f s", time.perf_counter() - t0)
+    pairs: list[PairResult] = []
+    prev = None
+    for i, th in enumerate(solve_at):
+        prev = solve_pair(stage, float(th), prev)
+        pairs.append(prev)
+        if progress is not None:
+            progress(i + 1, len(solve_at))
+    if mirrored:
+        order = [(j, 0) for j in range(half)] + [(j, 1) for j in range(half)]
+    else:
+        order = [(j, 0) for j in range(n)]
+    results, torque, forces, w = [], [], [], []
+    for j, k in order:
+        p = pairs[j]
+        swap = [k, 1 - k] if stage.discs == 2 else [0]
+        results.append(p.results[k])
+        torque.append(p.torque_Nmm[swap])
+        forces.append(p.bearing_forces[swap])
+        w.append(p.eccentric_displacement[swap])
+    extras = {
+        "disc_torque_Nmm": np.array(torque),
+        "disc_bearing_forces": np.array(forces),
+        "eccentric_displacement": np.array(w),
+        "pair_solves": len(solve_at),
+        "stage": stage.describe(),
+    }
+    return results, extras
