@@ -12,8 +12,11 @@ On ``cases/rv40e_fanholes.toml`` at its default mesh (or the case given), measur
    as an independent FE contact problem (a code that re-factorises at every active-set
    iteration would be slower still);
 
-and prints the ratios the design asks for: cycle / (assembly + factorisation) and naive / condensed
-per angle, plus the peak memory of the process.
+4. the reducer stage's cycle: two discs sharing the carrier (with the case's crankshafts), 180° of
+   pair solves, from an empty compliance cache like the single disc;
+
+and prints the ratios the design asks for: cycle / (assembly + factorisation), naive / condensed
+per angle and two-disc / single-disc cycle, plus the peak memory of the process.
 
 Run: ``python benchmarks/bench_cycle.py [CASE] [--naive-angles 5] [--step 1]``.
 """
@@ -30,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rvfem import contact, cycle, fem  # noqa: E402
+from rvfem import contact, cycle, fem, reducer  # noqa: E402
 from rvfem.case import load_case  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 
@@ -93,13 +96,25 @@ def main(argv=None) -> int:
 
     thetas = np.radians(np.arange(0.0, 360.0, args.step))
     t0 = time.perf_counter()
-    result = cycle.load_cycle(system, thetas)
+    result = cycle.load_cycle(system, thetas, stage=None)
     t_cycle = time.perf_counter() - t0
     tm = result.timings
     print(f"cycle of {len(thetas)} angles: {t_cycle:.2f} s = {t_cycle / len(thetas) * 1e3:.1f} ms/angle "
           f"(columns {tm['columns_solved']} in {tm['column_solve']:.2f} s, prefetch {tm['prefetch']:.2f} s, "
           f"Newton iterations per angle: mean {result.iterations.mean():.1f}, max {result.iterations.max()})")
     print(f"  ratio cycle / (assembly + factorisation) = {t_cycle / af:.1f}")
+
+    # the reducer stage: two discs sharing the carrier (and the case's crankshafts), each from an
+    # empty compliance cache like the single disc above
+    if case.loads.discs == 2:
+        pair_system = cycle.build_system(case, mesh)
+        stage = reducer.build_stage(pair_system, discs=2)
+        t0 = time.perf_counter()
+        pair = cycle.load_cycle(pair_system, thetas, stage=stage)
+        t_pair = time.perf_counter() - t0
+        print(f"two-disc cycle ({stage.describe()}): {t_pair:.2f} s, {pair.timings['pair_solves']} pair solves, "
+              f"columns {pair.timings['columns_solved']}")
+        print(f"  ratio two-disc cycle / single-disc cycle = {t_pair / t_cycle:.2f}")
 
     # naive: a handful of angles, no reuse
     picks = thetas[:: max(1, len(thetas) // args.naive_angles)][: args.naive_angles]

@@ -259,7 +259,7 @@ def build_stage(system, *, discs: int | None = None, second=None, second_disc: s
     if discs is None:
         split = getattr(case.loads, "torque_split", "stiffness")
         discs = 2 if (case.loads.discs == 2 and split == "stiffness") else 1
-    if influence == "case":
+    if isinstance(influence, str):
         influence = crankshaft_influence(case)
     torque = case.loads.torque_Nm * 1000.0
     if discs == 1:
@@ -454,3 +454,124 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         "stage": stage.describe(),
     }
     return results, extras
+
+
+# ------------------------------------------------------------------------------------------------
+# What the flexibility effect is made of
+# ------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class AttributionStep:
+    """One modelling step of the attribution: the bearing-load curves it gives.
+
+    Attributes
+    ----------
+    key : str
+        ``handbook``, ``equal_share``, ``one_disc``, ``two_discs`` or ``crankshafts``.
+    label : str
+        What the step adds, in words.
+    loads : ndarray (N, n)
+        Load magnitude of each bearing over the crank angles, N.
+    """
+
+    key: str
+    label: str
+    loads: np.ndarray
+
+
+@dataclass(frozen=True)
+class Attribution:
+    """The chain handbook → equal share of the FE pin resultant → one flexible disc with T/discs
+    → two discs sharing the carrier → crankshaft compliance, on the same crank angles.
+
+    ``final`` names the step that is the case's own model (the full FE answer).
+    """
+
+    theta: np.ndarray
+    steps: tuple[AttributionStep, ...]
+    final: str
+
+    def step(self, key: str) -> AttributionStep:
+        return next(s for s in self.steps if s.key == key)
+
+    def table(self, exponent: float) -> list[dict]:
+        """Per step and bearing: max, min and equivalent load (N) and their deltas against the
+        handbook (%), and the life ratio (F_hb,m/F_m)^(10/3)."""
+        from .evaluation import life_ratio
+        from .rigid import equivalent_load
+
+        ref = self.steps[0].loads
+        rows = []
+        for s in self.steps:
+            for i in range(s.loads.shape[0]):
+                mx, mn = float(s.loads[i].max()), float(s.loads[i].min())
+                fm = float(equivalent_load(s.loads[i], exponent))
+                rmx, rmn = float(ref[i].max()), float(ref[i].min())
+                rfm = float(equivalent_load(ref[i], exponent))
+                rows.append({
+                    "step": s.key, "label": s.label, "bearing": i + 1,
+                    "max_N": mx, "min_N": mn, "equivalent_N": fm,
+                    "delta_max_percent": 100.0 * (mx / rmx - 1.0),
+                    "delta_min_percent": 100.0 * (mn / rmn - 1.0),
+                    "delta_equivalent_percent": 100.0 * (fm / rfm - 1.0),
+                    "life_ratio": life_ratio(rfm, fm),
+                })
+        return rows
+
+
+STEP_LABELS = {
+    "handbook": "handbook (rigid disc, classical pin forces, T/2 per disc)",
+    "equal_share": "equal share of the FE pin resultant (pin-force distribution of the flexible disc)",
+    "one_disc": "one flexible disc with T/2 on rigid eccentrics (bearing load sharing)",
+    "two_discs": "two discs sharing the carrier, rigid crank support",
+    "crankshafts": "two discs sharing the carrier, crankshafts as beams",
+}
+
+
+def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attribution:
+    """Solve the modelling steps the case does not already have and collect their load curves.
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+    thetas : ndarray
+        Crank angles, rad (a uniformly sampled turn).
+    cycles : dict, optional
+        Already solved cycles by step key (``one_disc``, ``two_discs``, ``crankshafts``), e.g. the
+        run's own cycle, so that it is not solved twice. All steps share the disc's compliance.
+
+    Notes
+    -----
+    The equal share is built from the one-disc cycle's pin resultant (the handbook's load sharing
+    applied to the flexible disc's pin forces): F_i = −P/N + T_disc/(N·r0)·t_i.
+    """
+    from .cycle import load_cycle
+    from .compare import equal_share_forces
+    from .rigid import handbook_bearing_loads
+
+    case = system.case
+    cycles = dict(cycles or {})
+    need = ["one_disc"]
+    if case.loads.discs == 2:
+        need.append("two_discs")
+    f = crankshaft_influence(case)
+    if f is not None:
+        need.append("crankshafts")
+    for key in need:
+        if key in cycles:
+            continue
+        if key == "one_disc":
+            stage = None
+        else:
+            stage = build_stage(system, discs=2, influence=f if key == "crankshafts" else None)
+        cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
+    steps = [AttributionStep("handbook", STEP_LABELS["handbook"],
+                             handbook_bearing_loads(case, thetas).magnitude)]
+    share = np.linalg.norm(equal_share_forces(case, cycles["one_disc"]), axis=2).T
+    steps.append(AttributionStep("equal_share", STEP_LABELS["equal_share"], share))
+    for key in need:
+        steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
+    split = getattr(case.loads, "torque_split", "stiffness")
+    final = need[-1] if split == "stiffness" or case.loads.discs == 1 else "one_disc"
+    return Attribution(np.asarray(thetas), tuple(steps), final)
