@@ -646,3 +646,9 @@ def test_overrides_are_validated_like_the_file(tmp_path):
         load_case(path, overrides=("fan_holes.ligamnt=4.0",))
     with pytest.raises(CaseError, match="'fan_holes.ligament' must be finite"):
         load_case(path, overrides=("fan_holes.ligament=nan",))
+
+
+def test_p2_mesh_estimate_counts_edge_nodes(case_text, tmp_path):
+    p1 = load_case(case_text.write(tmp_path))
+    p2 = load_case(case_text.set("analysis", "element_order", "2").write(tmp_path))
+    assert estimated_mesh_nodes(p2)["total"] == pytest.approx(4 * estimated_mesh_nodes(p1)["total"], rel=1e-12)
