@@ -6,9 +6,28 @@ torque in N·m and speeds in rpm *in the file* (keys say so: ``torque_Nm``, ``sp
 degrees in the file (``*_deg``). The dataclasses keep the file's units; helpers such as
 :attr:`Loads.disc_torque_Nmm` convert.
 
+One schema
+----------
+Every key is declared once, on its dataclass field, with :func:`rvfem.schema.param`: type (from
+the annotation), unit, default, bounds, choices and meaning. The generic reader
+(:func:`rvfem.schema.read_table`) checks a file against these declarations and the reference
+tables of ``docs/case-format.md`` are generated from them (``python -m rvfem.schema
+docs/case-format.md``). Checks that involve several keys are the ``_check_*`` functions below.
+
+Validation
+----------
 Validation is complete before anything is returned: an unknown or misspelled key (with the closest
-known key suggested), a missing required key, a wrong type or a non-physical value raises
-:class:`~rvfem.errors.CaseError` naming the file and the key. Nothing is half-read.
+known key suggested; unknown keys are reported before missing ones), a missing required key, a
+wrong type, a non-finite or out-of-range number or a failed cross-field check raises
+:class:`~rvfem.errors.CaseError` naming the file and the dotted key, on one line. Nothing is
+half-read.
+
+A :class:`Case` built in code is validated the same way: :meth:`Case.__post_init__` checks every
+key of every table against its declaration (numbers are normalized to float, lists to tuples) and
+runs the cross-field checks, so ``Case(...)``, :meth:`Case.replace` and ``dataclasses.replace(case,
+...)`` all raise :class:`~rvfem.errors.CaseError` for an invalid case (the message names
+:attr:`Case.source`). The table dataclasses (:class:`Cycloid`, :class:`Pins`, ...) are plain values
+that are checked when they become part of a :class:`Case`.
 
 Example
 -------
@@ -21,16 +40,16 @@ Example
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import hashlib
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 from .errors import CaseError
 from .registry import bearing_model_names, pin_model_names
+from .schema import check_fields, file_fields, param, read_table, table_error
 
 __all__ = [
     "Case",
@@ -40,6 +59,7 @@ __all__ = [
     "Pins",
     "Cranks",
     "CrankBearing",
+    "CrankSupport",
     "FanHoles",
     "RoundHoles",
     "Material",
@@ -47,17 +67,24 @@ __all__ = [
     "Loads",
     "Analysis",
     "MeshSettings",
+    "MAX_MESH_NODES",
+    "estimated_mesh_nodes",
     "load_case",
     "parse_override",
     "apply_overrides",
     "case_from_dict",
     "case_to_dict",
+    "table_class",
+    "file_sha256",
 ]
 
 
 # --------------------------------------------------------------------------------------------
-# Dataclasses (units in the file's convention; see module docstring)
+# Dataclasses (units in the file's convention; see module docstring). Bounds: see the section
+# "Bounds" of docs/case-format.md for why each range is what it is.
 # --------------------------------------------------------------------------------------------
+
+_ANGLE = dict(unit="deg", low=-360.0, high=360.0)
 
 
 @dataclass(frozen=True)
@@ -75,9 +102,11 @@ class ProfileModification:
         Rotation of the profile about the disc centre, degrees.
     """
 
-    equidistant: float = 0.0
-    shift: float = 0.0
-    rotation_deg: float = 0.0
+    equidistant: float = param(0.0, unit="mm", low=-2.0, high=2.0,
+                               doc="ΔRrp, change of the generating pin radius (positive removes material)")
+    shift: float = param(0.0, unit="mm", low=-2.0, high=2.0, doc="ΔRp, change of the generating pin-circle radius")
+    rotation_deg: float = param(0.0, unit="deg", low=-10.0, high=10.0,
+                                doc="rotation of the profile about the disc centre")
 
 
 @dataclass(frozen=True)
@@ -89,8 +118,10 @@ class PitchError:
     k = 1…Zc (``amplitude`` = E_t,max), or an explicit list of ``values`` (one per tooth).
     """
 
-    amplitude: float = 0.0
-    values: tuple[float, ...] = ()
+    amplitude: float = param(0.0, unit="mm", low=-1.0, high=1.0,
+                             doc="E_t,max of E_t(k) = E_t,max·sin((k − 1)·π/2), k = 1…Zc")
+    values: tuple[float, ...] = param((), unit="mm", low=-1.0, high=1.0, max_length=199,
+                                      doc="one error per tooth (exactly Zc values)")
 
 
 @dataclass(frozen=True)
@@ -111,12 +142,12 @@ class Cycloid:
     pitch_error : PitchError
     """
 
-    teeth: int
-    eccentricity: float
-    thickness: float
-    central_hole_radius: float
-    modification: ProfileModification = ProfileModification()
-    pitch_error: PitchError = PitchError()
+    teeth: int = param(low=3, high=199, doc="number of lobes Zc")
+    eccentricity: float = param(unit="mm", low=0.01, high=50.0, doc="crank eccentricity e")
+    thickness: float = param(unit="mm", low=0.1, high=500.0, doc="disc width b (plane-stress thickness)")
+    central_hole_radius: float = param(unit="mm", low=0.1, high=1000.0, doc="radius of the central hole")
+    modification: ProfileModification = param(ProfileModification())
+    pitch_error: PitchError = param(PitchError())
 
 
 @dataclass(frozen=True)
@@ -133,13 +164,20 @@ class Pins:
         Pin radius r_rp, mm.
     model : str
         ``"rigid"`` (Signorini contact with a rigid pin) or ``"hertz"`` (the pin–tooth line
-        contact adds its Hertz approach).
+        contact adds its Hertz approach); any model registered in :mod:`rvfem.registry`.
     """
 
-    count: int
-    circle_radius: float
-    radius: float
-    model: str = "rigid"
+    count: int = param(low=4, high=200, doc="number of pins Zp, must exceed `cycloid.teeth`")
+    circle_radius: float = param(unit="mm", low=1.0, high=2000.0, doc="pin-circle radius Rp")
+    radius: float = param(unit="mm", low=0.1, high=200.0,
+                          doc="pin radius r_rp; neighbouring pins must not overlap (r_rp < Rp·sin(π/Zp))")
+    model: str = param("rigid", choices=pin_model_names,
+                       doc="rigid pins, or pins with Hertz line-contact compliance (registered pin models)")
+
+
+def _equal_crank_angles(values: Mapping[str, Any]) -> tuple[float, ...]:
+    n = values["cranks.count"]
+    return tuple(90.0 + 360.0 * i / n for i in range(n))
 
 
 @dataclass(frozen=True)
@@ -153,13 +191,16 @@ class Cranks:
     circle_radius : float
         Radius r0 of the circle of crank (and bore) centres, mm.
     angles_deg : tuple of float
-        Angular positions of the cranks on that circle, degrees. Default: equally spaced,
-        the first at 90°.
+        Angular positions of the cranks on that circle, degrees. Default in a file: equally
+        spaced, the first at 90° (a case built in code gives them).
     """
 
-    count: int
-    circle_radius: float
-    angles_deg: tuple[float, ...]
+    count: int = param(low=2, high=12, doc="number of cranks N")
+    circle_radius: float = param(unit="mm", low=1.0, high=2000.0,
+                                 doc="radius r0 of the circle of crank (and bore) centres")
+    angles_deg: tuple[float, ...] = param(**_ANGLE, max_length=12, default_from=_equal_crank_angles,
+                                          default_doc="equally spaced, first at 90°",
+                                          doc="angular positions α_i of the cranks (N distinct values)")
 
 
 @dataclass(frozen=True)
@@ -186,7 +227,8 @@ class CrankBearing:
         ISO 281 rating factors (material/manufacturing and edge-stress reduction).
     model : str
         ``"rollers"`` (discrete compression-only roller springs) or ``"rigid_bore"`` (bore tied to
-        a rigid ring with one isotropic bearing spring).
+        a rigid ring with one isotropic bearing spring); any model registered in
+        :mod:`rvfem.registry`.
     stiffness_law : str
         ``"palmgren"`` (line-contact load–deflection, both raceways) or ``"linear"``.
     linear_stiffness_N_per_mm : float or None
@@ -195,18 +237,27 @@ class CrankBearing:
         Isotropic bearing stiffness of the ``rigid_bore`` model, N/mm.
     """
 
-    rollers: int
-    roller_diameter: float
-    roller_length: float
-    pitch_diameter: float
-    bore_radius: float
-    radial_clearance: float = 0.0
-    b_m: float = 1.1
-    lambda_nu: float = 0.83
-    model: str = "rollers"
-    stiffness_law: str = "palmgren"
-    linear_stiffness_N_per_mm: float | None = None
-    rigid_bore_stiffness_N_per_mm: float = 7.0e5
+    rollers: int = param(low=2, high=200, doc="number of rollers Z")
+    roller_diameter: float = param(unit="mm", low=0.1, high=200.0,
+                                   doc="D_we; γ = D_we/D_m must lie in (0, 1)")
+    roller_length: float = param(unit="mm", low=0.1, high=500.0,
+                                 doc="effective roller length L_we (rating and Hertz contact length)")
+    pitch_diameter: float = param(unit="mm", low=1.0, high=2000.0, doc="D_m; the rollers must fit: Z·D_we < π·D_m")
+    bore_radius: float = param(unit="mm", low=0.5, high=1000.0,
+                               doc="radius of the disc bore, at least (D_m + D_we)/2 (the outer raceway)")
+    radial_clearance: float = param(0.0, unit="mm", low=0.0, high=1.0, doc="radial clearance of the bearing")
+    b_m: float = param(1.1, low=0.0, low_open=True, high=2.0,
+                       doc="ISO 281 rating factor for material and manufacturing quality")
+    lambda_nu: float = param(0.83, low=0.0, low_open=True, high=1.0,
+                             doc="ISO 281 reduction factor λ·ν (edge stress, accuracy)")
+    model: str = param("rollers", choices=bearing_model_names,
+                       doc="discrete compression-only roller springs, or the bore tied to a rigid ring with one "
+                           "isotropic spring (registered bearing models)")
+    stiffness_law: str = param("palmgren", choices=("palmgren", "linear"), doc="roller load–deflection law")
+    linear_stiffness_N_per_mm: float | None = param(None, unit="N/mm", low=1.0e2, high=1.0e10,
+                                                    doc="roller stiffness; required when `stiffness_law = \"linear\"`")
+    rigid_bore_stiffness_N_per_mm: float = param(7.0e5, unit="N/mm", low=1.0e2, high=1.0e10,
+                                                 doc="bearing stiffness of the `rigid_bore` model")
 
     @property
     def inner_raceway_radius(self) -> float:
@@ -219,6 +270,10 @@ class CrankBearing:
         return 0.5 * (self.pitch_diameter + self.roller_diameter)
 
 
+def _crank_count(values: Mapping[str, Any]) -> int:
+    return values["cranks.count"]
+
+
 @dataclass(frozen=True)
 class FanHoles:
     """Fan-shaped lightening holes: annular sectors between the bores.
@@ -226,7 +281,7 @@ class FanHoles:
     Attributes
     ----------
     count : int
-        Number of holes (default: one between each pair of neighbouring cranks).
+        Number of holes (default in a file: one between each pair of neighbouring cranks).
     inner_radius, outer_radius : float
         Radial extent of the sector, mm.
     span_deg : float or None
@@ -240,41 +295,50 @@ class FanHoles:
         first two cranks.
     """
 
-    inner_radius: float
-    outer_radius: float
-    count: int
-    span_deg: float | None = None
-    ligament: float | None = None
-    fillet_radius: float = 1.0
-    angle_offset_deg: float | None = None
+    inner_radius: float = param(unit="mm", low=0.5, high=2000.0, doc="inner radius of the sector")
+    outer_radius: float = param(unit="mm", low=0.5, high=2000.0, doc="outer radius, > `inner_radius`")
+    count: int = param(low=1, high=12, default_from=_crank_count, default_doc="`cranks.count`",
+                       doc="number of holes")
+    span_deg: float | None = param(None, unit="deg", low=0.0, low_open=True, high=180.0,
+                                   doc="angular span of one hole; span × count < 360°")
+    ligament: float | None = param(None, unit="mm", low=0.1, high=500.0,
+                                   doc="narrowest wall between a hole and the bores (the span follows)")
+    fillet_radius: float = param(1.0, unit="mm", low=0.0, high=100.0, doc="corner fillet radius")
+    angle_offset_deg: float | None = param(None, **_ANGLE, default_doc="midway between the first two cranks",
+                                           doc="centre line of the first hole")
 
 
 @dataclass(frozen=True)
 class RoundHoles:
     """Round lightening holes on a circle (radius, circle radius, count)."""
 
-    radius: float
-    circle_radius: float
-    count: int
-    angle_offset_deg: float | None = None
+    radius: float = param(unit="mm", low=0.1, high=1000.0, doc="hole radius")
+    circle_radius: float = param(unit="mm", low=0.5, high=2000.0, doc="radius of the circle of hole centres")
+    count: int = param(low=1, high=60, default_from=_crank_count, default_doc="`cranks.count`",
+                       doc="number of holes")
+    angle_offset_deg: float | None = param(None, **_ANGLE, doc="angular position of the first hole")
 
 
 @dataclass(frozen=True)
 class Material:
     """Linear elastic material of the disc (and, for Hertz, of pins and rollers)."""
 
-    name: str = "bearing steel"
-    youngs_modulus: float = 206000.0
-    poissons_ratio: float = 0.3
+    name: str = param("bearing steel", max_length=200, doc="label")
+    youngs_modulus: float = param(206000.0, unit="MPa", low=1.0e3, high=1.2e6, doc="E")
+    poissons_ratio: float = param(0.3, low=0.0, high=0.5, high_open=True, doc="ν")
 
 
 @dataclass(frozen=True)
 class DutyRow:
     """One row of a duty cycle: share of time, output speed (rpm), output torque (N·m)."""
 
-    time_share: float
-    speed_rpm: float
-    torque_Nm: float
+    time_share: float = param(unit="any", low=1.0e-9, high=1.0e9, doc="share of time (only ratios matter)")
+    speed_rpm: float = param(unit="rpm", low=1.0e-3, high=1.0e4, doc="output speed")
+    torque_Nm: float = param(unit="N·m", low=0.0, high=1.0e6, doc="output torque (0 or at least 0.001 N·m)")
+
+
+TORQUE_SPLITS = ("stiffness", "equal")
+"""Values of ``loads.torque_split``."""
 
 
 @dataclass(frozen=True)
@@ -291,12 +355,20 @@ class Loads:
         Number of cycloid discs sharing the torque.
     duty_cycle : tuple of DutyRow
         Optional load spectrum.
+    torque_split : str
+        How the discs share the torque: ``"stiffness"`` (two discs on one carrier, the torque
+        divides in proportion to their stiffness; one or two discs only) or ``"equal"`` (each disc
+        carries T/discs: the handbook's assumption).
     """
 
-    torque_Nm: float
-    speed_rpm: float
-    discs: int = 2
-    duty_cycle: tuple[DutyRow, ...] = ()
+    torque_Nm: float = param(unit="N·m", low=1.0e-3, high=1.0e6, doc="output torque T of the whole reducer")
+    speed_rpm: float = param(unit="rpm", low=1.0e-3, high=1.0e4, doc="output speed")
+    discs: int = param(2, low=1, high=4, doc="number of cycloid discs sharing the torque")
+    duty_cycle: tuple[DutyRow, ...] = param((), max_length=1000)
+    torque_split: str = param("stiffness", choices=TORQUE_SPLITS,
+                              doc="`\"stiffness\"`: two discs on one carrier share the torque in proportion to "
+                                  "their stiffness (1 or 2 discs); `\"equal\"`: each disc carries T/discs "
+                                  "(the handbook's assumption)")
 
     @property
     def disc_torque_Nmm(self) -> float:
@@ -326,12 +398,18 @@ class Analysis:
         Crank angles at which displacement/stress fields are kept for output.
     """
 
-    equivalent_load_exponent: float = 10.0 / 3.0
-    angle_step_deg: float = 1.0
-    element_order: int = 1
-    friction: float = 0.0
-    max_active_set_iterations: int = 50
-    saved_angles_deg: tuple[float, ...] = (0.0, 90.0, 180.0, 270.0)
+    equivalent_load_exponent: float = param(
+        10.0 / 3.0, low=1.0, high=20.0,
+        doc="p of the equivalent load (mean F^p)^(1/p) over a crank turn; 10/3 per ISO 281, 4 reproduces Gao et al.")
+    angle_step_deg: float = param(1.0, unit="deg", low=0.05, high=30.0,
+                                  doc="crank-angle step of the load cycle; the cycle has round(360/step) equal steps")
+    element_order: int = param(1, choices=(1, 2), labels={1: "P1", 2: "P2"}, doc="P1 or P2 triangles")
+    friction: float = param(0.0, low=0.0, high=1.0,
+                            doc="Coulomb friction coefficient at the pins (along the pins' known sliding "
+                                "direction; 0.05 in Zhang et al.)")
+    max_active_set_iterations: int = param(50, low=1, high=1000, doc="bound of the contact active-set loop")
+    saved_angles_deg: tuple[float, ...] = param((0.0, 90.0, 180.0, 270.0), **_ANGLE, max_length=360,
+                                                doc="crank angles at which fields are written")
 
 
 @dataclass(frozen=True)
@@ -342,31 +420,127 @@ class MeshSettings:
     the structural stress peaks); None means twice ``size_bore``, capped by ``size_interior``.
     """
 
-    size_flank: float = 0.4
-    size_bore: float = 0.4
-    size_interior: float = 2.5
-    min_wall: float = 1.0
-    size_hole: float | None = None
+    size_flank: float = param(0.4, unit="mm", low=0.01, high=100.0, doc="element size along the tooth flanks")
+    size_bore: float = param(0.4, unit="mm", low=0.01, high=100.0, doc="element size along the bores")
+    size_interior: float = param(2.5, unit="mm", low=0.01, high=100.0, doc="element size inside the disc")
+    min_wall: float = param(1.0, unit="mm", low=0.01, high=100.0, doc="thinnest wall the geometry check accepts")
+    size_hole: float | None = param(None, unit="mm", low=0.01, high=100.0,
+                                    default_doc="2 × `size_bore` (≤ `size_interior`)",
+                                    doc="element size on the central hole and the lightening holes (their "
+                                        "fillets carry the structural stress peaks)")
 
 
 @dataclass(frozen=True)
-class Case:
-    """One reducer and one analysis, validated. See the module docstring for units."""
+class CrankSupport:
+    """The crankshaft as a beam on two support bearings (optional table ``[crank_support]``).
 
-    name: str
-    cycloid: Cycloid
-    pins: Pins
-    cranks: Cranks
-    crank_bearing: CrankBearing
-    material: Material
-    loads: Loads
-    analysis: Analysis = Analysis()
-    mesh: MeshSettings = MeshSettings()
-    fan_holes: FanHoles | None = None
-    round_holes: RoundHoles | None = None
-    description: str = ""
-    source: str = field(default="<code>", compare=False)
-    overrides: tuple[str, ...] = field(default=(), compare=False)
+    Either the beam (``span``, ``eccentric_positions``, one of ``journal_diameter`` and
+    ``bending_stiffness_Nmm2``, the material and the support/carrier stiffnesses) or directly the
+    influence matrix ``influence_mm_per_N`` of the eccentrics. Only read and validated here; the
+    physics is elsewhere.
+
+    Attributes
+    ----------
+    span : float or None
+        Distance between the load centres of the two support bearings, mm.
+    eccentric_positions : tuple of float or None
+        Position of each eccentric (one per disc), mm from support 1, inside (0, span).
+    journal_diameter : float or None
+        Diameter of the crankshaft journal (solid circular section), mm.
+    bending_stiffness_Nmm2 : float or None
+        E·I of the crankshaft, N·mm².
+    youngs_modulus, poissons_ratio : float
+        Material of the crankshaft (MPa, –).
+    shear : bool
+        Include the Timoshenko shear deflection (needs ``journal_diameter``).
+    support_stiffness_N_per_mm : float or tuple of float or None
+        Radial stiffness of the support bearings: one value for both or (support 1, support 2),
+        N/mm; None: rigid supports.
+    carrier_stiffness_N_per_mm : float or tuple of float or None
+        Stiffness of the carrier at the supports, in series with the support bearings, N/mm.
+    influence_mm_per_N : tuple of tuple of float or None
+        discs × discs symmetric positive-definite matrix: displacement of eccentric i per unit
+        force on eccentric j, mm/N.
+    """
+
+    span: float | None = param(None, unit="mm", low=1.0, high=5000.0,
+                               doc="distance between the load centres of the two support bearings")
+    eccentric_positions: tuple[float, ...] | None = param(
+        None, unit="mm", low=0.0, low_open=True, high=5000.0, max_length=4,
+        doc="position of each eccentric from support 1, one per disc (`loads.discs`), distinct, inside (0, span)")
+    journal_diameter: float | None = param(None, unit="mm", low=1.0, high=1000.0,
+                                           doc="crankshaft journal diameter (solid circular section)")
+    bending_stiffness_Nmm2: float | None = param(None, unit="N·mm²", low=1.0e3, high=1.0e18,
+                                                 doc="crankshaft bending stiffness E·I; give this or `journal_diameter`")
+    youngs_modulus: float = param(206000.0, unit="MPa", low=1.0e3, high=1.2e6, doc="crankshaft E")
+    poissons_ratio: float = param(0.3, low=0.0, high=0.5, high_open=True, doc="crankshaft ν")
+    shear: bool = param(True, doc="Timoshenko shear deflection (needs `journal_diameter`)")
+    support_stiffness_N_per_mm: float | tuple[float, ...] | None = param(
+        None, unit="N/mm", low=1.0e2, high=1.0e10, max_length=2, default_doc="none (rigid supports)",
+        doc="radial stiffness of the support bearings: one value for both, or [support 1, support 2]")
+    carrier_stiffness_N_per_mm: float | tuple[float, ...] | None = param(
+        None, unit="N/mm", low=1.0e2, high=1.0e10, max_length=2, default_doc="none (rigid carrier)",
+        doc="carrier stiffness at the supports, in series with the support bearings: one value or a list of 2")
+    influence_mm_per_N: tuple[tuple[float, ...], ...] | None = param(
+        None, unit="mm/N", low=-1.0, high=1.0, max_length=4,
+        doc="instead of the beam keys: discs × discs symmetric positive-definite matrix, displacement of "
+            "eccentric i per unit force on eccentric j")
+
+    @staticmethod
+    def _pair(value: float | tuple[float, ...] | None) -> tuple[float | None, float | None]:
+        if value is None:
+            return (None, None)
+        if isinstance(value, tuple):
+            return (value[0], value[1])
+        return (value, value)
+
+    @property
+    def support_stiffness_pair(self) -> tuple[float | None, float | None]:
+        """Stiffness of support 1 and support 2, N/mm (None where not given: rigid)."""
+        return self._pair(self.support_stiffness_N_per_mm)
+
+    @property
+    def carrier_stiffness_pair(self) -> tuple[float | None, float | None]:
+        """Carrier stiffness at support 1 and support 2, N/mm (None where not given: rigid)."""
+        return self._pair(self.carrier_stiffness_N_per_mm)
+
+
+def _file_stem(values: Mapping[str, Any]) -> str:
+    source = values.get("<source>", "")
+    return Path(source).stem if source.endswith(".toml") else "case"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Case:
+    """One reducer and one analysis, validated on construction (see the module docstring).
+
+    All arguments are keywords. ``source`` names the file (or ``"<code>"``) in error messages;
+    ``overrides`` records the ``KEY=VALUE`` overrides applied on reading.
+    """
+
+    name: str = param(max_length=200, default_from=_file_stem, default_doc="file name without `.toml`",
+                      doc="case name used in reports and result folders")
+    cycloid: Cycloid = param()
+    pins: Pins = param()
+    cranks: Cranks = param()
+    crank_bearing: CrankBearing = param()
+    material: Material = param(Material())
+    loads: Loads = param()
+    analysis: Analysis = param(Analysis())
+    mesh: MeshSettings = param(MeshSettings())
+    fan_holes: FanHoles | None = param(None)
+    round_holes: RoundHoles | None = param(None)
+    crank_support: CrankSupport | None = param(None)
+    description: str = param("", max_length=10000, doc="free text")
+    source: str = param("<code>", compare=False, in_file=False)
+    overrides: tuple[str, ...] = param((), compare=False, in_file=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "source", str(self.source))
+        object.__setattr__(self, "overrides", tuple(self.overrides))
+        check_fields(self, "", self.source)
+        for check in _CROSS_CHECKS:
+            check(self)
 
     @property
     def short_amplitude_coefficient(self) -> float:
@@ -375,8 +549,7 @@ class Case:
 
     def replace(self, **changes: Any) -> "Case":
         """A copy with top-level fields replaced (validated again)."""
-        data = case_to_dict(dataclasses.replace(self, **changes))
-        return case_from_dict(data, source=self.source)
+        return dataclasses.replace(self, **changes)
 
     def digest(self) -> str:
         """sha256 of the canonical case data (used to name cached meshes and results)."""
@@ -384,125 +557,249 @@ class Case:
 
 
 # --------------------------------------------------------------------------------------------
-# Reading and validation
+# Cross-field checks (run by Case.__post_init__, in this order)
 # --------------------------------------------------------------------------------------------
 
 
-class _Table:
-    """Reads keys from one TOML table, remembering which were used, and reports problems with the
-    full dotted key and the file name."""
-
-    def __init__(self, data: Any, path: str, source: str):
-        self.path = path
-        self.source = source
-        if not isinstance(data, dict):
-            raise self.error(path or "<top>", f"must be a table, got {type(data).__name__}")
-        self.data = data
-        self.used: set[str] = set()
-
-    def key(self, name: str) -> str:
-        return f"{self.path}.{name}" if self.path else name
-
-    def error(self, key: str, message: str) -> CaseError:
-        return CaseError(f"{self.source}: '{key}' {message}")
-
-    def has(self, name: str) -> bool:
-        return name in self.data
-
-    def get(self, name: str, kind: str, default: Any = ..., *, choices: tuple[str, ...] = ()) -> Any:
-        """Value of ``name`` converted to ``kind`` ('int', 'float', 'str', 'floats')."""
-        self.used.add(name)
-        key = self.key(name)
-        if name not in self.data:
-            if default is ...:
-                raise self.error(key, "is missing (required)")
-            return default
-        value = self.data[name]
-        if kind == "int":
-            if isinstance(value, bool) or not isinstance(value, int):
-                raise self.error(key, f"must be an integer, got {value!r}")
-        elif kind == "float":
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise self.error(key, f"must be a number, got {value!r}")
-            value = float(value)
-            if not math.isfinite(value):
-                raise self.error(key, f"must be finite, got {value!r}")
-        elif kind == "str":
-            if not isinstance(value, str):
-                raise self.error(key, f"must be a string, got {value!r}")
-            if choices and value not in choices:
-                hint = _closest(value, choices)
-                raise self.error(
-                    key,
-                    f"must be one of {', '.join(repr(c) for c in choices)}, got {value!r}"
-                    + (f" (did you mean {hint!r}?)" if hint else ""),
-                )
-        elif kind == "floats":
-            if not isinstance(value, list) or any(
-                isinstance(v, bool) or not isinstance(v, (int, float)) for v in value
-            ):
-                raise self.error(key, f"must be a list of numbers, got {value!r}")
-            value = tuple(float(v) for v in value)
-        else:  # pragma: no cover - programming error
-            raise AssertionError(kind)
-        return value
-
-    def sub(self, name: str, required: bool = True) -> "_Table | None":
-        self.used.add(name)
-        if name not in self.data:
-            if required:
-                raise self.error(self.key(name), "is missing (required table)")
-            return None
-        return _Table(self.data[name], self.key(name), self.source)
-
-    def finish(self, known: tuple[str, ...] = ()) -> None:
-        """Raise on any key that was not read (misspelled or unknown)."""
-        for name in self.data:
-            if name not in self.used:
-                hint = _closest(name, tuple(self.used) + known)
-                raise self.error(
-                    self.key(name),
-                    "is not a known key"
-                    + (f" (did you mean '{self.key(hint)}'?)" if hint else "")
-                    + "; remove it or check the spelling",
-                )
+def _error(case: Case, key: str, message: str) -> CaseError:
+    return table_error(case.source, key, message)
 
 
-def _closest(word: str, options: tuple[str, ...]) -> str | None:
-    match = difflib.get_close_matches(word, options, n=1, cutoff=0.6)
-    return match[0] if match else None
-
-
-def _positive(t: _Table, name: str, value: float | int | None, *, allow_zero: bool = False) -> None:
-    if value is None:
-        return
-    if value < 0 or (value == 0 and not allow_zero):
-        need = "non-negative" if allow_zero else "positive"
-        raise t.error(t.key(name), f"must be {need}, got {value!r}")
-
-
-def _read_modification(t: _Table | None) -> ProfileModification:
-    if t is None:
-        return ProfileModification()
-    m = ProfileModification(
-        equidistant=t.get("equidistant", "float", 0.0),
-        shift=t.get("shift", "float", 0.0),
-        rotation_deg=t.get("rotation_deg", "float", 0.0),
-    )
-    t.finish()
-    return m
-
-
-def _read_pitch_error(t: _Table | None, teeth: int) -> PitchError:
-    if t is None:
-        return PitchError()
-    p = PitchError(amplitude=t.get("amplitude", "float", 0.0), values=t.get("values", "floats", ()))
-    t.finish()
-    if p.values and len(p.values) != teeth:
-        raise t.error(t.key("values"), f"must have one value per tooth ({teeth}), got {len(p.values)}")
+def _check_cycloid_and_pins(case: Case) -> None:
+    cyc, pins = case.cycloid, case.pins
+    p = cyc.pitch_error
+    if p.values and len(p.values) != cyc.teeth:
+        raise _error(case, "cycloid.pitch_error.values",
+                     f"must have one value per tooth ({cyc.teeth}), got {len(p.values)}")
     if p.values and p.amplitude:
-        raise t.error(t.key("amplitude"), "and 'values' exclude each other; give one of them")
-    return p
+        raise _error(case, "cycloid.pitch_error.amplitude", "and 'values' exclude each other; give one of them")
+    if pins.count <= cyc.teeth:
+        raise _error(case, "pins.count", f"(Zp = {pins.count}) must exceed cycloid.teeth (Zc = {cyc.teeth}); "
+                                         "a cycloid drive needs more pins than lobes")
+    k = case.short_amplitude_coefficient
+    if k >= 1.0:
+        raise _error(case, "cycloid.eccentricity",
+                     f"is too large: the short-amplitude coefficient k = e·Zp/Rp = {k:.3f} must be < 1 "
+                     "(reduce the eccentricity or enlarge pins.circle_radius)")
+    if pins.radius >= pins.circle_radius * math.sin(math.pi / pins.count):
+        raise _error(case, "pins.radius", f"({pins.radius} mm) is too large: neighbouring pins overlap")
+
+
+def _check_cranks(case: Case) -> None:
+    cranks = case.cranks
+    if len(cranks.angles_deg) != cranks.count:
+        raise _error(case, "cranks.angles_deg",
+                     f"must list {cranks.count} angles (cranks.count), got {len(cranks.angles_deg)}")
+    wrapped = sorted(a % 360.0 for a in cranks.angles_deg)
+    gaps = [b - a for a, b in zip(wrapped, wrapped[1:] + [wrapped[0] + 360.0])]
+    if min(gaps) < 1e-6:
+        raise _error(case, "cranks.angles_deg", f"must be distinct angles (mod 360°), got {list(cranks.angles_deg)}")
+
+
+def _check_crank_bearing(case: Case) -> None:
+    b = case.crank_bearing
+    key = "crank_bearing."
+    if b.stiffness_law == "linear" and b.linear_stiffness_N_per_mm is None:
+        raise _error(case, key + "linear_stiffness_N_per_mm", "is missing (required when stiffness_law = 'linear')")
+    if b.roller_diameter >= b.pitch_diameter:   # γ = D_we/D_m in (0, 1): ISO 281 f_c, inner raceway > 0
+        raise _error(case, key + "roller_diameter", "must be smaller than pitch_diameter")
+    if math.pi * b.pitch_diameter - b.rollers * b.roller_diameter <= 0:
+        raise _error(case, key + "rollers",
+                     f": {b.rollers} rollers of {b.roller_diameter} mm do not fit the pitch circle of "
+                     f"{b.pitch_diameter} mm (circumference {math.pi * b.pitch_diameter:.2f} mm)")
+    if b.bore_radius <= 0.5 * b.pitch_diameter:
+        raise _error(case, key + "bore_radius",
+                     f"({b.bore_radius} mm) must exceed half the pitch diameter ({0.5 * b.pitch_diameter} mm)")
+    outer = b.outer_raceway_radius
+    if b.bore_radius < outer * (1.0 - 1e-9):
+        raise _error(case, key + "bore_radius",
+                     f"({b.bore_radius} mm) must be at least the outer raceway radius (D_m + D_we)/2 = {outer:g} mm: "
+                     "the rollers do not fit between the eccentric and the bore")
+
+
+def _check_holes(case: Case) -> None:
+    fan = case.fan_holes
+    if fan is not None:
+        if fan.outer_radius <= fan.inner_radius:
+            raise _error(case, "fan_holes.outer_radius", "must exceed inner_radius")
+        if (fan.span_deg is None) == (fan.ligament is None):
+            raise _error(case, "fan_holes.span_deg", "or 'ligament': give exactly one of them")
+        if fan.span_deg is not None and fan.span_deg * fan.count >= 360.0:
+            raise _error(case, "fan_holes.span_deg", f"× count must stay below 360°, got {fan.span_deg * fan.count}°")
+
+
+MIN_DUTY_TORQUE_NM = 1.0e-3
+"""Smallest non-zero torque of a duty-cycle row, N·m (a smaller one is a zero in disguise whose
+T^p underflows and makes the service life infinite)."""
+
+
+def _check_loads(case: Case) -> None:
+    loads = case.loads
+    if loads.torque_split == "stiffness" and loads.discs > 2:
+        raise _error(case, "loads.torque_split",
+                     f"= 'stiffness' needs 1 or 2 discs (loads.discs = {loads.discs}); use 'equal'")
+    for i, row in enumerate(loads.duty_cycle):
+        if 0.0 < row.torque_Nm < MIN_DUTY_TORQUE_NM:
+            raise _error(case, f"loads.duty_cycle[{i}].torque_Nm",
+                         f"must be 0 or at least {MIN_DUTY_TORQUE_NM:g} N·m, got {row.torque_Nm!r}")
+    if loads.duty_cycle and not any(row.torque_Nm > 0 for row in loads.duty_cycle):
+        raise _error(case, "loads.duty_cycle", "needs at least one row with a positive torque_Nm")
+
+
+MAX_MESH_NODES = 2_000_000
+"""Largest estimated node count a case may ask for (:func:`estimated_mesh_nodes`)."""
+
+_MESH_SIZE_GROWTH = 0.25
+_MESH_BAND_FACTOR = 2.0
+_MESH_HOLE_SIZE_FACTOR = 2.0
+
+
+def estimated_mesh_nodes(case: Case) -> dict[str, float]:
+    """Estimate of the node count of the disc mesh, before meshing, per size key.
+
+    The mesh sizes follow the size field of :mod:`rvfem.mesh`: size h_c on a curve of length L_c,
+    held for a band of 2·h_c and growing by 0.25 mm/mm to ``size_interior`` H. A triangulation of
+    nearly equilateral triangles of edge h has 2/(√3·h²) nodes per unit area, so
+
+        n ≈ 2/√3 · [A/H² + Σ_c L_c·(2/h_c + (1/h_c − 1/H)/0.25)]
+
+    with A the disc area (pin-circle disc minus holes, bores and pins' depth) and L_c the lengths of
+    the profile (≈ 2π·Rp·(1 + k), the lobes' arc), the bores, the central hole and the lightening
+    holes. It is meant for refusing absurd requests, not for planning: it is 1.2–1.4 times Gmsh's
+    vertex counts on the shipped cases. For P2 elements (``analysis.element_order = 2``) the
+    nodes are the vertices plus the edge midpoints, about 3 edges per vertex: four times the
+    vertex count.
+
+    Returns
+    -------
+    dict
+        ``{"mesh.size_interior": n_interior, "mesh.size_flank": n_flank, "mesh.size_bore": n_bore,
+        "mesh.size_hole": n_hole, "total": n}`` (node counts, float).
+    """
+    ms, cyc, pins = case.mesh, case.cycloid, case.pins
+    big = ms.size_interior
+    hole_size = ms.size_hole if ms.size_hole is not None else min(big, _MESH_HOLE_SIZE_FACTOR * ms.size_bore)
+    outer = max(pins.circle_radius - pins.radius, 1e-3)
+    bore = case.crank_bearing.bore_radius
+    area = math.pi * outer ** 2 - math.pi * cyc.central_hole_radius ** 2 - case.cranks.count * math.pi * bore ** 2
+    hole_length = 2.0 * math.pi * cyc.central_hole_radius
+    if case.fan_holes is not None:
+        fan = case.fan_holes
+        hole_length += fan.count * 2.0 * (fan.outer_radius + fan.outer_radius - fan.inner_radius)
+    if case.round_holes is not None:
+        hole_length += case.round_holes.count * 2.0 * math.pi * case.round_holes.radius
+    density = 2.0 / math.sqrt(3.0)
+
+    def band(length: float, size: float) -> float:
+        size = min(size, big)
+        return density * length * (_MESH_BAND_FACTOR / size + (1.0 / size - 1.0 / big) / _MESH_SIZE_GROWTH)
+
+    parts = {
+        "mesh.size_interior": density * max(area, 0.0) / big ** 2,
+        "mesh.size_flank": band(2.0 * math.pi * pins.circle_radius * (1.0 + case.short_amplitude_coefficient),
+                                ms.size_flank),
+        "mesh.size_bore": band(case.cranks.count * 2.0 * math.pi * bore, ms.size_bore),
+        "mesh.size_hole": band(hole_length, hole_size),
+    }
+    if case.analysis.element_order == 2:
+        parts = {key: 4.0 * value for key, value in parts.items()}
+    parts["total"] = sum(parts.values())
+    return parts
+
+
+def _check_mesh(case: Case) -> None:
+    parts = estimated_mesh_nodes(case)
+    if parts["total"] > MAX_MESH_NODES:
+        by_key = {k: v for k, v in parts.items() if k != "total"}
+        if case.mesh.size_hole is None:   # the hole size follows size_bore
+            by_key["mesh.size_bore"] += by_key.pop("mesh.size_hole")
+        worst = max(by_key, key=by_key.get)
+        raise _error(case, worst,
+                     f"asks for too fine a mesh: about {parts['total']:.3g} "
+                     f"{'P2 ' if case.analysis.element_order == 2 else ''}nodes estimated "
+                     f"({by_key[worst]:.3g} from this size), more than "
+                     f"{MAX_MESH_NODES:.0e}; make it larger")
+
+
+def _check_crank_support(case: Case) -> None:
+    s = case.crank_support
+    if s is None:
+        return
+    discs = case.loads.discs
+    key = "crank_support."
+    beam_keys = ("span", "eccentric_positions", "journal_diameter", "bending_stiffness_Nmm2",
+                 "support_stiffness_N_per_mm", "carrier_stiffness_N_per_mm")
+    if s.influence_mm_per_N is not None:
+        for name in beam_keys:
+            if getattr(s, name) is not None:
+                raise _error(case, key + name, "and 'influence_mm_per_N' exclude each other: the influence "
+                                               "matrix replaces the beam model; give one of them")
+        defaults = {f.name: f.default for f in dataclasses.fields(CrankSupport)}
+        for name in ("youngs_modulus", "poissons_ratio", "shear"):
+            if getattr(s, name) != defaults[name]:
+                raise _error(case, key + name, "only applies to the beam model, not with 'influence_mm_per_N'")
+        matrix = s.influence_mm_per_N
+        if len(matrix) != discs or any(len(row) != discs for row in matrix):
+            shape = f"{len(matrix)}×{'/'.join(sorted({str(len(r)) for r in matrix})) or 0}"
+            raise _error(case, key + "influence_mm_per_N",
+                         f"must be a {discs}×{discs} matrix (loads.discs = {discs}), got {shape}")
+        scale = max(abs(v) for row in matrix for v in row)
+        for i in range(discs):
+            for j in range(i):
+                if abs(matrix[i][j] - matrix[j][i]) > 1e-9 * scale:
+                    raise _error(case, key + "influence_mm_per_N",
+                                 f"must be symmetric, got [{i}][{j}] = {matrix[i][j]!r} and [{j}][{i}] = {matrix[j][i]!r}")
+        if not _positive_definite(matrix):
+            raise _error(case, key + "influence_mm_per_N", "must be positive definite (a compliance matrix)")
+        return
+    for name in ("span", "eccentric_positions"):
+        if getattr(s, name) is None:
+            raise _error(case, key + name, "is missing (required for the beam model; or give 'influence_mm_per_N')")
+    positions = s.eccentric_positions
+    if len(positions) != discs:
+        raise _error(case, key + "eccentric_positions",
+                     f"must list {discs} positions (loads.discs), got {len(positions)}")
+    for i, x in enumerate(positions):
+        if not 0.0 < x < s.span:
+            raise _error(case, f"{key}eccentric_positions[{i}]",
+                         f"({x:g} mm) must lie strictly between the supports, in (0, {s.span:g}) mm (crank_support.span)")
+    if len(set(positions)) != len(positions):
+        raise _error(case, key + "eccentric_positions", f"must be distinct, got {list(positions)}")
+    if (s.journal_diameter is None) == (s.bending_stiffness_Nmm2 is None):
+        raise _error(case, key + "journal_diameter",
+                     "or 'bending_stiffness_Nmm2': give exactly one of them (or 'influence_mm_per_N' instead of the beam)")
+    if s.shear and s.journal_diameter is None:
+        raise _error(case, key + "shear", "= true needs 'journal_diameter' (the shear area); set shear = false "
+                                          "with bending_stiffness_Nmm2")
+    for name in ("support_stiffness_N_per_mm", "carrier_stiffness_N_per_mm"):
+        value = getattr(s, name)
+        if isinstance(value, tuple) and len(value) != 2:
+            raise _error(case, key + name, f"must be one number or a list of 2 (support 1, support 2), got {len(value)} values")
+
+
+def _positive_definite(matrix: tuple[tuple[float, ...], ...]) -> bool:
+    """Cholesky factorization succeeds (symmetric input)."""
+    n = len(matrix)
+    low = [[0.0] * n for _ in range(n)]
+    for i in range(n):
+        for j in range(i + 1):
+            s = matrix[i][j] - sum(low[i][k] * low[j][k] for k in range(j))
+            if i == j:
+                if not s > 0.0:
+                    return False
+                low[i][i] = math.sqrt(s)
+            else:
+                low[i][j] = s / low[j][j]
+    return True
+
+
+_CROSS_CHECKS = (_check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_holes, _check_loads,
+                 _check_mesh, _check_crank_support)
+
+
+# --------------------------------------------------------------------------------------------
+# Reading
+# --------------------------------------------------------------------------------------------
 
 
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
@@ -513,226 +810,19 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     CaseError
         With the file (``source``) and the dotted key of the first problem found.
     """
-    top = _Table(data, "", source)
-    name = top.get("name", "str", Path(source).stem if source.endswith(".toml") else "case")
-    description = top.get("description", "str", "")
+    return read_table(Case, data, "", source, extra={"source": source})
 
-    # cycloid ---------------------------------------------------------------------------------
-    t = top.sub("cycloid")
-    teeth = t.get("teeth", "int")
-    ecc = t.get("eccentricity", "float")
-    thick = t.get("thickness", "float")
-    hole = t.get("central_hole_radius", "float")
-    modification = _read_modification(t.sub("modification", required=False))
-    pitch_error = _read_pitch_error(t.sub("pitch_error", required=False), teeth)
-    t.finish()
-    _positive(t, "teeth", teeth)
-    for key, val in (("eccentricity", ecc), ("thickness", thick), ("central_hole_radius", hole)):
-        _positive(t, key, val)
-    cycloid = Cycloid(teeth, ecc, thick, hole, modification, pitch_error)
 
-    # pins ------------------------------------------------------------------------------------
-    t = top.sub("pins")
-    pins = Pins(
-        count=t.get("count", "int"),
-        circle_radius=t.get("circle_radius", "float"),
-        radius=t.get("radius", "float"),
-        model=t.get("model", "str", "rigid", choices=pin_model_names()),
-    )
-    t.finish()
-    for key in ("count", "circle_radius", "radius"):
-        _positive(t, key, getattr(pins, key))
-    if pins.count <= teeth:
-        raise t.error(
-            t.key("count"),
-            f"(Zp = {pins.count}) must exceed cycloid.teeth (Zc = {teeth}); "
-            "a cycloid drive needs more pins than lobes",
-        )
-    k = ecc * pins.count / pins.circle_radius
-    if k >= 1.0:
-        raise top.error(
-            "cycloid.eccentricity",
-            f"is too large: the short-amplitude coefficient k = e·Zp/Rp = {k:.3f} must be < 1 "
-            "(reduce the eccentricity or enlarge pins.circle_radius)",
-        )
-    if pins.radius >= pins.circle_radius * math.sin(math.pi / pins.count):
-        raise t.error(t.key("radius"), f"({pins.radius} mm) is too large: neighbouring pins overlap")
-
-    # cranks ----------------------------------------------------------------------------------
-    t = top.sub("cranks")
-    n = t.get("count", "int")
-    _positive(t, "count", n)
-    if n < 2:
-        raise t.error(t.key("count"), f"must be at least 2, got {n}")
-    r0 = t.get("circle_radius", "float")
-    _positive(t, "circle_radius", r0)
-    angles = t.get("angles_deg", "floats", tuple(90.0 + 360.0 * i / n for i in range(n)))
-    t.finish()
-    if len(angles) != n:
-        raise t.error(t.key("angles_deg"), f"must list {n} angles (cranks.count), got {len(angles)}")
-    cranks = Cranks(n, r0, angles)
-
-    # crank bearing ---------------------------------------------------------------------------
-    t = top.sub("crank_bearing")
-    bearing = CrankBearing(
-        rollers=t.get("rollers", "int"),
-        roller_diameter=t.get("roller_diameter", "float"),
-        roller_length=t.get("roller_length", "float"),
-        pitch_diameter=t.get("pitch_diameter", "float"),
-        bore_radius=t.get("bore_radius", "float"),
-        radial_clearance=t.get("radial_clearance", "float", 0.0),
-        b_m=t.get("b_m", "float", 1.1),
-        lambda_nu=t.get("lambda_nu", "float", 0.83),
-        model=t.get("model", "str", "rollers", choices=bearing_model_names()),
-        stiffness_law=t.get("stiffness_law", "str", "palmgren", choices=("palmgren", "linear")),
-        linear_stiffness_N_per_mm=t.get("linear_stiffness_N_per_mm", "float", None),
-        rigid_bore_stiffness_N_per_mm=t.get("rigid_bore_stiffness_N_per_mm", "float", 7.0e5),
-    )
-    t.finish()
-    for key in ("rollers", "roller_diameter", "roller_length", "pitch_diameter", "bore_radius",
-                "b_m", "lambda_nu", "rigid_bore_stiffness_N_per_mm"):
-        _positive(t, key, getattr(bearing, key))
-    _positive(t, "radial_clearance", bearing.radial_clearance, allow_zero=True)
-    _positive(t, "linear_stiffness_N_per_mm", bearing.linear_stiffness_N_per_mm)
-    if bearing.stiffness_law == "linear" and bearing.linear_stiffness_N_per_mm is None:
-        raise t.error(t.key("linear_stiffness_N_per_mm"), "is missing (required when stiffness_law = 'linear')")
-    if bearing.roller_diameter >= bearing.pitch_diameter:
-        raise t.error(t.key("roller_diameter"), "must be smaller than pitch_diameter")
-    gap = math.pi * bearing.pitch_diameter - bearing.rollers * bearing.roller_diameter
-    if gap <= 0:
-        raise t.error(
-            t.key("rollers"),
-            f": {bearing.rollers} rollers of {bearing.roller_diameter} mm do not fit the pitch circle "
-            f"of {bearing.pitch_diameter} mm (circumference {math.pi * bearing.pitch_diameter:.2f} mm)",
-        )
-    if bearing.bore_radius <= 0.5 * bearing.pitch_diameter:
-        raise t.error(
-            t.key("bore_radius"),
-            f"({bearing.bore_radius} mm) must exceed half the pitch diameter ({0.5 * bearing.pitch_diameter} mm)",
-        )
-
-    # holes -----------------------------------------------------------------------------------
-    fan = None
-    t = top.sub("fan_holes", required=False)
-    if t is not None:
-        fan = FanHoles(
-            inner_radius=t.get("inner_radius", "float"),
-            outer_radius=t.get("outer_radius", "float"),
-            count=t.get("count", "int", n),
-            span_deg=t.get("span_deg", "float", None),
-            ligament=t.get("ligament", "float", None),
-            fillet_radius=t.get("fillet_radius", "float", 1.0),
-            angle_offset_deg=t.get("angle_offset_deg", "float", None),
-        )
-        t.finish()
-        for key in ("inner_radius", "outer_radius", "count", "span_deg", "ligament"):
-            _positive(t, key, getattr(fan, key))
-        _positive(t, "fillet_radius", fan.fillet_radius, allow_zero=True)
-        if fan.outer_radius <= fan.inner_radius:
-            raise t.error(t.key("outer_radius"), "must exceed inner_radius")
-        if (fan.span_deg is None) == (fan.ligament is None):
-            raise t.error(t.key("span_deg"), "or 'ligament': give exactly one of them")
-        if fan.span_deg is not None and fan.span_deg * fan.count >= 360.0:
-            raise t.error(t.key("span_deg"), f"× count must stay below 360°, got {fan.span_deg * fan.count}°")
-    rnd = None
-    t = top.sub("round_holes", required=False)
-    if t is not None:
-        rnd = RoundHoles(
-            radius=t.get("radius", "float"),
-            circle_radius=t.get("circle_radius", "float"),
-            count=t.get("count", "int", n),
-            angle_offset_deg=t.get("angle_offset_deg", "float", None),
-        )
-        t.finish()
-        for key in ("radius", "circle_radius", "count"):
-            _positive(t, key, getattr(rnd, key))
-
-    # material --------------------------------------------------------------------------------
-    t = top.sub("material", required=False) or _Table({}, "material", source)
-    material = Material(
-        name=t.get("name", "str", "bearing steel"),
-        youngs_modulus=t.get("youngs_modulus", "float", 206000.0),
-        poissons_ratio=t.get("poissons_ratio", "float", 0.3),
-    )
-    t.finish()
-    _positive(t, "youngs_modulus", material.youngs_modulus)
-    if not 0.0 <= material.poissons_ratio < 0.5:
-        raise t.error(t.key("poissons_ratio"), f"must lie in [0, 0.5), got {material.poissons_ratio}")
-
-    # loads -----------------------------------------------------------------------------------
-    t = top.sub("loads")
-    rows = []
-    raw_rows = t.data.get("duty_cycle", [])
-    t.used.add("duty_cycle")
-    if not isinstance(raw_rows, list):
-        raise t.error(t.key("duty_cycle"), "must be an array of tables ([[loads.duty_cycle]])")
-    for i, raw in enumerate(raw_rows):
-        r = _Table(raw, f"{t.key('duty_cycle')}[{i}]", source)
-        row = DutyRow(r.get("time_share", "float"), r.get("speed_rpm", "float"), r.get("torque_Nm", "float"))
-        r.finish()
-        _positive(r, "time_share", row.time_share)
-        _positive(r, "speed_rpm", row.speed_rpm)
-        _positive(r, "torque_Nm", row.torque_Nm, allow_zero=True)
-        rows.append(row)
-    loads = Loads(
-        torque_Nm=t.get("torque_Nm", "float"),
-        speed_rpm=t.get("speed_rpm", "float"),
-        discs=t.get("discs", "int", 2),
-        duty_cycle=tuple(rows),
-    )
-    t.finish()
-    for key in ("torque_Nm", "speed_rpm", "discs"):
-        _positive(t, key, getattr(loads, key))
-
-    # analysis --------------------------------------------------------------------------------
-    t = top.sub("analysis", required=False) or _Table({}, "analysis", source)
-    analysis = Analysis(
-        equivalent_load_exponent=t.get("equivalent_load_exponent", "float", 10.0 / 3.0),
-        angle_step_deg=t.get("angle_step_deg", "float", 1.0),
-        element_order=t.get("element_order", "int", 1),
-        friction=t.get("friction", "float", 0.0),
-        max_active_set_iterations=t.get("max_active_set_iterations", "int", 50),
-        saved_angles_deg=t.get("saved_angles_deg", "floats", (0.0, 90.0, 180.0, 270.0)),
-    )
-    t.finish()
-    _positive(t, "equivalent_load_exponent", analysis.equivalent_load_exponent)
-    _positive(t, "angle_step_deg", analysis.angle_step_deg)
-    _positive(t, "friction", analysis.friction, allow_zero=True)
-    _positive(t, "max_active_set_iterations", analysis.max_active_set_iterations)
-    if analysis.element_order not in (1, 2):
-        raise t.error(t.key("element_order"), f"must be 1 (P1) or 2 (P2), got {analysis.element_order}")
-    if analysis.angle_step_deg > 30.0:
-        raise t.error(t.key("angle_step_deg"), f"must be at most 30°, got {analysis.angle_step_deg}")
-
-    # mesh ------------------------------------------------------------------------------------
-    t = top.sub("mesh", required=False) or _Table({}, "mesh", source)
-    mesh = MeshSettings(
-        size_flank=t.get("size_flank", "float", 0.4),
-        size_bore=t.get("size_bore", "float", 0.4),
-        size_interior=t.get("size_interior", "float", 2.5),
-        min_wall=t.get("min_wall", "float", 1.0),
-        size_hole=t.get("size_hole", "float", None),
-    )
-    t.finish()
-    for key in ("size_flank", "size_bore", "size_interior", "min_wall", "size_hole"):
-        _positive(t, key, getattr(mesh, key))
-
-    top.finish()
-    return Case(
-        name=name,
-        description=description,
-        cycloid=cycloid,
-        pins=pins,
-        cranks=cranks,
-        crank_bearing=bearing,
-        material=material,
-        loads=loads,
-        analysis=analysis,
-        mesh=mesh,
-        fan_holes=fan,
-        round_holes=rnd,
-        source=source,
-    )
+def table_class(dotted: str) -> type:
+    """The dataclass of the table at dotted key ``dotted`` ("" for the top level, e.g.
+    ``"cycloid.modification"``, ``"loads.duty_cycle"``)."""
+    cls: type = Case
+    for part in [p for p in dotted.split(".") if p]:
+        spec = {s.name: s for s in file_fields(cls)}.get(part)
+        if spec is None or spec.item is None:
+            raise KeyError(f"no table {dotted!r} in the case format")
+        cls = spec.item
+    return cls
 
 
 def parse_override(text: str) -> tuple[tuple[str, ...], Any]:

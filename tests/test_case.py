@@ -346,3 +346,309 @@ def test_case_from_dict_names_the_source():
     with pytest.raises(CaseError) as info:
         case_from_dict(data, source="study/variant_7.toml")
     assert str(info.value).startswith("study/variant_7.toml: 'pins.count'")
+
+
+# --------------------------------------------------------------------------------------------
+# one schema: order of the checks, generated docs, bounds on every number
+# --------------------------------------------------------------------------------------------
+
+import copy  # noqa: E402
+import dataclasses  # noqa: E402
+import re  # noqa: E402
+
+from rvfem import case as case_module  # noqa: E402
+from rvfem import registry  # noqa: E402
+from rvfem.case import CrankSupport, estimated_mesh_nodes, table_class  # noqa: E402
+from rvfem.schema import file_fields, render_case_format  # noqa: E402
+
+from conftest import ROOT  # noqa: E402
+
+
+def test_misspelled_required_key_is_unknown_not_missing(case_text, tmp_path):
+    case_text.drop("cycloid", "eccentricity").set("cycloid", "eccentricty", "1.3")
+    message = expect_error(tmp_path, case_text, "cycloid.eccentricty", "is not a known key",
+                           "did you mean 'cycloid.eccentricity'")
+    assert "missing" not in message
+
+
+def test_docs_tables_are_generated_from_the_schema():
+    path = ROOT / "docs" / "case-format.md"
+    text = path.read_text(encoding="utf-8")
+    assert render_case_format(text) == text, (
+        "docs/case-format.md is stale; regenerate it with: python -m rvfem.schema docs/case-format.md")
+
+
+def _all_tables(cls=Case, prefix=""):
+    yield prefix, cls
+    for spec in file_fields(cls):
+        if spec.item is not None:
+            yield from _all_tables(spec.item, f"{prefix}.{spec.name}".lstrip("."))
+
+
+def test_every_table_has_a_generated_section_in_the_docs():
+    text = (ROOT / "docs" / "case-format.md").read_text(encoding="utf-8")
+    for dotted, cls in _all_tables():
+        if any(spec.item is None for spec in file_fields(cls)):
+            assert f"<!-- schema: {dotted} -->" in text, dotted
+        assert table_class(dotted) is cls
+
+
+def test_every_number_and_string_is_bounded():
+    for dotted, cls in _all_tables():
+        for spec in file_fields(cls):
+            p = spec.param
+            if spec.kind in ("int", "float", "floats", "matrix", "float_or_floats"):
+                assert p.allowed() is not None or (p.low is not None and p.high is not None), f"{dotted}.{spec.name}"
+            if spec.kind in ("str", "floats", "matrix", "tables") and p.allowed() is None:
+                assert p.max_length is not None, f"{dotted}.{spec.name}"
+            assert p.doc or spec.kind in ("table", "tables"), f"{dotted}.{spec.name} has no meaning in the docs"
+
+
+def _numeric_keys(data, prefix=""):
+    for key, value in data.items():
+        dotted = f"{prefix}{key}"
+        if isinstance(value, dict):
+            yield from _numeric_keys(value, dotted + ".")
+        elif isinstance(value, float):
+            yield dotted
+
+
+FAN_DATA = case_to_dict(load_case(CASES_DIR / "rv40e_fanholes.toml"))
+
+
+def _with(data, dotted, value):
+    out = copy.deepcopy(data)
+    *tables, key = dotted.split(".")
+    table = out
+    for part in tables:
+        table = table[part]
+    table[key] = value
+    return out
+
+
+@pytest.mark.parametrize("dotted", sorted(_numeric_keys(FAN_DATA)))
+@pytest.mark.parametrize("value, pattern", [(math.nan, "must be finite, got nan"),
+                                            (math.inf, "must be finite, got inf"),
+                                            (-math.inf, "must be finite, got -inf"),
+                                            (1e300, "must (be at most|lie in) "),
+                                            (-1e300, "must be (positive|non-negative|at least)")])
+def test_every_number_rejects_non_finite_and_huge_values(dotted, value, pattern):
+    with pytest.raises(CaseError) as info:
+        case_from_dict(_with(FAN_DATA, dotted, value), source="x.toml")
+    message = str(info.value)
+    assert re.match(rf"x\.toml: '{re.escape(dotted)}' {pattern}", message), message
+
+
+@pytest.mark.parametrize("table, key, value, fragment", [
+    ("cranks", "count", "13", "must be at most 12"),
+    ("pins", "count", "500", "must be at most 200"),
+    ("analysis", "equivalent_load_exponent", "25.0", "must be at most 20"),
+    ("analysis", "equivalent_load_exponent", "0.5", "must be at least 1"),
+    ("analysis", "angle_step_deg", "1e-9", "must be at least 0.05°"),
+    ("loads", "torque_Nm", "1e9", "must be at most 1e+06 N·m"),
+    ("cycloid", "eccentricity", "5e-324", "must be at least 0.01 mm"),
+    ("", "name", '"' + "x" * 201 + '"', "at most 200 characters"),
+    ("crank_bearing", "b_m", "0.0", "must be positive"),
+])
+def test_ranges(case_text, tmp_path, table, key, value, fragment):
+    case_text.set(table, key, value)
+    expect_error(tmp_path, case_text, f"{table}.{key}".lstrip("."), fragment)
+
+
+def test_control_characters_in_keys_stay_on_one_line(case_text, tmp_path):
+    case_text.set("pins", '"col\\nour"', "1")
+    message = expect_error(tmp_path, case_text, "pins.col\\nour", "is not a known key")
+    assert "\n" not in message
+
+
+def test_bore_smaller_than_the_outer_raceway(case_text, tmp_path):
+    case_text.set("crank_bearing", "bore_radius", "17.0")    # (31 + 5)/2 = 18
+    expect_error(tmp_path, case_text, "crank_bearing.bore_radius", "outer raceway radius (D_m + D_we)/2 = 18 mm")
+
+
+def test_crank_angles_must_be_distinct(case_text, tmp_path):
+    case_text.set("cranks", "angles_deg", "[90, -270, 330]")
+    expect_error(tmp_path, case_text, "cranks.angles_deg", "must be distinct")
+
+
+def test_duty_cycle_needs_a_positive_torque(case_text, tmp_path):
+    case_text.append("[[loads.duty_cycle]]\ntime_share = 1.0\nspeed_rpm = 15.0\ntorque_Nm = 0.0")
+    expect_error(tmp_path, case_text, "loads.duty_cycle", "at least one row with a positive torque")
+
+
+def test_duty_cycle_torque_below_a_milli_newton_metre(case_text, tmp_path):
+    case_text.append("[[loads.duty_cycle]]\ntime_share = 1.0\nspeed_rpm = 15.0\ntorque_Nm = 1e-300")
+    expect_error(tmp_path, case_text, "loads.duty_cycle[0].torque_Nm", "must be 0 or at least 0.001 N·m")
+
+
+def test_bad_element_order_lists_the_orders(case_text, tmp_path):
+    case_text.set("analysis", "element_order", "0")
+    expect_error(tmp_path, case_text, "analysis.element_order", "must be 1 (P1) or 2 (P2), got 0")
+
+
+# --------------------------------------------------------------------------------------------
+# model names come from the registry at validation time
+# --------------------------------------------------------------------------------------------
+
+
+def test_a_model_registered_at_run_time_is_accepted(case_text, tmp_path, monkeypatch):
+    class SoftBearing:
+        name = "soft_test_bearing"
+
+    monkeypatch.setitem(registry._BEARINGS, SoftBearing.name, SoftBearing)
+    case_text.set("crank_bearing", "model", '"soft_test_bearing"')
+    assert load_case(case_text.write(tmp_path)).crank_bearing.model == "soft_test_bearing"
+
+
+# --------------------------------------------------------------------------------------------
+# mesh size: node estimate before meshing
+# --------------------------------------------------------------------------------------------
+
+
+def test_mesh_estimate_uses_the_mesher_size_field_constants():
+    from rvfem import mesh
+
+    assert case_module._MESH_SIZE_GROWTH == mesh.SIZE_GROWTH
+    assert case_module._MESH_BAND_FACTOR == mesh.BAND_FACTOR
+    assert case_module._MESH_HOLE_SIZE_FACTOR == mesh.HOLE_SIZE_FACTOR
+
+
+def test_mesh_estimate_scales_with_the_sizes():
+    case = load_case(CASES_DIR / "rv40e_fanholes.toml")
+    half = case.replace(mesh=dataclasses.replace(case.mesh, **{k: getattr(case.mesh, k) / 2 for k in (
+        "size_flank", "size_bore", "size_interior", "size_hole")}))
+    a, b = estimated_mesh_nodes(case), estimated_mesh_nodes(half)
+    assert b["mesh.size_interior"] == pytest.approx(4 * a["mesh.size_interior"], rel=1e-12)  # area/h²
+    for key in ("mesh.size_flank", "mesh.size_bore", "mesh.size_hole"):                    # length/h
+        assert b[key] == pytest.approx(2 * a[key], rel=1e-12)
+    # nodes per area of an equilateral triangulation: 2/(√3 h²); the interior term is exactly that
+    area = (math.pi * (64.0 - 3.0) ** 2 - math.pi * 12.0 ** 2 - 3 * math.pi * 18.0 ** 2)
+    assert a["mesh.size_interior"] == pytest.approx(2 / math.sqrt(3) * area / 2.5 ** 2, rel=1e-12)
+
+
+def test_too_fine_a_mesh_is_refused_before_meshing(case_text, tmp_path):
+    case_text.append("[mesh]\nsize_interior = 0.05")   # 2/√3·7200 mm²/(0.05 mm)² ≈ 3.3 million
+    message = expect_error(tmp_path, case_text, "mesh.size_interior", "too fine a mesh", "nodes estimated")
+    assert "2e+06" in message
+
+
+# --------------------------------------------------------------------------------------------
+# loads.torque_split
+# --------------------------------------------------------------------------------------------
+
+
+def test_torque_split_defaults_to_stiffness(case_text, tmp_path):
+    assert load_case(case_text.write(tmp_path)).loads.torque_split == "stiffness"
+
+
+def test_stiffness_split_needs_one_or_two_discs(case_text, tmp_path):
+    case_text.set("loads", "discs", "3")
+    expect_error(tmp_path, case_text, "loads.torque_split", "1 or 2 discs", "use 'equal'")
+    case_text.set("loads", "torque_split", '"equal"')
+    assert load_case(case_text.write(tmp_path)).loads.discs == 3
+
+
+def test_torque_split_choices(case_text, tmp_path):
+    case_text.set("loads", "torque_split", '"equl"')
+    expect_error(tmp_path, case_text, "loads.torque_split", "must be one of", "did you mean 'equal'")
+
+
+# --------------------------------------------------------------------------------------------
+# [crank_support]
+# --------------------------------------------------------------------------------------------
+
+BEAM = "[crank_support]\nspan = 60.0\neccentric_positions = [20.0, 40.0]\njournal_diameter = 25.0\n"
+
+
+def test_crank_support_beam_loads(case_text, tmp_path):
+    case_text.append(BEAM + "support_stiffness_N_per_mm = [3e5, 4e5]\ncarrier_stiffness_N_per_mm = 1e6")
+    s = load_case(case_text.write(tmp_path)).crank_support
+    assert (s.span, s.eccentric_positions, s.journal_diameter, s.youngs_modulus, s.shear) == (
+        60.0, (20.0, 40.0), 25.0, 206000.0, True)
+    assert s.support_stiffness_pair == (3e5, 4e5)
+    assert s.carrier_stiffness_pair == (1e6, 1e6)
+
+
+def test_crank_support_is_optional_and_pairs_default_to_none(case_text, tmp_path):
+    assert load_case(case_text.write(tmp_path)).crank_support is None
+    s = CrankSupport(span=60.0, eccentric_positions=(20.0, 40.0), journal_diameter=25.0)
+    assert s.support_stiffness_pair == (None, None) and s.carrier_stiffness_pair == (None, None)
+
+
+def test_crank_support_influence_matrix_loads(case_text, tmp_path):
+    case_text.append("[crank_support]\ninfluence_mm_per_N = [[2e-6, 1e-6], [1e-6, 2e-6]]")
+    s = load_case(case_text.write(tmp_path)).crank_support
+    assert s.influence_mm_per_N == ((2e-6, 1e-6), (1e-6, 2e-6)) and s.span is None
+
+
+@pytest.mark.parametrize("extra, key, fragment", [
+    ("", "crank_support.span", "is missing"),
+    ("span = 60.0\njournal_diameter = 25.0", "crank_support.eccentric_positions", "is missing"),
+    ("span = 60.0\neccentric_positions = [20.0]\njournal_diameter = 25.0", "crank_support.eccentric_positions",
+     "must list 2 positions"),
+    ("span = 60.0\neccentric_positions = [20.0, 60.0]\njournal_diameter = 25.0",
+     "crank_support.eccentric_positions[1]", "strictly between the supports"),
+    ("span = 60.0\neccentric_positions = [20.0, 20.0]\njournal_diameter = 25.0",
+     "crank_support.eccentric_positions", "must be distinct"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]", "crank_support.journal_diameter", "exactly one"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]\njournal_diameter = 25.0\nbending_stiffness_Nmm2 = 4e9",
+     "crank_support.journal_diameter", "exactly one"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]\nbending_stiffness_Nmm2 = 4e9",
+     "crank_support.shear", "needs 'journal_diameter'"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]\njournal_diameter = 25.0\n"
+     "support_stiffness_N_per_mm = [1e5, 1e5, 1e5]", "crank_support.support_stiffness_N_per_mm", "at most 2 values"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]\njournal_diameter = 25.0\n"
+     "carrier_stiffness_N_per_mm = [1e5]", "crank_support.carrier_stiffness_N_per_mm", "list of 2"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]\njournal_diameter = 25.0\n"
+     "support_stiffness_N_per_mm = 0.0", "crank_support.support_stiffness_N_per_mm", "must be positive"),
+    ("span = 60.0\neccentric_positions = [20.0, 40.0]\njournal_diameter = 25.0\nshear = 1",
+     "crank_support.shear", "must be true or false"),
+    ("influence_mm_per_N = [[2e-6, 1e-6], [0.0, 2e-6]]", "crank_support.influence_mm_per_N", "must be symmetric"),
+    ("influence_mm_per_N = [[1e-6, 2e-6], [2e-6, 1e-6]]", "crank_support.influence_mm_per_N",
+     "must be positive definite"),
+    ("influence_mm_per_N = [[1e-6]]", "crank_support.influence_mm_per_N", "must be a 2×2 matrix"),
+    ("influence_mm_per_N = [1e-6, 1e-6]", "crank_support.influence_mm_per_N", "list of lists"),
+    ("influence_mm_per_N = [[2e-6, 1e-6], [1e-6, 2e-6]]\nspan = 60.0", "crank_support.span", "exclude each other"),
+    ("influence_mm_per_N = [[2e-6, 1e-6], [1e-6, 2e-6]]\nshear = false", "crank_support.shear",
+     "only applies to the beam model"),
+    ("spn = 60.0", "crank_support.spn", "did you mean 'crank_support.span'"),
+])
+def test_crank_support_errors(case_text, tmp_path, extra, key, fragment):
+    case_text.append("[crank_support]\n" + extra)
+    expect_error(tmp_path, case_text, key, fragment)
+
+
+# --------------------------------------------------------------------------------------------
+# cases built in code are validated like files
+# --------------------------------------------------------------------------------------------
+
+
+def test_case_built_in_code_is_validated_and_normalized():
+    case = load_case(CASES_DIR / "rv40e.toml")
+    fields = {f.name: getattr(case, f.name) for f in dataclasses.fields(case) if f.name not in ("source",)}
+    with pytest.raises(CaseError, match=r"^<code>: 'pins.radius' must be finite"):
+        Case(**{**fields, "pins": dataclasses.replace(case.pins, radius=math.nan)})
+    with pytest.raises(CaseError, match=r"^<code>: 'cycloid.teeth' must be an integer"):
+        Case(**{**fields, "cycloid": dataclasses.replace(case.cycloid, teeth=39.0)})
+    with pytest.raises(CaseError, match=r"'loads.torque_split'"):
+        dataclasses.replace(case, loads=dataclasses.replace(case.loads, discs=4))
+    same = Case(**{**fields, "cycloid": dataclasses.replace(case.cycloid, thickness=9, central_hole_radius=12)})
+    assert same == case and isinstance(same.cycloid.thickness, float)
+    assert same.digest() == case.digest()
+
+
+def test_overrides_are_validated_like_the_file(tmp_path):
+    path = CASES_DIR / "rv40e_fanholes.toml"
+    case = load_case(path, overrides=("fan_holes.ligament=4.0", "loads.torque_split=equal"))
+    assert case.fan_holes.ligament == 4.0 and case.loads.torque_split == "equal"
+    assert case.overrides == ("fan_holes.ligament=4.0", "loads.torque_split=equal")
+    with pytest.raises(CaseError, match="did you mean 'fan_holes.ligament'"):
+        load_case(path, overrides=("fan_holes.ligamnt=4.0",))
+    with pytest.raises(CaseError, match="'fan_holes.ligament' must be finite"):
+        load_case(path, overrides=("fan_holes.ligament=nan",))
+
+
+def test_p2_mesh_estimate_counts_edge_nodes(case_text, tmp_path):
+    p1 = load_case(case_text.write(tmp_path))
+    p2 = load_case(case_text.set("analysis", "element_order", "2").write(tmp_path))
+    assert estimated_mesh_nodes(p2)["total"] == pytest.approx(4 * estimated_mesh_nodes(p1)["total"], rel=1e-12)
