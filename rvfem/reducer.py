@@ -141,7 +141,7 @@ def crankshaft_influence(case) -> np.ndarray | None:
     κ = 6(1 + ν)/(7 + 6ν) when ``shear`` is on), on supports of compliance
     1/k_support + 1/k_carrier per side.
     """
-    cs = getattr(case, "crank_support", None)
+    cs = case.crank_support
     if cs is None:
         return None
     if cs.influence_mm_per_N is not None:
@@ -158,7 +158,7 @@ def crankshaft_influence(case) -> np.ndarray | None:
             shear = kappa * E / (2.0 * (1.0 + nu)) * math.pi * d * d / 4.0
     ks = cs.support_stiffness_pair
     kc = cs.carrier_stiffness_pair
-    compliance = tuple(1.0 / ks[i] + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    compliance = tuple((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
     return beam_influence(cs.span, cs.eccentric_positions, EI, shear, compliance)
 
 
@@ -246,7 +246,8 @@ def build_stage(system, *, discs: int | None = None, second=None, second_disc: s
         Disc A.
     discs : {1, 2}, optional
         1: one disc with the equal torque share T_out/discs; 2: both discs on one carrier.
-        Default from the case (``loads.discs`` and ``loads.torque_split``).
+        Default from the case (``loads.discs`` and ``loads.torque_split``): with
+        ``torque_split = "equal"`` one disc on rigid eccentrics (``[crank_support]`` unused).
     second : rvfem.cycle.DiscSystem, optional
         Disc B's model for ``second_disc = "half_pitch"``: the case with its cranks and holes turned
         by −β (:func:`half_pitch_case`), meshed and built like disc A.
@@ -256,11 +257,13 @@ def build_stage(system, *, discs: int | None = None, second=None, second_disc: s
         ``[crank_support]``.
     """
     case = system.case
+    equal_split = case.loads.discs > 1 and case.loads.torque_split == "equal"
     if discs is None:
-        split = getattr(case.loads, "torque_split", "stiffness")
-        discs = 2 if (case.loads.discs == 2 and split == "stiffness") else 1
+        discs = 1 if equal_split or case.loads.discs == 1 else 2
     if isinstance(influence, str):
-        influence = crankshaft_influence(case)
+        # the equal split is rvfem 0.1's and the handbook's model: one disc with T/discs on rigid
+        # eccentrics; [crank_support] belongs to the two-disc stage
+        influence = None if (discs == 1 and equal_split) else crankshaft_influence(case)
     torque = case.loads.torque_Nm * 1000.0
     if discs == 1:
         f = None if influence is None else np.asarray(influence, dtype=float)[:1, :1]
@@ -572,6 +575,5 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     steps.append(AttributionStep("equal_share", STEP_LABELS["equal_share"], share))
     for key in need:
         steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
-    split = getattr(case.loads, "torque_split", "stiffness")
-    final = need[-1] if split == "stiffness" or case.loads.discs == 1 else "one_disc"
+    final = need[-1] if case.loads.torque_split == "stiffness" or case.loads.discs == 1 else "one_disc"
     return Attribution(np.asarray(thetas), tuple(steps), final)
