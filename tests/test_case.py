@@ -545,6 +545,7 @@ def test_stiffness_split_needs_one_or_two_discs(case_text, tmp_path):
     case_text.set("loads", "discs", "3")
     expect_error(tmp_path, case_text, "loads.torque_split", "1 or 2 discs", "use 'equal'")
     case_text.set("loads", "torque_split", '"equal"')
+    case_text.drop_table("crank_support")      # its eccentric positions are those of two discs
     assert load_case(case_text.write(tmp_path)).loads.discs == 3
 
 
@@ -561,6 +562,7 @@ BEAM = "[crank_support]\nspan = 60.0\neccentric_positions = [20.0, 40.0]\njourna
 
 
 def test_crank_support_beam_loads(case_text, tmp_path):
+    case_text.drop_table("crank_support")    # the shipped case has one
     case_text.append(BEAM + "support_stiffness_N_per_mm = [3e5, 4e5]\ncarrier_stiffness_N_per_mm = 1e6")
     s = load_case(case_text.write(tmp_path)).crank_support
     assert (s.span, s.eccentric_positions, s.journal_diameter, s.youngs_modulus, s.shear) == (
@@ -570,12 +572,14 @@ def test_crank_support_beam_loads(case_text, tmp_path):
 
 
 def test_crank_support_is_optional_and_pairs_default_to_none(case_text, tmp_path):
+    case_text.drop_table("crank_support")    # the shipped case has one
     assert load_case(case_text.write(tmp_path)).crank_support is None
     s = CrankSupport(span=60.0, eccentric_positions=(20.0, 40.0), journal_diameter=25.0)
     assert s.support_stiffness_pair == (None, None) and s.carrier_stiffness_pair == (None, None)
 
 
 def test_crank_support_influence_matrix_loads(case_text, tmp_path):
+    case_text.drop_table("crank_support")    # the shipped case has one
     case_text.append("[crank_support]\ninfluence_mm_per_N = [[2e-6, 1e-6], [1e-6, 2e-6]]")
     s = load_case(case_text.write(tmp_path)).crank_support
     assert s.influence_mm_per_N == ((2e-6, 1e-6), (1e-6, 2e-6)) and s.span is None
@@ -614,6 +618,7 @@ def test_crank_support_influence_matrix_loads(case_text, tmp_path):
     ("spn = 60.0", "crank_support.spn", "did you mean 'crank_support.span'"),
 ])
 def test_crank_support_errors(case_text, tmp_path, extra, key, fragment):
+    case_text.drop_table("crank_support")    # the shipped case has one
     case_text.append("[crank_support]\n" + extra)
     expect_error(tmp_path, case_text, key, fragment)
 
