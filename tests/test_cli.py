@@ -213,3 +213,28 @@ def test_json_output_is_strict_json_with_null_for_non_finite(monkeypatch, capsys
     assert report["bearings"][0]["L10h_h"] is None and report["bearings"][1]["L10h_h"] > 0
     assert cli.main(["rigid", CRV80E]) == 0
     assert "      –" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("tty", [True, False])
+def test_run_progress_draws_stages_and_the_cycle(tty):
+    """The progress display of ``rvfem run`` (a tqdm bar on a terminal, plain lines otherwise)."""
+    import io
+
+    from rvfem.run import STAGES
+
+    stream = io.StringIO()
+    progress = cli._RunProgress(stream, tty)
+    for stage in STAGES:
+        total = 36 if stage in ("cycle", "images") else 1
+        progress(stage, 0, total)
+        for done in range(1, total):
+            progress(stage, done, total)
+        progress(stage, total, total)
+    progress.close()
+    text = stream.getvalue()
+    assert text.count("done in") == len(STAGES)
+    assert f"[{len(STAGES)}/{len(STAGES)}] writing the report: done in" in text
+    if tty:
+        assert "flexible load cycle:   0%" in text and "/36" in text          # the tqdm bar of the cycle
+    else:
+        assert "rvfem run: cycle 36/36" not in text and "cycle 18/36 angles (50 %)" in text
