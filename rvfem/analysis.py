@@ -29,13 +29,20 @@ import time
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
 from . import hertz, iso281, rigid
 from .case import Case, apply_overrides, case_to_dict, file_sha256, load_case, parse_override
 from .errors import CaseError
+
+if TYPE_CHECKING:  # the heavier modules are imported where used
+    from .compare import Comparison
+    from .cycle import CycleResult, DiscSystem
+    from .geometry import DiscGeometry
+    from .mesh import DiscMesh
+    from .postprocess import FieldSnapshot, PeakStress
 
 log = logging.getLogger(__name__)
 
@@ -416,10 +423,10 @@ class StressResult:
         Largest element (not averaged) von Mises stress over the kept fields, MPa.
     """
 
-    peak: Any
-    away_from_contacts: Any
-    band_mm: dict
-    snapshots: tuple
+    peak: PeakStress
+    away_from_contacts: PeakStress | None
+    band_mm: dict[str, float]
+    snapshots: tuple[FieldSnapshot, ...]
     peak_element_von_mises_MPa: float
 
 
@@ -469,16 +476,16 @@ class Analysis:
 
     case: Case
     provenance: CaseProvenance
-    geometry: Any
-    mesh: Any
-    system: Any
+    geometry: DiscGeometry
+    mesh: DiscMesh
+    system: DiscSystem
     theta: np.ndarray
     rigid: RigidAnalysis
     classical: rigid.PinForces
-    cycle: Any
-    comparison: Any
+    cycle: CycleResult
+    comparison: Comparison
     stress: StressResult
-    hertz: dict
+    hertz: dict[str, hertz.RollerHertz]
     torsional_stiffness_Nm_per_arcmin: float
     duty_cycle: DutyCycleResult | None = None
     timings: dict = field(default_factory=dict)
