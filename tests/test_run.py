@@ -402,6 +402,15 @@ def test_bad_step_is_a_case_error(coarse_case_file, tmp_path, capsys):
     assert "angle step" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("value", ["0", "-10", "400"])
+def test_bad_field_step_is_one_line_and_leaves_nothing(coarse_case_file, tmp_path, capsys, value):
+    assert cli.main(["run", str(coarse_case_file), "-o", str(tmp_path / "o"), "--no-images",
+                     "--field-step", value]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "field step" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_p2_fields_are_written_on_the_linear_mesh(coarse_case_file, cache_dir, tmp_path):
     result = run_case(coarse_case_file, tmp_path / "p2", order=2, angle_step_deg=30.0, cache_dir=cache_dir,
                       images=False)
