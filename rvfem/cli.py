@@ -172,6 +172,7 @@ class _RunProgress:
         self.names, self.descriptions = list(STAGES), STAGES
         self.started: dict[str, float] = {}
         self.bar = None
+        self.pending = ""  # a status line drawn on a terminal, not yet ended
         self.last_tenth = -1
 
     def _head(self, stage: str) -> str:
@@ -191,13 +192,21 @@ class _RunProgress:
 
                 self.bar = tqdm(total=total, desc=self._head(stage), file=self.stream, leave=False,
                                 unit="angle" if stage == "cycle" else "file", dynamic_ncols=True)
-            elif not self.tty and stage == "cycle":
+            elif self.tty:  # a status line, replaced when the stage ends
+                self.pending = f"{self._head(stage)} …"
+                self.stream.write(self.pending)
+                self.stream.flush()
+            elif stage == "cycle":
                 self.stream.write(f"{self._head(stage)}: {total} crank angles\n")
             return
         elapsed = now - self.started.get(stage, now)
         if done >= total:
+            line = f"{self._head(stage)}: done in {elapsed:.1f} s"
+            if self.pending:
+                line = "\r" + line.ljust(len(self.pending))
+                self.pending = ""
             self.close()
-            self.stream.write(f"{self._head(stage)}: done in {elapsed:.1f} s\n")
+            self.stream.write(line + "\n")
             self.stream.flush()
             return
         if self.bar is not None:
@@ -211,10 +220,15 @@ class _RunProgress:
                     self.stream.flush()
 
     def close(self) -> None:
-        """Remove a bar still drawn (at the end of a stage, or before an error message)."""
+        """Remove a bar still drawn and end a status line (at the end of a stage, or before an
+        error message)."""
         if self.bar is not None:
             self.bar.close()
             self.bar = None
+        if self.pending:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.pending = ""
 
 
 def _run_run(args: argparse.Namespace) -> int:
