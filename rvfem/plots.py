@@ -231,6 +231,6 @@ def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
     axes[0].set_title(title)
     if subtitle:
         fig.suptitle(subtitle)
-    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.tight_layout(rect=(0, 0, 1, 0.95 if subtitle else 1.0))
     fig.savefig(path, dpi=dpi)
     return path
