@@ -1,8 +1,10 @@
 """Command line: ``rvfem <subcommand> ...``.
 
-Only this module prints. Library code raises :class:`~rvfem.errors.RvfemError` subclasses for
-anything a user can cause; :func:`main` turns them into one line on stderr and exit code 2.
-Anything else is a bug and keeps its traceback. Ctrl-C exits with 130.
+This module parses arguments and prints; the computing is in :mod:`rvfem.analysis` and the
+formatting in :mod:`rvfem.outputs`. Library code raises :class:`~rvfem.errors.RvfemError`
+subclasses for anything a user can cause; :func:`main` turns them into one line on stderr and exit
+code 2. Anything else is a bug: one line on stderr asking to report it, with the path of a log file
+holding the traceback (shown on stderr too with ``-vv``), and exit code 1. Ctrl-C exits with 130.
 
 Adding a subcommand: write ``_add_<name>_arguments(parser)`` and ``_run_<name>(args) -> int`` and
 append one :class:`Subcommand` to :data:`SUBCOMMANDS`.
@@ -13,29 +15,22 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import math
 import os
 import sys
-from dataclasses import asdict, dataclass
+import tempfile
+import traceback
+from dataclasses import dataclass
 from typing import Callable, TextIO
 
 from . import __version__
 from .case import Case, load_case
 from .errors import RvfemError
-from .evaluation import (
-    STRIBECK_FACTOR,
-    bearing_speed_rpm,
-    crank_bearing_hertz,
-    crank_bearing_rating,
-    duty_cycle_life,
-    rating_life_hours,
-    stribeck_max_roller_load,
-)
-from .rigid import handbook_bearing_loads, summarize_bearing_loads
 
-__all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_USER_ERROR", "EXIT_INTERRUPTED"]
+__all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_INTERNAL_ERROR",
+           "EXIT_USER_ERROR", "EXIT_INTERRUPTED"]
 
 EXIT_OK = 0
+EXIT_INTERNAL_ERROR = 1
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
 EXIT_BROKEN_PIPE = 141
@@ -58,13 +53,25 @@ class Subcommand:
 # --------------------------------------------------------------------------------------------
 
 
-def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
+def _add_case_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", help="case file (TOML)")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a case key, e.g. --set fan_holes.ligament=4.0 (repeatable; the value "
+                             "is a TOML literal, checked like the file)")
+
+
+def _load(args: argparse.Namespace) -> Case:
+    return load_case(args.case, overrides=tuple(args.set))
+
+
+def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
+    _add_case_argument(parser)
 
 
 def _run_check(args: argparse.Namespace) -> int:
-    case = load_case(args.case)
-    print(f"OK: case '{case.name}' ({args.case}) is valid")
+    case = _load(args)
+    given = f" with {', '.join(case.overrides)}" if case.overrides else ""
+    print(f"OK: case '{case.name}' ({args.case}){given} is valid")
     return EXIT_OK
 
 
@@ -74,116 +81,20 @@ def _run_check(args: argparse.Namespace) -> int:
 
 
 def _add_rigid_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("case", help="case file (TOML)")
-    parser.add_argument("--json", action="store_true", help="write the results as JSON to stdout")
-
-
-def rigid_report(case: Case) -> dict:
-    """Results of the rigid handbook evaluation of a case as a JSON-ready dict.
-
-    Loads in N, angles in degrees, speeds in rpm, lives in hours, pressures in MPa, lengths in mm.
-    """
-    loads = handbook_bearing_loads(case)
-    exponent = case.analysis.equivalent_load_exponent
-    summaries = summarize_bearing_loads(loads, exponent)
-    n_b = bearing_speed_rpm(case.loads.speed_rpm, case.pins.count, case.cycloid.teeth)
-    rating = crank_bearing_rating(case.crank_bearing)
-    mat = case.material
-    bearings = []
-    for s in summaries:
-        inner, outer = crank_bearing_hertz(
-            case.crank_bearing, s.max_N, youngs_modulus_MPa=mat.youngs_modulus, poissons_ratio=mat.poissons_ratio
-        )
-        life = rating_life_hours(rating, s.equivalent_N, n_b)
-        entry = {
-            "bearing": s.bearing + 1,
-            "crank_angle_deg": case.cranks.angles_deg[s.bearing],
-            "max_load_N": s.max_N,
-            "max_at_deg": s.max_at_deg,
-            "min_load_N": s.min_N,
-            "min_at_deg": s.min_at_deg,
-            "equivalent_load_N": s.equivalent_N,
-            "L10h_h": life,
-            "max_roller_load_N": stribeck_max_roller_load(s.max_N, case.crank_bearing.rollers),
-            "hertz_inner": asdict(inner),
-            "hertz_outer": asdict(outer),
-        }
-        bearings.append(entry)
-    comp = loads.components
-    report = {
-        "case": case.name,
-        "source": case.source,
-        "model": "rigid handbook (equal load sharing, zero clearance)",
-        "output_torque_Nm": case.loads.torque_Nm,
-        "disc_torque_Nmm": comp.disc_torque_Nmm,
-        "output_speed_rpm": case.loads.speed_rpm,
-        "bearing_speed_rpm": n_b,
-        "k": comp.k,
-        "k_y": comp.k_y,
-        "sum_px_N": comp.sum_px,
-        "sum_py_N": comp.sum_py,
-        "equivalent_load_exponent": exponent,
-        "angle_step_deg": 360.0 / loads.theta.size,
-        "dynamic_load_rating_N": rating,
-        "stribeck_factor": STRIBECK_FACTOR,
-        "bearings": bearings,
-    }
-    if case.loads.duty_cycle:
-        rated_life = min(b["L10h_h"] for b in bearings)
-        duty = duty_cycle_life(case.loads.duty_cycle, rated_life, case.loads.speed_rpm, case.loads.torque_Nm)
-        report["duty_cycle"] = {"rated_life_h": rated_life, **asdict(duty)}
-    return report
-
-
-def _format_rigid(report: dict, out: TextIO) -> None:
-    p = report["equivalent_load_exponent"]
-    p_text = "10/3" if math.isclose(p, 10.0 / 3.0) else f"{p:g}"
-    w = out.write
-    w(f"Case {report['case']} ({report['source']}): {report['model']}\n")
-    w(
-        f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {report['disc_torque_Nmm'] / 1000:g} N·m, "
-        f"output speed {report['output_speed_rpm']:g} rpm, bearing speed {report['bearing_speed_rpm']:g} rpm\n"
-    )
-    w(
-        f"  k = {report['k']:.4f}, k_y = {report['k_y']:.4f}, ΣPx = {report['sum_px_N']:.1f} N, "
-        f"ΣPy = {report['sum_py_N']:.1f} N, crank-angle step {report['angle_step_deg']:g}°\n"
-    )
-    w(f"  dynamic load rating C = {report['dynamic_load_rating_N']:.1f} N; equivalent load exponent p = {p_text}\n\n")
-    header = (
-        f"{'bearing':>7} {'max N':>9} {'at °':>6} {'min N':>9} {'at °':>6} {'F_m N':>9} "
-        f"{'L10h h':>9} {'Q_max N':>8} {'p_in MPa':>9} {'p_out MPa':>9}\n"
-    )
-    w(header)
-    w("-" * (len(header) - 1) + "\n")
-    for b in report["bearings"]:
-        w(
-            f"{b['bearing']:>7d} {b['max_load_N']:9.1f} {b['max_at_deg']:6.1f} {b['min_load_N']:9.1f} "
-            f"{b['min_at_deg']:6.1f} {b['equivalent_load_N']:9.1f} {b['L10h_h']:9.0f} "
-            f"{b['max_roller_load_N']:8.1f} {b['hertz_inner']['peak_pressure_MPa']:9.1f} "
-            f"{b['hertz_outer']['peak_pressure_MPa']:9.1f}\n"
-        )
-    w(
-        "\n  at °: crank angle θ of the eccentric relative to the carrier; F_m = (mean F^p)^(1/p) over a turn\n"
-        f"  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Hertz at Q_max = {report['stribeck_factor']:g}·F_max/Z "
-        "(p_in: eccentric, p_out: disc bore)\n"
-    )
-    duty = report.get("duty_cycle")
-    if duty:
-        w(
-            f"  duty cycle: equivalent torque {duty['equivalent_torque_Nm']:.1f} N·m, equivalent speed "
-            f"{duty['equivalent_speed_rpm']:.2f} rpm, service life {duty['service_life_h']:.0f} h "
-            f"(from the shortest rated life {duty['rated_life_h']:.0f} h)\n"
-        )
+    _add_case_argument(parser)
+    parser.add_argument("--json", action="store_true", help="write the results as JSON to stdout "
+                        "(non-finite numbers as null)")
 
 
 def _run_rigid(args: argparse.Namespace) -> int:
-    case = load_case(args.case)
-    report = rigid_report(case)
+    from .analysis import analyse_rigid
+    from .outputs import rigid_summary, rigid_text
+
+    report = rigid_summary(analyse_rigid(_load(args)))
     if args.json:
-        json.dump(report, sys.stdout, indent=2, allow_nan=False)
-        sys.stdout.write("\n")
+        print(json.dumps(report, indent=2, allow_nan=False))
     else:
-        _format_rigid(report, sys.stdout)
+        print(rigid_text(report))
     return EXIT_OK
 
 
@@ -193,7 +104,7 @@ def _run_rigid(args: argparse.Namespace) -> int:
 
 
 def _add_mesh_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("case", help="case file (TOML)")
+    _add_case_argument(parser)
     parser.add_argument("--cache-dir", default="meshes",
                         help="directory of cached meshes and previews (default: meshes)")
     parser.add_argument("--force", action="store_true", help="re-mesh even if a cached mesh exists")
@@ -205,7 +116,7 @@ def _run_mesh(args: argparse.Namespace) -> int:
     from .geometry import disc_geometry
     from .mesh import mesh_case, mesh_preview_png
 
-    case = load_case(args.case)
+    case = _load(args)
     start = time.perf_counter()
     geom = disc_geometry(case)
     mesh = mesh_case(case, args.cache_dir, use_cache=not args.force, geometry=geom)
@@ -228,13 +139,15 @@ def _run_mesh(args: argparse.Namespace) -> int:
 
 
 def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("case", help="case file (TOML)")
+    from .registry import bearing_model_names
+
+    _add_case_argument(parser)
     parser.add_argument("-o", "--output", metavar="DIR",
                         help="result folder (default: results/<case name>); must not exist or be empty "
                              "unless --overwrite")
     parser.add_argument("--step", type=float, metavar="DEG", help="crank-angle step in degrees (overrides "
                         "analysis.angle_step_deg)")
-    parser.add_argument("--bearing-model", choices=("rollers", "rigid_bore"),
+    parser.add_argument("--bearing-model", choices=bearing_model_names(),
                         help="crank-bearing model (overrides crank_bearing.model)")
     parser.add_argument("--order", type=int, choices=(1, 2), help="element order (overrides analysis.element_order)")
     parser.add_argument("--overwrite", action="store_true",
@@ -242,84 +155,80 @@ def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--field-step", type=float, metavar="DEG",
                         help="also keep stress fields (VTU frames) every DEG degrees; default: the case's "
                              "saved angles and the angle of the largest bearing load")
-    parser.add_argument("--no-images", action="store_true", help="skip the PyVista stress and mesh images")
+    parser.add_argument("--no-images", action="store_true", help="skip the PyVista stress images")
     parser.add_argument("--cache-dir", default="meshes", help="directory of cached meshes (default: meshes)")
 
 
 class _RunProgress:
-    """Progress of ``rvfem run`` on stderr: a redrawn status line with a bar for the load cycle on a
-    terminal, plain log lines otherwise."""
+    """Progress of ``rvfem run`` on stderr: a tqdm bar for the load cycle and the images on a
+    terminal, plain lines otherwise (one per stage, and every tenth of the cycle)."""
 
-    BAR = 30
+    BAR_STAGES = ("cycle", "vtk", "images")
 
     def __init__(self, stream: TextIO, tty: bool):
         from .run import STAGES
 
-        self.stream, self.tty, self.stages = stream, tty, list(STAGES)
-        self.descriptions = STAGES
+        self.stream, self.tty = stream, tty
+        self.names, self.descriptions = list(STAGES), STAGES
         self.started: dict[str, float] = {}
-        self.first_tick: dict[str, tuple[float, int]] = {}  # (time, angles done) of the first tick
-        self.last_draw = 0.0
+        self.bar = None
+        self.pending = ""  # a status line drawn on a terminal, not yet ended
         self.last_tenth = -1
-        self.width = 0
 
-    def _line(self, text: str, final: bool = False) -> None:
-        if self.tty:
-            pad = max(0, self.width - len(text))
-            self.stream.write("\r" + text + " " * pad + ("\n" if final else ""))
-            self.width = 0 if final else len(text)
-        elif final:
-            self.stream.write(text + "\n")
-        self.stream.flush()
+    def _head(self, stage: str) -> str:
+        index = self.names.index(stage) + 1 if stage in self.names else 0
+        return f"rvfem run [{index}/{len(self.names)}] {self.descriptions.get(stage, stage)}"
 
     def __call__(self, stage: str, done: int, total: int) -> None:
         import time
 
         now = time.perf_counter()
-        index = self.stages.index(stage) + 1 if stage in self.stages else 0
-        head = f"rvfem run [{index}/{len(self.stages)}] {self.descriptions.get(stage, stage)}"
         if done == 0:
+            self.close()
             self.started[stage] = now
-            self.first_tick.pop(stage, None)
             self.last_tenth = -1
-            if self.tty:
-                self._line(head + " …")
+            if self.tty and stage in self.BAR_STAGES and total > 1:
+                from tqdm import tqdm
+
+                self.bar = tqdm(total=total, desc=self._head(stage), file=self.stream, leave=False,
+                                unit="angle" if stage == "cycle" else "file", dynamic_ncols=True)
+            elif self.tty:  # a status line, replaced when the stage ends
+                self.pending = f"{self._head(stage)} …"
+                self.stream.write(self.pending)
+                self.stream.flush()
             elif stage == "cycle":
-                self._line(f"{head}: {total} crank angles", final=True)
+                self.stream.write(f"{self._head(stage)}: {total} crank angles\n")
             return
         elapsed = now - self.started.get(stage, now)
         if done >= total:
-            self._line(f"{head}: done in {elapsed:.1f} s", final=True)
+            line = f"{self._head(stage)}: done in {elapsed:.1f} s"
+            if self.pending:
+                line = "\r" + line.ljust(len(self.pending))
+                self.pending = ""
+            self.close()
+            self.stream.write(line + "\n")
+            self.stream.flush()
             return
-        if stage != "cycle":
-            return
-        if self.tty:
-            self.first_tick.setdefault(stage, (now, done))
-            if now - self.last_draw < 0.1:
-                return
-            self.last_draw = now
-            filled = int(self.BAR * done / total)
-            # the first angle also computes the interface compliance the whole cycle reuses:
-            # estimate the rate from the angles after it
-            t_first, d_first = self.first_tick.setdefault(stage, (now, done))
-            rate = (now - t_first) / (done - d_first) if done > d_first else None
-            left = "" if rate is None else f", about {rate * (total - done):.0f} s left"
-            self._line(f"{head} [{'#' * filled}{'.' * (self.BAR - filled)}] {done}/{total}, "
-                       f"{elapsed:.1f} s{left}")
-        else:
+        if self.bar is not None:
+            self.bar.update(done - self.bar.n)
+        elif not self.tty and stage == "cycle":
             tenth = 10 * done // total
             if tenth > self.last_tenth:
                 self.last_tenth = tenth
                 if tenth > 0:
-                    self._line(f"rvfem run: cycle {done}/{total} angles ({10 * tenth} %), {elapsed:.1f} s",
-                               final=True)
+                    self.stream.write(f"rvfem run: cycle {done}/{total} angles ({10 * tenth} %), {elapsed:.1f} s\n")
+                    self.stream.flush()
 
-    def abort(self) -> None:
-        """End a half-drawn status line (before an error message)."""
-        if self.tty and self.width:
+    def close(self) -> None:
+        """Remove a bar still drawn and end a status line (at the end of a stage, or before an
+        error message)."""
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+        if self.pending:
             self.stream.write("\n")
             self.stream.flush()
-            self.width = 0
+            self.pending = ""
 
 
 def _run_run(args: argparse.Namespace) -> int:
@@ -327,16 +236,15 @@ def _run_run(args: argparse.Namespace) -> int:
 
     from .run import run_case, summary_text
 
-    case = load_case(args.case)
+    case = _load(args)
     out_dir = Path(args.output) if args.output else Path("results") / case.name
     progress = _RunProgress(sys.stderr, sys.stderr.isatty())
     try:
         result = run_case(case, out_dir, angle_step_deg=args.step, bearing_model=args.bearing_model,
                           order=args.order, overwrite=args.overwrite, progress=progress,
                           cache_dir=args.cache_dir, images=not args.no_images, field_step_deg=args.field_step)
-    except BaseException:
-        progress.abort()
-        raise
+    finally:
+        progress.close()
     print(summary_text(result.summary))
     print(f"  results: {result.out_dir}/ (summary.json, report.html; schema in docs/outputs.md)")
     return EXIT_OK
@@ -379,9 +287,22 @@ def _setup_logging(verbosity: int) -> None:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr, force=True)
 
 
+def _write_crash_log(command: str, argv: list[str] | None) -> str:
+    """Write the current exception's traceback to a log file in the temporary folder; its path."""
+    text = (f"rvfem {__version__} {command}\nargv: {argv if argv is not None else sys.argv[1:]}\n"
+            f"python {sys.version.split()[0]} on {sys.platform}\n\n{traceback.format_exc()}")
+    try:
+        fd, path = tempfile.mkstemp(prefix="rvfem-error-", suffix=".log")
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        return path
+    except OSError:
+        return "(no log file: the temporary folder is not writable)"
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; returns the exit code (0 ok, 2 user error, 130 interrupted,
-    141 output pipe closed early)."""
+    """Run the command line; returns the exit code (0 ok, 1 internal error, 2 user error,
+    130 interrupted, 141 output pipe closed early)."""
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -400,6 +321,14 @@ def main(argv: list[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return EXIT_BROKEN_PIPE
+    except Exception as exc:  # a bug: one line, the traceback in a log file
+        log_path = _write_crash_log(args.command, argv)
+        if args.verbose >= 2:
+            traceback.print_exc(file=sys.stderr)
+        reason = " ".join(str(exc).split())
+        print(f"rvfem {args.command}: internal error ({type(exc).__name__}{': ' + reason if reason else ''}); "
+              f"this is a bug in rvfem, please report it with the log file {log_path}", file=sys.stderr)
+        return EXIT_INTERNAL_ERROR
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -23,33 +23,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import evaluation, rigid
+from . import iso281, rigid
 from .case import Case
-from .cycle import CycleResult, bore_centres
+from .cycle import CycleResult
+from .geometry import crank_centres
+from .rigid import BearingLoadSummary
 
-__all__ = ["LoadStats", "BearingComparison", "Comparison", "equal_share_forces", "rigid_vs_flexible"]
-
-
-@dataclass(frozen=True)
-class LoadStats:
-    """Load statistics of one bearing over one crank revolution (N, degrees, hours)."""
-
-    max_N: float
-    max_at_deg: float
-    min_N: float
-    min_at_deg: float
-    equivalent_N: float
-    L10h: float
+__all__ = ["BearingComparison", "Comparison", "equal_share_forces", "rigid_vs_flexible"]
 
 
 @dataclass(frozen=True)
 class BearingComparison:
-    """One bearing: the three models and the flexible-vs-rigid deltas (percent)."""
+    """One bearing: the three models (load statistics with their L10h, N, degrees, hours) and the
+    flexible-vs-rigid deltas (percent)."""
 
     bearing: int
-    rigid: LoadStats
-    flexible: LoadStats
-    equal_share: LoadStats
+    rigid: BearingLoadSummary
+    flexible: BearingLoadSummary
+    equal_share: BearingLoadSummary
     delta_max_percent: float
     delta_min_percent: float
     delta_equivalent_percent: float
@@ -89,7 +80,7 @@ def equal_share_forces(case: Case, result: CycleResult) -> np.ndarray:
     and t_i the unit tangent of the crank circle at bearing i (counter-clockwise): the resultant
     is shared equally and the torque is carried by equal tangential forces.
     """
-    c = bore_centres(case)
+    c = crank_centres(case)
     n = len(c)
     t = np.stack([-c[:, 1], c[:, 0]], axis=1) / np.linalg.norm(c, axis=1)[:, None]
     minus_p = result.bearing_forces.sum(axis=1)          # −P
@@ -97,12 +88,8 @@ def equal_share_forces(case: Case, result: CycleResult) -> np.ndarray:
     return minus_p[:, None, :] / n + share * t[None, :, :]
 
 
-def _stats(theta, magnitude, exponent, rating, speed) -> list[LoadStats]:
-    out = []
-    for s in rigid.summarize_loads(theta, magnitude, exponent):
-        life = evaluation.rating_life_hours(rating, s.equivalent_N, speed)
-        out.append(LoadStats(s.max_N, s.max_at_deg, s.min_N, s.min_at_deg, s.equivalent_N, life))
-    return out
+def _stats(theta, magnitude, exponent, rating, speed) -> list[BearingLoadSummary]:
+    return [rigid.with_rating_life(s, rating, speed) for s in rigid.summarize_loads(theta, magnitude, exponent)]
 
 
 def rigid_vs_flexible(case: Case, result: CycleResult) -> Comparison:
@@ -115,8 +102,8 @@ def rigid_vs_flexible(case: Case, result: CycleResult) -> Comparison:
         A full revolution sampled uniformly (the handbook curve is evaluated at the same angles).
     """
     p = case.analysis.equivalent_load_exponent
-    rating = evaluation.crank_bearing_rating(case.crank_bearing)
-    speed = evaluation.bearing_speed_rpm(case.loads.speed_rpm, case.pins.count, case.cycloid.teeth)
+    rating = iso281.crank_bearing_rating(case.crank_bearing)
+    speed = iso281.case_bearing_speed_rpm(case)
     theta = result.theta
     hb = rigid.handbook_bearing_loads(case, theta)
     flex = result.bearing_loads.T
@@ -129,7 +116,7 @@ def rigid_vs_flexible(case: Case, result: CycleResult) -> Comparison:
             delta_max_percent=100.0 * (f.max_N / r.max_N - 1.0),
             delta_min_percent=100.0 * (f.min_N / r.min_N - 1.0),
             delta_equivalent_percent=100.0 * (f.equivalent_N / r.equivalent_N - 1.0),
-            life_ratio=evaluation.life_ratio(r.equivalent_N, f.equivalent_N),
+            life_ratio=iso281.life_ratio(r.equivalent_N, f.equivalent_N),
         ))
     # pin resultant in the eccentric's frame: P_x ⟂ eccentric, P_y along it
     p_res = -result.bearing_forces.sum(axis=1)

@@ -485,27 +485,12 @@ def mesh_case(case: Case, cache_dir: str | os.PathLike = "meshes", *, use_cache:
 
 def mesh_preview_png(mesh: DiscMesh, path: str | os.PathLike, *, title: str | None = None,
                      dpi: int = 150) -> Path:
-    """Write an off-screen PNG of the mesh: the whole disc and a close-up of a bore and the teeth
-    next to it, boundaries coloured (matplotlib Agg; no display needed). Returns the path."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    """Write an off-screen PNG of the mesh: the whole disc and a close-up of the rim under bore 1
+    and the teeth next to it, boundaries coloured (:func:`rvfem.plots.mesh_plot`, matplotlib Agg;
+    no display needed). Returns the path."""
+    from .plots import mesh_plot
 
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig = Figure(figsize=(13, 6.5))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 2)
     x, y = mesh.points[:, 0], mesh.points[:, 1]
-    colours = {"profile": "tab:red", "central_hole": "tab:green"}
-    cycle = ["tab:blue", "tab:orange", "tab:purple", "tab:brown", "tab:olive", "tab:cyan"]
-    for ax in axes:
-        ax.triplot(x, y, mesh.triangles, lw=0.15, color="0.35")
-        for i, (name, e) in enumerate(mesh.boundaries.items()):
-            loop = np.append(e[:, 0], e[0, 0])
-            ax.plot(x[loop], y[loop], lw=1.0, color=colours.get(name, cycle[i % len(cycle)]))
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("y [mm]")
     # close-up: around the point of bore_0 farthest from the centre (rim under the bore)
     if "bore_0" in mesh.boundaries:
         b = mesh.boundary_nodes("bore_0")
@@ -513,16 +498,11 @@ def mesh_preview_png(mesh: DiscMesh, path: str | os.PathLike, *, title: str | No
         c = c * (1 + 3.0 / np.hypot(*c))
     else:
         c = mesh.points[mesh.boundary_nodes("profile")[0]]
-    half = 8.0
-    axes[1].set_xlim(c[0] - half, c[0] + half)
-    axes[1].set_ylim(c[1] - half, c[1] + half)
-    axes[1].set_title("close-up: rim under bore_0 and teeth")
-    axes[0].set_title(title or f"{mesh.path.stem}")
-    fig.suptitle(f"{mesh.n_nodes} nodes, {mesh.n_elements} triangles (P1), "
-                 f"min {mesh.quality_measure} = {mesh.min_quality:.3f}")
-    fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(path, dpi=dpi)
-    return path
+    return mesh_plot(path, mesh.points, mesh.triangles, mesh.boundaries,
+                     closeup_centre=(float(c[0]), float(c[1])), title=title or f"{mesh.path.stem}",
+                     subtitle=f"{mesh.n_nodes} nodes, {mesh.n_elements} triangles (P1), "
+                              f"min {mesh.quality_measure} = {mesh.min_quality:.3f}",
+                     closeup_title="close-up: rim under bore_0 and teeth", dpi=dpi)
 
 
 def to_skfem(mesh: DiscMesh, named_boundaries: bool = True):

@@ -1,4 +1,4 @@
-"""Plots of a load cycle (matplotlib, Agg canvas: no display needed).
+"""Plots of a load cycle and the picture of the mesh (matplotlib, Agg canvas: no display needed).
 
 Each function draws one figure into a PNG file and returns its path. Matplotlib is imported only
 inside the functions (``Figure`` with an Agg canvas, never :mod:`matplotlib.pyplot`, so no global
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
+__all__ = ["mesh_plot", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
 
 DPI = 120
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
@@ -175,3 +175,62 @@ def pins_in_contact_plot(path: str | os.PathLike, theta: np.ndarray, count: np.n
     ax.legend(fontsize=9)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray, boundaries: dict, *,
+              closeup_centre: tuple[float, float], closeup_half_height: float = 8.0, title: str = "",
+              subtitle: str = "", closeup_title: str = "close-up", dpi: int = 150) -> Path:
+    """The mesh: the whole disc (left) and a close-up (right), element edges thin, boundaries coloured.
+
+    The one picture of the mesh, used by ``rvfem mesh`` (:func:`rvfem.mesh.mesh_preview_png`) and
+    by ``rvfem run`` (``images/mesh.png``).
+
+    Parameters
+    ----------
+    path : path-like
+        PNG to write (its folder is created if missing).
+    points : ndarray (n, 2)
+        Mesh vertices, mm.
+    triangles : ndarray (m, 3)
+        Vertex indices of the (linear) triangles.
+    boundaries : dict
+        Boundary name → edges (vertex index pairs), as :attr:`rvfem.mesh.DiscMesh.boundaries`.
+    closeup_centre : (float, float)
+        Centre of the close-up, mm.
+    closeup_half_height : float
+        Half of the close-up's visible height, mm.
+    title, subtitle, closeup_title : str
+        Title of the left panel, of the figure, and of the close-up.
+    dpi : int
+        Resolution.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = _figure((13.0, 6.5))
+    axes = fig.subplots(1, 2)
+    pts = np.asarray(points, dtype=float)
+    x, y = pts[:, 0], pts[:, 1]
+    colours = {"profile": "tab:red", "central_hole": "tab:green"}
+    cycle = ["tab:blue", "tab:orange", "tab:purple", "tab:brown", "tab:olive", "tab:cyan"]
+    for ax in axes:
+        ax.triplot(x, y, np.asarray(triangles), lw=0.15, color="0.35")
+        for i, (name, edges) in enumerate(boundaries.items()):
+            loop = np.append(np.asarray(edges)[:, 0], np.asarray(edges)[0, 0])
+            ax.plot(x[loop], y[loop], lw=1.0, color=colours.get(name, cycle[i % len(cycle)]))
+        ax.set_aspect("equal")
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+    cx, cy = closeup_centre
+    axes[1].set_xlim(cx - closeup_half_height, cx + closeup_half_height)
+    axes[1].set_ylim(cy - closeup_half_height, cy + closeup_half_height)
+    axes[1].set_title(closeup_title)
+    axes[0].set_title(title)
+    if subtitle:
+        fig.suptitle(subtitle)
+    fig.tight_layout(rect=(0, 0, 1, 0.95 if subtitle else 1.0))
+    fig.savefig(path, dpi=dpi)
+    return path

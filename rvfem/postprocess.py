@@ -1,15 +1,17 @@
-"""Post-processing of a flexible load cycle: stress snapshots, the peak stress and where it is,
-Hertz pressures of the most loaded roller.
+"""Disc stresses of a flexible load cycle: field snapshots, the stress envelope, the peak von Mises
+stress and where it is.
 
-Everything here is computed from the results of :func:`rvfem.cycle.load_cycle` (no new solve):
-the displacement fields it keeps (the case's saved angles and the angle of the largest bearing
-load) give the stresses; the roller loads give the Hertz pressures.
+Everything here is computed from the results of :func:`rvfem.cycle.load_cycle` (no new solve): the
+displacement fields it keeps (the case's saved angles and the angle of the largest bearing load)
+give the stress fields; a cycle solved with ``stress_envelope=True`` gives the largest von Mises
+stress of every vertex over every solved angle. (Roller-raceway Hertz pressures are in
+:mod:`rvfem.hertz`.)
 
 Typical use::
 
-    snapshots = field_snapshots(system, cycle)
-    peak = peak_von_mises(snapshots, mesh)
-    hertz = roller_hertz(case, cycle)
+    cycle = load_cycle(system, stress_envelope=True)
+    peak = peak_von_mises(cycle, mesh.points, mesh.boundaries)
+    snapshots = field_snapshots(system, cycle, extra_angles=[math.radians(peak.theta_deg)])
 """
 
 from __future__ import annotations
@@ -19,14 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import evaluation, fem
-from .case import Case
+from . import fem
 
 __all__ = [
     "FieldSnapshot",
     "StressEnvelope",
     "PeakStress",
-    "RollerHertz",
     "FEATURE_LABELS",
     "feature_label",
     "max_load_index",
@@ -34,7 +34,6 @@ __all__ = [
     "field_snapshots",
     "stress_envelope",
     "peak_von_mises",
-    "roller_hertz",
 ]
 
 
@@ -77,7 +76,7 @@ class FieldSnapshot:
 
 @dataclass(frozen=True)
 class PeakStress:
-    """The largest von Mises stress (over the cycle, or the kept fields) and where it occurs.
+    """The largest von Mises stress (over every solved angle, or over given fields) and where it occurs.
 
     Attributes
     ----------
@@ -105,39 +104,6 @@ class PeakStress:
     feature: str
     feature_label: str
     distance_to_feature_mm: float
-
-
-@dataclass(frozen=True)
-class RollerHertz:
-    """Hertz line contact of one roller on both raceways.
-
-    Attributes
-    ----------
-    source : str
-        ``"fe_rollers"`` (largest roller load of the FE cycle), ``"stribeck_rigid"`` (Q_max =
-        4.6·F_max/Z with the handbook F_max) or ``"stribeck_flexible"`` (the same with the FE
-        F_max).
-    roller_load_N : float
-        Q, N.
-    inner : rvfem.evaluation.HertzLineContact
-        Roller on the eccentric (convex raceway).
-    outer : rvfem.evaluation.HertzLineContact
-        Roller in the disc bore (concave raceway).
-    bearing : int or None
-        0-based bearing of that roller (FE only).
-    roller : int or None
-        0-based roller index (FE only).
-    theta_deg : float or None
-        Crank angle at which it carries Q (FE), or at which the bearing load is largest.
-    """
-
-    source: str
-    roller_load_N: float
-    inner: evaluation.HertzLineContact
-    outer: evaluation.HertzLineContact
-    bearing: int | None = None
-    roller: int | None = None
-    theta_deg: float | None = None
 
 
 FEATURE_LABELS = {
@@ -310,48 +276,3 @@ def peak_von_mises(source, points: np.ndarray,
         feature_label=feature_label(feature),
         distance_to_feature_mm=dist,
     )
-
-
-def _contacts(case: Case, q: float) -> tuple[evaluation.HertzLineContact, evaluation.HertzLineContact]:
-    return evaluation.roller_raceway_contacts(case.crank_bearing, q, youngs_modulus_MPa=case.material.youngs_modulus,
-                                              poissons_ratio=case.material.poissons_ratio)
-
-
-def roller_hertz(case: Case, cycle, rigid_max_N: float, rigid_max_at_deg: float | None = None,
-                 rigid_max_bearing: int | None = None) -> dict[str, RollerHertz]:
-    """Hertz pressures of the most loaded roller, from the FE roller loads and from Stribeck.
-
-    Parameters
-    ----------
-    case : Case
-    cycle : rvfem.cycle.CycleResult
-    rigid_max_N : float
-        Largest handbook bearing load over the cycle, N.
-    rigid_max_at_deg : float, optional
-        Its crank angle, degrees.
-    rigid_max_bearing : int, optional
-        Its bearing (0-based).
-
-    Returns
-    -------
-    dict
-        ``"stribeck_rigid"`` and ``"stribeck_flexible"`` always (Q_max = 4.6·F_max/Z, Gao et al.'s
-        eq. 21, with the handbook and the FE bearing load), ``"fe_rollers"`` when the cycle has
-        discrete roller loads (bearing model ``rollers``).
-    """
-    z = case.crank_bearing.rollers
-    out = {}
-    if cycle.roller_loads is not None:
-        k, i, j = np.unravel_index(int(np.argmax(cycle.roller_loads)), cycle.roller_loads.shape)
-        q = float(cycle.roller_loads[k, i, j])
-        out["fe_rollers"] = RollerHertz("fe_rollers", q, *_contacts(case, q), bearing=int(i), roller=int(j),
-                                        theta_deg=math.degrees(float(cycle.theta[k])))
-    q = evaluation.stribeck_max_roller_load(rigid_max_N, z)
-    out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_contacts(case, q), bearing=rigid_max_bearing,
-                                        theta_deg=rigid_max_at_deg)
-    k, i = max_load_index(cycle.bearing_forces)
-    f = float(np.linalg.norm(cycle.bearing_forces[k, i]))
-    q = evaluation.stribeck_max_roller_load(f, z)
-    out["stribeck_flexible"] = RollerHertz("stribeck_flexible", q, *_contacts(case, q), bearing=i,
-                                           theta_deg=math.degrees(float(cycle.theta[k])))
-    return out

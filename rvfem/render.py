@@ -1,4 +1,7 @@
-"""Off-screen images of the disc with PyVista/VTK: stresses on the deformed disc, the mesh.
+"""Off-screen images of the disc with PyVista/VTK: stresses on the deformed disc, close-ups.
+
+The picture of the mesh is drawn with matplotlib (:func:`rvfem.plots.mesh_plot`), which needs no
+OpenGL.
 
 No display is needed. On Linux the module selects VTK's EGL render window
 (``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow``, unless the variable is already set) before VTK is
@@ -31,7 +34,6 @@ __all__ = [
     "check_rendering",
     "nice_factor",
     "stress_image",
-    "mesh_image",
 ]
 
 RENDER_WINDOW_VARIABLE = "VTK_DEFAULT_OPENGL_WINDOW"
@@ -344,48 +346,4 @@ def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[fl
     elif half_height is None:
         half_height = 5.0
     _top_view(pl, focus, half_height)
-    return _save(pl, path)
-
-
-def mesh_image(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray, boundaries: dict, *,
-               title: str, closeup_centre: tuple[float, float], closeup_half_height: float = 8.0,
-               window_size: tuple[int, int] = (1800, 900)) -> Path:
-    """Render the mesh: the whole disc (left) and a close-up (right), boundaries coloured.
-
-    Parameters
-    ----------
-    path : path-like
-        PNG file to write.
-    points, triangles : ndarray
-        Mesh vertices (mm) and triangles.
-    boundaries : dict
-        Boundary name → edges.
-    title : str
-    closeup_centre : (float, float)
-        Centre of the close-up, mm.
-    closeup_half_height : float
-        Half of the close-up's visible height, mm.
-    window_size : (int, int)
-
-    Returns
-    -------
-    Path
-    """
-    pv = _pyvista()
-    path = Path(path)
-    pts = np.asarray(points, dtype=float)
-    disc = pv.PolyData.from_regular_faces(_xyz(pts), np.asarray(triangles, dtype=np.int64))
-    palette = ["#d62728", "#2ca02c", "#1f77b4", "#ff7f0e", "#9467bd", "#8c564b", "#17becf", "#bcbd22"]
-    pl = pv.Plotter(off_screen=True, window_size=list(window_size), shape=(1, 2), border=False)
-    radius = float(np.max(np.hypot(*pts.T)))
-    for col, (centre, half) in enumerate((((0.0, 0.0), 1.05 * radius), (closeup_centre, closeup_half_height))):
-        pl.subplot(0, col)
-        pl.set_background(BACKGROUND)
-        pl.add_mesh(disc, color="#f4f4f4", show_edges=True, edge_color="#404040", line_width=0.6, lighting=False)
-        for k, (name, edges) in enumerate(boundaries.items()):
-            loop = np.append(np.asarray(edges)[:, 0], np.asarray(edges)[0, 0])
-            pl.add_mesh(pv.lines_from_points(_xyz(pts[loop], 0.3)), color=palette[k % len(palette)],
-                        line_width=2.5, lighting=False)
-        pl.add_text(title if col == 0 else "close-up", position="upper_left", font_size=11, color="black")
-        _top_view(pl, centre, half)
     return _save(pl, path)

@@ -1,7 +1,9 @@
 """The HTML report of a run: one self-contained file (styles inline, images embedded as base64).
 
 It is written from the ``summary.json`` content, so the report and the JSON always show the same
-numbers, plus the case (its parameters) and the PNG files of the run.
+numbers, plus the case (its parameters) and the PNG files of the run. The writer that calls it is
+:func:`rvfem.outputs.write_report`; the formulas behind the assumptions listed are in
+docs/theory.md.
 """
 
 from __future__ import annotations
@@ -94,7 +96,11 @@ def assumptions(summary: dict, case: Case) -> list[str]:
                    "so no FE roller loads; Hertz only from the Stribeck estimate).")
     pin = ("rigid pins (Signorini contact: gap ≥ 0, force ≥ 0)" if m["pin_model"] == "rigid"
            else "pins with Hertz line-contact compliance")
-    return [
+    overrides = summary["case"].get("overrides") or {}
+    stated = ([f"Values set on top of the case file (overrides): "
+               f"{', '.join(f'{_e(k)} = {_e(v)}' for k, v in overrides.items())}; case.json holds every value used."]
+              if overrides else [])
+    return stated + [
         f"2D plane-stress finite-element model of one cycloid disc (thickness {case.cycloid.thickness:g} mm, "
         f"E = {case.material.youngs_modulus:g} MPa, ν = {case.material.poissons_ratio:g}), "
         f"P{m['element_order']} triangles; the disc stiffness is factorised once and each crank angle is "
@@ -106,8 +112,8 @@ def assumptions(summary: dict, case: Case) -> list[str]:
         f"Pins: {pin}; " + (f"Coulomb friction μ = {case.analysis.friction:g} along the sliding direction."
                              if case.analysis.friction > 0 else "no friction (μ = 0)."),
         bearing,
-        "Carrier: one rigid body that only rotates about the reducer axis; its rotation is the unknown conjugate to "
-        "the disc torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
+        "Carrier: one rigid body that only rotates, about the disc centre in the disc frame; its rotation is the "
+        "unknown conjugate to the disc torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
         "Rigid reference: the handbook model (Gao et al., eqs. 4-10; rigid disc, rigid bearings, equal load sharing, "
         f"pin-force resultant ratio k_y = {m['handbook_k_y']:.3f}), evaluated at the same crank angles. The FE "
         f"pin-force resultant ratio |P_y/P_x| comes out {m['fe_pin_resultant_ratio']:.3f} on average.",
@@ -122,8 +128,8 @@ def assumptions(summary: dict, case: Case) -> list[str]:
         "are spread over a footprint of about 1.5 elements, so the stress right under a contact depends on the mesh "
         "and is not the Hertz contact stress (see the Hertz table for that); the \"away from contacts\" peak "
         f"ignores a band of {summary['stress']['away_from_contacts']['profile_band_mm']:.2g} mm along the profile and "
-        f"{summary['stress']['away_from_contacts']['bore_band_mm']:.2g} mm along the bores. Stress peaks are "
-        "searched over the kept fields only (the angles listed under Stress images)."
+        f"{summary['stress']['away_from_contacts']['bore_band_mm']:.2g} mm along the bores. Both stress peaks are "
+        "searched over every solved crank angle (the cycle's von Mises envelope), and their fields are kept."
         if summary["stress"].get("away_from_contacts") else
         "Stresses: vertex values are area-weighted averages of the adjacent element stresses.",
         "Images: deformation with the disc's rigid-body motion removed, magnified by the factor written on the "

@@ -48,6 +48,7 @@ Bearing loads
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass
@@ -70,6 +71,7 @@ __all__ = [
     "equivalent_load",
     "summarize_bearing_loads",
     "summarize_loads",
+    "with_rating_life",
     "classical_pin_forces",
 ]
 
@@ -155,7 +157,10 @@ class RigidLoads:
 
 @dataclass(frozen=True)
 class BearingLoadSummary:
-    """Extremes and equivalent value of one bearing's load over a sampled cycle.
+    """Extremes, equivalent value and life of one bearing's load over a sampled cycle.
+
+    The one load-statistics record of rvfem, for the handbook, the finite-element and the
+    equal-share curves alike (:func:`summarize_loads`, :func:`rvfem.compare.rigid_vs_flexible`).
 
     Attributes
     ----------
@@ -169,6 +174,9 @@ class BearingLoadSummary:
         (mean F^p)^(1/p) over the cycle, N.
     exponent : float
         The exponent p used.
+    L10h : float or None
+        ISO 281 rating life with this equivalent load, hours (:func:`rvfem.iso281.rating_life_hours`);
+        None until a rating and a speed are applied (:func:`with_rating_life`).
     """
 
     bearing: int
@@ -178,6 +186,7 @@ class BearingLoadSummary:
     min_at_deg: float
     equivalent_N: float
     exponent: float
+    L10h: float | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,11 +233,14 @@ class PinForces:
 def load_cycle_angles(step_deg: float) -> np.ndarray:
     """Uniformly spaced crank angles covering one full turn, endpoint excluded.
 
+    The one crank-angle sampler of rvfem: the handbook model, the finite-element load cycle and the
+    outputs all use these angles, so their curves line up sample by sample.
+
     Parameters
     ----------
     step_deg : float
-        Requested step, degrees. The number of samples is round(360/step_deg), so the actual step
-        is 360°/n (equal to the request whenever it divides 360°).
+        Requested step, degrees. The number of samples is n = round(360/step_deg), so the actual step
+        is 360°/n (equal to the request whenever it divides 360°; otherwise a warning is logged).
 
     Returns
     -------
@@ -238,7 +250,16 @@ def load_cycle_angles(step_deg: float) -> np.ndarray:
     if not step_deg > 0:
         raise ValueError(f"step_deg must be positive, got {step_deg!r}")
     n = max(1, int(round(360.0 / step_deg)))
-    return 2.0 * np.pi * np.arange(n) / n
+    if not math.isclose(n * step_deg, 360.0, rel_tol=1e-9):
+        logger.warning("angle step %g° does not divide 360°: using %d angles (step %.6g°)", step_deg, n, 360.0 / n)
+    return np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+
+
+def with_rating_life(summary: BearingLoadSummary, rating_N: float, bearing_speed_rpm: float) -> BearingLoadSummary:
+    """``summary`` with its ISO 281 life L10h (hours) for the rating C (N) at the bearing speed n_b (rpm)."""
+    from .iso281 import rating_life_hours
+
+    return dataclasses.replace(summary, L10h=rating_life_hours(rating_N, summary.equivalent_N, bearing_speed_rpm))
 
 
 def _as_theta(theta) -> np.ndarray:

@@ -90,7 +90,7 @@ def test_version(capsys):
 
 
 def test_keyboard_interrupt_exits_130(monkeypatch, capsys):
-    def interrupted(path):
+    def interrupted(path, overrides=()):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli, "load_case", interrupted)
@@ -114,3 +114,127 @@ def test_entry_point_in_a_subprocess(case_text, tmp_path):
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2
     assert bad.stdout == "" and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
+
+
+def test_rigid_is_computed_by_the_library(capsys):
+    """``rvfem rigid --json`` prints what rvfem.analysis.analyse_rigid computes, nothing else."""
+    from rvfem.analysis import analyse_rigid
+    from rvfem.case import load_case
+
+    result = analyse_rigid(load_case(CRV80E))
+    assert cli.main(["rigid", CRV80E, "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["dynamic_load_rating_N"] == result.rating_N
+    for entry, b in zip(report["bearings"], result.bearings):
+        assert entry["max_load_N"] == b.loads.max_N and entry["L10h_h"] == b.loads.L10h
+        assert entry["hertz_inner"]["peak_pressure_MPa"] == b.hertz_inner.peak_pressure_MPa
+
+
+def test_set_overrides_a_case_key(capsys):
+    assert cli.main(["rigid", CRV80E, "--json", "--set", "loads.torque_Nm=392.0"]) == 0
+    half = json.loads(capsys.readouterr().out)
+    assert half["overrides"] == ["loads.torque_Nm=392.0"]
+    # the handbook loads are linear in the torque
+    assert half["bearings"][0]["max_load_N"] == pytest.approx(5576.9 / 2, abs=0.05)
+    assert cli.main(["check", CRV80E, "--set", "loads.torque_Nm=392.0", "--set", "analysis.angle_step_deg=5"]) == 0
+    assert "loads.torque_Nm=392.0, analysis.angle_step_deg=5" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("command", ["check", "rigid", "mesh", "run"])
+def test_bad_set_is_one_line_naming_the_key(command, tmp_path, capsys):
+    args = [command, CRV80E, "--set", "loads.torque_Nmm=392.0"]
+    if command == "run":
+        args += ["-o", str(tmp_path / "out")]
+    if command == "mesh":
+        args += ["--cache-dir", str(tmp_path / "cache")]
+    assert cli.main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "loads.torque_Nmm" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+    assert cli.main([command, CRV80E, "--set", "no_equals_sign"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "KEY=VALUE" in err
+
+
+def test_bearing_model_choices_come_from_the_registry():
+    from rvfem.registry import bearing_model_names
+
+    parser = cli.build_parser()
+    run = next(a for a in parser._subparsers._group_actions[0].choices["run"]._actions
+               if a.dest == "bearing_model")
+    assert tuple(run.choices) == bearing_model_names()
+
+
+def test_internal_error_is_one_line_with_a_log_file(monkeypatch, capsys):
+    import rvfem.analysis
+
+    def broken(case, theta=None):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr(rvfem.analysis, "analyse_rigid", broken)
+    assert cli.main(["rigid", CRV80E]) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and "Traceback" not in err
+    assert "internal error (ZeroDivisionError: float division by zero)" in err and "please report" in err
+    log_path = err.rstrip().rsplit(" ", 1)[1]
+    with open(log_path, encoding="utf-8") as fh:
+        logged = fh.read()
+    assert "Traceback" in logged and "ZeroDivisionError" in logged and "broken" in logged
+    import os
+
+    os.remove(log_path)
+    # -vv shows the traceback as well
+    assert cli.main(["-vv", "rigid", CRV80E]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback" in err and err.strip().splitlines()[-1].startswith("rvfem rigid: internal error")
+    os.remove(err.rstrip().rsplit(" ", 1)[1])
+
+
+def test_json_output_is_strict_json_with_null_for_non_finite(monkeypatch, capsys):
+    """A zero torque gives zero bearing loads and an infinite life: null, never Infinity."""
+    import dataclasses
+
+    import rvfem.analysis
+
+    real = rvfem.analysis.analyse_rigid
+
+    def infinite_life(case, theta=None):
+        result = real(case, theta)
+        b = result.bearings[0]
+        bearings = (dataclasses.replace(b, loads=dataclasses.replace(b.loads, L10h=float("inf"))),
+                    *result.bearings[1:])
+        return dataclasses.replace(result, bearings=bearings)
+
+    monkeypatch.setattr(rvfem.analysis, "analyse_rigid", infinite_life)
+    assert cli.main(["rigid", CRV80E, "--json"]) == 0
+    text = capsys.readouterr().out
+    assert "Infinity" not in text and "NaN" not in text
+    report = json.loads(text, parse_constant=lambda c: pytest.fail(f"non-JSON constant {c}"))
+    assert report["bearings"][0]["L10h_h"] is None and report["bearings"][1]["L10h_h"] > 0
+    assert cli.main(["rigid", CRV80E]) == 0
+    assert "      –" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("tty", [True, False])
+def test_run_progress_draws_stages_and_the_cycle(tty):
+    """The progress display of ``rvfem run`` (a tqdm bar on a terminal, plain lines otherwise)."""
+    import io
+
+    from rvfem.run import STAGES
+
+    stream = io.StringIO()
+    progress = cli._RunProgress(stream, tty)
+    for stage in STAGES:
+        total = 36 if stage in ("cycle", "images") else 1
+        progress(stage, 0, total)
+        for done in range(1, total):
+            progress(stage, done, total)
+        progress(stage, total, total)
+    progress.close()
+    text = stream.getvalue()
+    assert text.count("done in") == len(STAGES)
+    assert f"[{len(STAGES)}/{len(STAGES)}] writing the report: done in" in text
+    if tty:
+        assert "flexible load cycle:   0%" in text and "/36" in text          # the tqdm bar of the cycle
+    else:
+        assert "rvfem run: cycle 36/36" not in text and "cycle 18/36 angles (50 %)" in text

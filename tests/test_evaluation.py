@@ -1,5 +1,5 @@
-"""Speed, ISO 281 rating and life, duty cycle and Hertz contact against published numbers and
-closed forms."""
+"""Speed, ISO 281 rating and life, duty cycle (rvfem.iso281) and Hertz contact (rvfem.hertz) against
+published numbers and closed forms."""
 
 from __future__ import annotations
 
@@ -8,22 +8,25 @@ import math
 import pytest
 
 from rvfem.case import DutyRow, load_case
-from rvfem.evaluation import (
-    bearing_speed_rpm,
+from rvfem.hertz import (
     composite_modulus,
-    constant_load_life_hours,
     crank_bearing_hertz,
-    crank_bearing_rating,
-    duty_cycle_life,
-    dynamic_load_rating,
     hertz_half_width,
     hertz_line_contact,
     hertz_peak_pressure,
-    life_ratio,
     palmgren_approach,
-    rating_life_hours,
     reduced_radius,
     stribeck_max_roller_load,
+)
+from rvfem.iso281 import (
+    bearing_speed_rpm,
+    case_duty_cycle_life,
+    constant_load_life_hours,
+    crank_bearing_rating,
+    duty_cycle_life,
+    dynamic_load_rating,
+    life_ratio,
+    rating_life_hours,
 )
 from rvfem.rigid import handbook_bearing_loads, summarize_bearing_loads
 
@@ -214,3 +217,25 @@ def test_stribeck_and_crank_bearing_hertz_crv80e():
     assert inner == hertz_line_contact(q, 9.0, 2.5, 13.0, concave=False)
     assert outer == hertz_line_contact(q, 9.0, 2.5, 18.0, concave=True)
     assert inner.peak_pressure_MPa > outer.peak_pressure_MPa   # convex inner raceway is the critical one
+
+
+def test_case_duty_cycle_uses_the_shortest_life():
+    case = load_case(CASES_DIR / "crv80e.toml")
+    assert case_duty_cycle_life(case, [6008.0, 7000.0]) is None        # no duty cycle in the file
+    rows = (DutyRow(0.25, 15.0, 1568.0), DutyRow(0.75, 15.0, 784.0))
+    loads = case.loads.__class__(**{**case.loads.__dict__, "duty_cycle": rows})
+    with_duty = case.replace(loads=loads)
+    d = case_duty_cycle_life(with_duty, [7000.0, 6008.0, 9000.0])
+    assert d.rated_life_h == 6008.0
+    assert d == duty_cycle_life(rows, 6008.0, 15.0, 784.0)
+    # a quarter of the time at twice the rated torque: damage rate 0.25·2^(10/3) + 0.75
+    assert d.service_life_h == pytest.approx(6008.0 / (0.25 * 2 ** (10 / 3) + 0.75), rel=1e-12)
+
+
+def test_former_module_name_still_exports_the_formulas():
+    import rvfem.contact  # noqa: F401  (imports PALMGREN_COEFFICIENT from rvfem.evaluation)
+    from rvfem import evaluation, hertz, iso281
+
+    assert evaluation.PALMGREN_COEFFICIENT is hertz.PALMGREN_COEFFICIENT == 3.84e-5
+    assert evaluation.rating_life_hours is iso281.rating_life_hours
+    assert evaluation.hertz_line_contact is hertz.hertz_line_contact

@@ -1,7 +1,8 @@
 """``rvfem run``: the result folder against the Python API, file formats, and nothing lost.
 
 Runs a coarse version of the default case (mesh sizes doubled, 20° crank-angle step, fields at 0°
-and at the largest bearing load) once through the command line and checks every output.
+and at the largest bearing load) once through the command line and checks every output; a second
+run adds a duty cycle, ``--field-step`` and ``--set``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,8 @@ import meshio
 import numpy as np
 import pytest
 
-from rvfem import cli, render
+from rvfem import cli, outputs, render
+from rvfem.analysis import analyse
 from rvfem.case import file_sha256, load_case
 from rvfem.compare import rigid_vs_flexible
 from rvfem.cycle import build_system, load_cycle
@@ -400,6 +402,15 @@ def test_bad_step_is_a_case_error(coarse_case_file, tmp_path, capsys):
     assert "angle step" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("value", ["0", "-10", "400"])
+def test_bad_field_step_is_one_line_and_leaves_nothing(coarse_case_file, tmp_path, capsys, value):
+    assert cli.main(["run", str(coarse_case_file), "-o", str(tmp_path / "o"), "--no-images",
+                     "--field-step", value]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "field step" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_p2_fields_are_written_on_the_linear_mesh(coarse_case_file, cache_dir, tmp_path):
     result = run_case(coarse_case_file, tmp_path / "p2", order=2, angle_step_deg=30.0, cache_dir=cache_dir,
                       images=False)
@@ -413,3 +424,186 @@ def test_p2_fields_are_written_on_the_linear_mesh(coarse_case_file, cache_dir, t
     pd = mesh.point_data
     np.testing.assert_allclose(pd["von_mises_MPa"], _von_mises(pd["sxx_MPa"], pd["syy_MPa"], pd["sxy_MPa"]),
                                rtol=1e-10, atol=1e-9)
+
+
+# --------------------------------------------------------------------------------------------
+# Duty cycle, --field-step and --set (a second run)
+# --------------------------------------------------------------------------------------------
+
+#: A start-run-stop cycle after the accelerated test of Gao et al. (CRV-80E, section 3): 0.3 s
+#: accelerating (mean speed half the rated one, 2.5 times the rated torque), 1.7 s at the rated
+#: speed and torque, 0.3 s braking; scaled to the RV-40E's 412 N·m.
+DUTY_ROWS = [(0.3, 7.5, 1030.0), (1.7, 15.0, 412.0), (0.3, 7.5, 1030.0)]
+FIELD_STEP_DEG = 60.0
+SPEED_OVERRIDE_RPM = 20.0
+
+
+@pytest.fixture(scope="module")
+def duty_run(workspace, cache_dir) -> tuple[Path, dict, str]:
+    """``rvfem run`` of the coarse case with a duty cycle, ``--field-step`` and ``--set``."""
+    text = (CaseText.shipped("rv40e_fanholes")
+            .set("mesh", "size_flank", "0.7").set("mesh", "size_bore", "0.8").set("mesh", "size_interior", "5.0")
+            .set("analysis", "angle_step_deg", str(STEP_DEG)).set("analysis", "saved_angles_deg", "[0.0]"))
+    for t, n, torque in DUTY_ROWS:
+        text.append(f"[[loads.duty_cycle]]\ntime_share = {t}\nspeed_rpm = {n}\ntorque_Nm = {torque}")
+    path = text.write(workspace, "duty.toml")
+    out = workspace / "duty"
+    import contextlib
+    import io
+
+    screen = io.StringIO()
+    with contextlib.redirect_stdout(screen):
+        code = cli.main(["run", str(path), "-o", str(out), "--cache-dir", str(cache_dir), "--no-images",
+                         "--field-step", str(FIELD_STEP_DEG), "--set", f"loads.speed_rpm={SPEED_OVERRIDE_RPM}"])
+    assert code == 0
+    return out, json.loads((out / "summary.json").read_text(encoding="utf-8")), screen.getvalue()
+
+
+def test_duty_cycle_service_life_is_palmgren_miner_of_the_rated_lives(duty_run):
+    out, s, screen = duty_run
+    n0, t0 = SPEED_OVERRIDE_RPM, 412.0
+    # Gao et al., eqs. 17-18 written out: damage rate Σ t_i n_i T_i^(10/3) / Σ t_i
+    rate = sum(t * n * torque ** (10 / 3) for t, n, torque in DUTY_ROWS) / sum(t for t, _, _ in DUTY_ROWS)
+    t_m = (sum(t * n * torque ** (10 / 3) for t, n, torque in DUTY_ROWS)
+           / sum(t * n for t, n, _ in DUTY_ROWS)) ** 0.3
+    for model in ("rigid", "flexible"):
+        d = s["duty_cycle"][model]
+        rated = min(b[model]["L10h_h"] for b in s["bearings"])
+        assert d["rated_life_h"] == pytest.approx(rated, rel=1e-12)
+        assert d["service_life_h"] == pytest.approx(rated * n0 * t0 ** (10 / 3) / rate, rel=1e-12)
+        assert d["equivalent_torque_Nm"] == pytest.approx(t_m, rel=1e-12)
+        assert d["equivalent_speed_rpm"] == pytest.approx((0.3 * 7.5 * 2 + 1.7 * 15.0) / 2.3, rel=1e-12)
+    # the flexible model changes the rated life only: the service lives scale alike
+    d = s["duty_cycle"]
+    assert d["flexible"]["service_life_h"] / d["rigid"]["service_life_h"] == pytest.approx(
+        d["flexible"]["rated_life_h"] / d["rigid"]["rated_life_h"], rel=1e-12)
+    # the rated speed is the overridden one: n_b = 20·40/(40 − 39) = 800 rpm
+    assert s["model"]["bearing_speed_rpm"] == pytest.approx(800.0)
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "Duty cycle (Palmgren–Miner)" in html and f"{d['flexible']['service_life_h']:.0f}" in html
+    assert "duty cycle: service life" in screen and f"flexible {d['flexible']['service_life_h']:.0f} h" in screen
+
+
+def test_set_overrides_are_recorded_and_stated(duty_run):
+    out, s, screen = duty_run
+    assert s["case"]["overrides"] == {"loads.speed_rpm": SPEED_OVERRIDE_RPM}
+    assert s["case"]["matches_file"] is False
+    assert s["case"]["sha256"] == file_sha256(Path(s["case"]["file"]))
+    assert "loads.speed_rpm" not in s["case"]["defaults_used"] and "analysis.element_order" in s["case"]["defaults_used"]
+    assert json.loads((out / "case.json").read_text(encoding="utf-8"))["loads"]["speed_rpm"] == SPEED_OVERRIDE_RPM
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "overrides: <code>loads.speed_rpm = 20.0</code>" in html
+    assert "overrides: loads.speed_rpm = 20.0" in screen.splitlines()[0]
+
+
+def test_field_step_keeps_a_field_every_step(duty_run):
+    out, s, _ = duty_run
+    angles = [f["theta_deg"] for f in s["fields"]]
+    every = np.arange(0.0, 360.0, FIELD_STEP_DEG)              # all solved angles (20° step)
+    for theta in every:
+        assert any(math.isclose(theta, a, abs_tol=1e-9) for a in angles), theta
+    # besides: the largest bearing load and the stress peaks, nothing else
+    extra = {round(a, 6) for a in angles} - {round(t, 6) for t in every}
+    assert extra <= {round(s["max_bearing_load"]["theta_deg"], 6), round(s["peak_von_mises_at"]["theta_deg"], 6),
+                     round(s["stress"]["away_from_contacts"]["at"]["theta_deg"], 6)}
+    assert s["stress"]["field_angles_deg"] == pytest.approx(angles)
+    assert [t for t, _ in _pvd_files(out)] == pytest.approx(sorted(angles))
+    for f in s["fields"]:
+        assert (out / f["vtu"]).is_file() and "image" not in f
+
+
+# --------------------------------------------------------------------------------------------
+# The analysis without outputs; the documented keys
+# --------------------------------------------------------------------------------------------
+
+
+def test_analyse_writes_nothing_and_gives_the_summary_numbers(coarse_case_file, cache_dir, summary, tmp_path,
+                                                              monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    cached = sorted(p.name for p in cache_dir.iterdir())
+    analysis = analyse(coarse_case_file, cache_dir=cache_dir)
+    assert list(tmp_path.iterdir()) == [] and sorted(p.name for p in cache_dir.iterdir()) == cached
+    built = outputs.build_summary(analysis)
+    skipped = {"timings_s", "files", "fields", "images", "plots"}
+    assert {k: v for k, v in built.items() if k not in skipped} == {k: v for k, v in summary.items()
+                                                                     if k not in skipped}
+    assert built["files"] == [] and built["images"] == {}
+    assert [f["theta_deg"] for f in built["fields"]] == [f["theta_deg"] for f in summary["fields"]]
+    assert json.loads(json.dumps(built, allow_nan=False)) == built
+
+
+def _documented_keys() -> set[str]:
+    """Key paths of the summary.json table in docs/outputs.md (see the rules above the table)."""
+    import re
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "outputs.md").read_text(encoding="utf-8")
+    table = text[text.index("| key | type | meaning |"):]
+    table = table[: table.index("\n\n")]
+    keys: set[str] = set()
+    parents: list[str] = []
+    for row in table.splitlines()[2:]:
+        first = row.split("|")[1].strip()
+        names = re.findall(r"`([^`]+)`", first)
+        if first.startswith("&nbsp;"):
+            keys.update(p + n for p in parents for n in names)
+        else:
+            keys.update(names)
+            parents = names
+    return keys
+
+
+OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timings_s"}
+"""Objects whose keys are names (case keys, files, stages), documented as a whole."""
+
+
+def _written_keys(obj, prefix: str = "") -> set[str]:
+    """Key paths of a summary; an array of objects is ``name[]`` and its entries' keys ``name[].key``."""
+    keys = {prefix} if prefix else set()
+    if prefix in OPAQUE_KEYS:
+        return keys
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            name = f"{prefix}.{k}" if prefix else k
+            if isinstance(v, list) and v and isinstance(v[0], dict):
+                keys.add(name + "[]")
+                for entry in v:
+                    keys |= _written_keys(entry, name + "[]")
+            else:
+                keys |= _written_keys(v, name)
+    return keys
+
+
+def test_summary_keys_are_the_documented_ones(summary, duty_run):
+    written = _written_keys(summary) | _written_keys(duty_run[1])
+    documented = _documented_keys()
+    assert written - documented == set(), "keys written but not in docs/outputs.md"
+    assert documented - written == set(), "keys in docs/outputs.md that no run writes"
+
+
+# --------------------------------------------------------------------------------------------
+# The atomic result folder
+# --------------------------------------------------------------------------------------------
+
+
+def test_result_folder_moves_into_place_only_when_complete(tmp_path):
+    out = tmp_path / "a" / "out"
+    with outputs.result_folder(out) as folder:
+        (folder / "x.txt").write_text("new")
+        assert not out.exists() and folder.parent == out.parent
+    assert [p.name for p in out.iterdir()] == ["x.txt"]
+    assert [p.name for p in out.parent.iterdir()] == ["out"]
+    # an existing folder is refused before anything is written, and kept
+    with pytest.raises(OutputError, match="exists and is not empty"):
+        with outputs.result_folder(out):
+            pytest.fail("entered")
+    # a failure inside leaves the previous results as they were, and no temporary folder
+    with pytest.raises(ZeroDivisionError):
+        with outputs.result_folder(out, overwrite=True) as folder:
+            (folder / "y.txt").write_text("half")
+            1 / 0
+    assert [p.name for p in out.iterdir()] == ["x.txt"] and (out / "x.txt").read_text() == "new"
+    assert [p.name for p in out.parent.iterdir()] == ["out"]
+    with outputs.result_folder(out, overwrite=True) as folder:
+        (folder / "y.txt").write_text("complete")
+    assert [p.name for p in out.iterdir()] == ["y.txt"]
+    assert [p.name for p in out.parent.iterdir()] == ["out"]

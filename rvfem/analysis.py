@@ -1,0 +1,636 @@
+"""One analysis of a case, computed and held in memory: nothing is written.
+
+:func:`analyse` runs the chain check → mesh (cached) → FE model → rigid handbook model → flexible
+load cycle → evaluation (rigid vs flexible, stresses, Hertz, stiffness, duty cycle) and returns an
+:class:`Analysis`, a frozen object with every result a report needs. The writers of
+:mod:`rvfem.outputs` turn it into files; :func:`rvfem.run.run_case` chains the two. A notebook or a
+design study uses :func:`analyse` directly::
+
+    from rvfem.analysis import analyse
+    a = analyse("cases/rv40e_fanholes.toml", angle_step_deg=5.0)
+    a.comparison.bearings[0].delta_max_percent, a.stress.peak.von_mises_MPa
+
+:func:`analyse_rigid` is the rigid handbook evaluation alone (what ``rvfem rigid`` prints): loads,
+ISO 281 rating and life, Stribeck/Hertz pressures and the duty cycle, in milliseconds.
+
+Adding a result: give :class:`Analysis` a new field with a default (``None`` when it does not
+apply), compute it in :func:`analyse`, add a piece to :data:`rvfem.outputs.SUMMARY_PIECES` and its
+keys to docs/outputs.md (a test checks that the documented and the written keys agree). The
+physics and the sources of every formula are in docs/theory.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import os
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Mapping
+
+import numpy as np
+
+from . import hertz, iso281, rigid
+from .case import Case, apply_overrides, case_to_dict, file_sha256, load_case, parse_override
+from .errors import CaseError
+
+if TYPE_CHECKING:  # the heavier modules are imported where used
+    from .compare import Comparison
+    from .cycle import CycleResult, DiscSystem
+    from .geometry import DiscGeometry
+    from .mesh import DiscMesh
+    from .postprocess import FieldSnapshot, PeakStress
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "STAGES",
+    "CONTACT_BAND_ELEMENTS",
+    "ProgressCallback",
+    "Stages",
+    "CaseProvenance",
+    "RigidBearing",
+    "RigidAnalysis",
+    "StressResult",
+    "DutyCycleResult",
+    "Analysis",
+    "resolve_case",
+    "cycle_angles",
+    "kept_field_angles",
+    "analyse_rigid",
+    "analyse",
+]
+
+STAGES: dict[str, str] = {
+    "check": "checking the case",
+    "mesh": "meshing the disc (cached)",
+    "model": "assembling and factorising the disc model",
+    "rigid": "rigid handbook model",
+    "cycle": "flexible load cycle",
+    "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
+}
+"""Stages of :func:`analyse` in order, with a one-line description (what the progress callback
+reports)."""
+
+CONTACT_BAND_ELEMENTS = 6.0
+"""Width of the band along the tooth profile and the bores excluded from the "away from contacts"
+stress peak, in element sizes there (``mesh.size_flank``, ``mesh.size_bore``): four times the
+footprint half-width over which the pin and roller forces are spread."""
+
+MIN_ANGLES = 4
+"""Fewest crank angles per turn a load cycle may have."""
+
+ProgressCallback = Callable[[str, int, int], None]
+"""``progress(stage, done, total)``: called with ``done = 0`` when a stage starts, with
+``done = total`` when it ends, and after every crank angle of the ``cycle`` stage (``total`` =
+number of angles). An exception raised by the callback (e.g. KeyboardInterrupt) aborts the
+analysis."""
+
+
+class Stages:
+    """Times named stages and reports them to an optional progress callback.
+
+    Parameters
+    ----------
+    progress : ProgressCallback, optional
+    descriptions : dict
+        Stage name → one-line description (logged at INFO level when the stage starts).
+    """
+
+    def __init__(self, progress: ProgressCallback | None, descriptions: Mapping[str, str] = STAGES):
+        self.progress = progress
+        self.descriptions = descriptions
+        self.seconds: dict[str, float] = {}
+
+    def start(self, name: str, total: int = 1) -> float:
+        """Report the start of stage ``name``; returns the start time (``time.perf_counter``)."""
+        log.info("%s", self.descriptions.get(name, name))
+        if self.progress is not None:
+            self.progress(name, 0, total)
+        return time.perf_counter()
+
+    def tick(self, name: str, done: int, total: int) -> None:
+        """Report progress within stage ``name``."""
+        if self.progress is not None:
+            self.progress(name, done, total)
+
+    def end(self, name: str, started: float, total: int = 1) -> None:
+        """Record the wall time of stage ``name`` (s) and report its end."""
+        self.seconds[name] = time.perf_counter() - started
+        if self.progress is not None:
+            self.progress(name, total, total)
+
+
+# --------------------------------------------------------------------------------------------
+# The case as analysed
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CaseProvenance:
+    """Where the analysed case comes from.
+
+    Attributes
+    ----------
+    file : str or None
+        Case file path as given (None for a case built in code).
+    sha256 : str or None
+        sha256 of the case file's bytes.
+    matches_file : bool
+        True if the analysed case is exactly the file's (no overrides, not modified in code).
+    overrides : dict
+        Dotted case key → value, for every value set on top of the file: ``KEY=VALUE`` overrides
+        (:attr:`rvfem.case.Case.overrides`, ``rvfem ... --set``) and the options
+        ``angle_step_deg``, ``bearing_model``, ``order`` (``--step``, ``--bearing-model``,
+        ``--order``).
+    defaults_used : tuple of (str, value)
+        Dotted keys that neither the file nor an override sets, with the default value used.
+    """
+
+    file: str | None
+    sha256: str | None
+    matches_file: bool
+    overrides: dict = field(default_factory=dict)
+    defaults_used: tuple[tuple[str, Any], ...] = ()
+
+
+_WITH_OVERRIDES = " (with overrides)"  # suffix rvfem.case.load_case gives Case.source with overrides
+
+
+def _defaults_used(raw: dict, case: Case) -> tuple[tuple[str, Any], ...]:
+    """Dotted keys of ``case`` that ``raw`` (the file's data) does not set, with their values."""
+    out: list[tuple[str, Any]] = []
+
+    def walk(full: Any, given: Any, prefix: str) -> None:
+        if not isinstance(full, dict):
+            return
+        for key, value in full.items():
+            dotted = f"{prefix}{key}"
+            if not isinstance(given, dict) or key not in given:
+                if value not in ([], {}, "", None):
+                    out.append((dotted, value))
+            elif isinstance(value, dict):
+                walk(value, given[key], dotted + ".")
+
+    walk(case_to_dict(case), raw, "")
+    return tuple(out)
+
+
+def _read_raw(path: Path) -> dict | None:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError):
+        return None
+
+
+def resolve_case(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
+                 angle_step_deg: float | None = None, bearing_model: str | None = None,
+                 order: int | None = None) -> tuple[Case, CaseProvenance]:
+    """The case to analyse, with the options applied, and where it comes from.
+
+    Parameters
+    ----------
+    case : Case or path
+        A case (built in code, or read with :func:`rvfem.case.load_case`, overrides included) or
+        the path of a case file.
+    overrides : tuple of str
+        ``KEY=VALUE`` overrides applied when ``case`` is a path (see :func:`rvfem.case.load_case`).
+    angle_step_deg : float, optional
+        Crank-angle step, degrees (overrides ``analysis.angle_step_deg``).
+    bearing_model : str, optional
+        Overrides ``crank_bearing.model`` (one of :func:`rvfem.registry.bearing_model_names`).
+    order : {1, 2}, optional
+        Overrides ``analysis.element_order``.
+
+    Returns
+    -------
+    (Case, CaseProvenance)
+
+    Raises
+    ------
+    CaseError
+        A bad file, override or option (one line naming the key).
+    """
+    from .registry import bearing_model_names
+
+    if isinstance(case, Case):
+        base = case
+        source = case.source[: -len(_WITH_OVERRIDES)] if case.source.endswith(_WITH_OVERRIDES) else case.source
+        path: Path | None = Path(source)
+        if path.is_file():
+            try:
+                matches = load_case(path, case.overrides) == case
+            except CaseError:
+                matches = False
+        else:
+            path, matches = None, False
+    else:
+        path = Path(case)
+        base = load_case(path, overrides)
+        matches = True
+
+    given: dict[str, Any] = {}
+    for text in base.overrides:
+        parts, value = parse_override(text)
+        given[".".join(parts)] = value
+    defaults: tuple[tuple[str, Any], ...] = ()
+    if path is not None and matches:
+        raw = _read_raw(path)
+        if raw is not None:
+            defaults = _defaults_used(apply_overrides(raw, base.overrides), base)
+
+    options: dict[str, Any] = {}
+    analysis, bearing = base.analysis, base.crank_bearing
+    if angle_step_deg is not None:
+        if not (isinstance(angle_step_deg, (int, float)) and angle_step_deg > 0):
+            raise CaseError(f"the angle step must be positive, got {angle_step_deg!r}")
+        analysis = dataclasses.replace(analysis, angle_step_deg=float(angle_step_deg))
+        options["analysis.angle_step_deg"] = float(angle_step_deg)
+    if order is not None:
+        if order not in (1, 2):
+            raise CaseError(f"the element order must be 1 or 2, got {order!r}")
+        analysis = dataclasses.replace(analysis, element_order=int(order))
+        options["analysis.element_order"] = int(order)
+    if bearing_model is not None:
+        names = bearing_model_names()
+        if bearing_model not in names:
+            raise CaseError(f"the bearing model must be one of {', '.join(repr(n) for n in names)}, "
+                            f"got {bearing_model!r}")
+        bearing = dataclasses.replace(bearing, model=bearing_model)
+        options["crank_bearing.model"] = bearing_model
+    try:
+        effective = base.replace(analysis=analysis, crank_bearing=bearing) if options else base
+    except CaseError as exc:
+        text = ", ".join(f"{k} = {v}" for k, v in options.items())
+        raise CaseError(f"the overrides ({text}) are not valid: {exc}") from None
+    if options:
+        effective = dataclasses.replace(effective, overrides=base.overrides)
+    given.update(options)
+    provenance = CaseProvenance(
+        file=str(path) if path is not None else None,
+        sha256=file_sha256(path) if path is not None else None,
+        matches_file=matches and not given,
+        overrides=given,
+        defaults_used=defaults,
+    )
+    return effective, provenance
+
+
+def cycle_angles(case: Case) -> np.ndarray:
+    """Crank angles of a load cycle of ``case``: :func:`rvfem.rigid.load_cycle_angles` at
+    ``analysis.angle_step_deg``, at least :data:`MIN_ANGLES` of them, rad.
+
+    Raises
+    ------
+    CaseError
+        If the step leaves fewer than four angles per turn.
+    """
+    step = case.analysis.angle_step_deg
+    if int(round(360.0 / step)) < MIN_ANGLES:
+        raise CaseError(f"the angle step {step:g}° leaves fewer than {MIN_ANGLES} angles per turn")
+    return rigid.load_cycle_angles(step)
+
+
+# --------------------------------------------------------------------------------------------
+# Rigid handbook evaluation (``rvfem rigid``)
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RigidBearing:
+    """One crank bearing in the rigid handbook evaluation.
+
+    Attributes
+    ----------
+    loads : rvfem.rigid.BearingLoadSummary
+        Maximum, minimum (with crank angles, degrees), equivalent load (N) and L10h (hours).
+    crank_angle_deg : float
+        Position α_i of the crank, degrees.
+    max_roller_load_N : float
+        Stribeck's most loaded roller at the maximum bearing load, Q_max = 4.6·F_max/Z, N.
+    hertz_inner, hertz_outer : rvfem.hertz.HertzLineContact
+        Hertz contact of that roller on the eccentric (convex) and in the disc bore (concave).
+    """
+
+    loads: rigid.BearingLoadSummary
+    crank_angle_deg: float
+    max_roller_load_N: float
+    hertz_inner: hertz.HertzLineContact
+    hertz_outer: hertz.HertzLineContact
+
+
+@dataclass(frozen=True, eq=False)
+class RigidAnalysis:
+    """The rigid handbook evaluation of a case: loads, rating, lives, Hertz, duty cycle.
+
+    Attributes
+    ----------
+    case : Case
+    loads : rvfem.rigid.RigidLoads
+        Bearing forces over the sampled crank angles (and the handbook components k, k_y, ΣP…).
+    bearings : tuple of RigidBearing
+    rating_N : float
+        ISO 281 dynamic load rating C of the crank bearing, N.
+    bearing_speed_rpm : float
+        n_b = n_out·Zp/(Zp − Zc), rpm.
+    exponent : float
+        Equivalent-load exponent p.
+    stribeck_factor : float
+        Factor of Stribeck's Q_max = factor·F/Z.
+    duty_cycle : rvfem.iso281.DutyCycleLife or None
+        Service life of the case's duty cycle from the shortest bearing life (None without a duty
+        cycle).
+    """
+
+    case: Case
+    loads: rigid.RigidLoads
+    bearings: tuple[RigidBearing, ...]
+    rating_N: float
+    bearing_speed_rpm: float
+    exponent: float
+    stribeck_factor: float
+    duty_cycle: iso281.DutyCycleLife | None
+
+    @property
+    def angle_step_deg(self) -> float:
+        """Crank-angle step actually used, degrees."""
+        return 360.0 / self.loads.theta.size
+
+
+def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
+    """Rigid handbook evaluation of a case (Gao et al. eqs. 4-14 and 20-22; see docs/theory.md).
+
+    Parameters
+    ----------
+    case : Case
+    theta : ndarray, optional
+        Crank angles, rad; default one turn at ``analysis.angle_step_deg``
+        (:func:`rvfem.rigid.load_cycle_angles`).
+
+    Returns
+    -------
+    RigidAnalysis
+
+    Raises
+    ------
+    CaseError
+        If the case lies outside the handbook model (Zp − Zc ≠ 1, unequally spaced cranks).
+    """
+    loads = rigid.handbook_bearing_loads(case, theta)
+    exponent = case.analysis.equivalent_load_exponent
+    rating = iso281.crank_bearing_rating(case.crank_bearing)
+    speed = iso281.case_bearing_speed_rpm(case)
+    mat = case.material
+    bearings = []
+    for s in rigid.summarize_bearing_loads(loads, exponent):
+        inner, outer = hertz.crank_bearing_hertz(case.crank_bearing, s.max_N, youngs_modulus_MPa=mat.youngs_modulus,
+                                                 poissons_ratio=mat.poissons_ratio)
+        bearings.append(RigidBearing(
+            loads=rigid.with_rating_life(s, rating, speed),
+            crank_angle_deg=case.cranks.angles_deg[s.bearing],
+            max_roller_load_N=hertz.stribeck_max_roller_load(s.max_N, case.crank_bearing.rollers),
+            hertz_inner=inner,
+            hertz_outer=outer,
+        ))
+    duty = iso281.case_duty_cycle_life(case, [b.loads.L10h for b in bearings])
+    return RigidAnalysis(case=case, loads=loads, bearings=tuple(bearings), rating_N=rating, bearing_speed_rpm=speed,
+                         exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR, duty_cycle=duty)
+
+
+# --------------------------------------------------------------------------------------------
+# The full analysis
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class StressResult:
+    """Disc stresses of a load cycle.
+
+    Attributes
+    ----------
+    peak : rvfem.postprocess.PeakStress
+        Largest vertex von Mises stress over every solved crank angle (the cycle's envelope).
+    away_from_contacts : rvfem.postprocess.PeakStress or None
+        The same ignoring a band along the tooth profile and the bores (the structural peak).
+    band_mm : dict
+        Boundary name → width of the ignored band, mm.
+    snapshots : tuple of rvfem.postprocess.FieldSnapshot
+        The kept fields (saved angles, largest bearing load, the two peaks, ``field_step_deg``).
+    peak_element_von_mises_MPa : float
+        Largest element (not averaged) von Mises stress over the kept fields, MPa.
+    """
+
+    peak: PeakStress
+    away_from_contacts: PeakStress | None
+    band_mm: dict[str, float]
+    snapshots: tuple[FieldSnapshot, ...]
+    peak_element_von_mises_MPa: float
+
+
+@dataclass(frozen=True)
+class DutyCycleResult:
+    """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives."""
+
+    rigid: iso281.DutyCycleLife
+    flexible: iso281.DutyCycleLife
+
+
+@dataclass(frozen=True, eq=False)
+class Analysis:
+    """Everything one analysis of a case computed (see the module docstring); writes nothing.
+
+    Attributes
+    ----------
+    case : Case
+        The case as analysed (overrides applied).
+    provenance : CaseProvenance
+        Case file, checksum, overrides and defaults used.
+    geometry : rvfem.geometry.DiscGeometry
+    mesh : rvfem.mesh.DiscMesh
+    system : rvfem.cycle.DiscSystem
+        The factorised disc model (for further solves).
+    theta : ndarray (n,)
+        Crank angles of the cycle, rad.
+    rigid : RigidAnalysis
+        The handbook evaluation at the same angles (``rigid.loads`` are the handbook curves).
+    classical : rvfem.rigid.PinForces
+        Classical rigid pin forces at the same angles (moment exact at every angle).
+    cycle : rvfem.cycle.CycleResult
+        The flexible load cycle.
+    comparison : rvfem.compare.Comparison
+        Rigid, flexible and equal-share load statistics and lives per bearing.
+    stress : StressResult
+    hertz : dict of str to rvfem.hertz.RollerHertz
+        ``fe_rollers`` (bearing model ``rollers`` only), ``stribeck_rigid``, ``stribeck_flexible``.
+    torsional_stiffness_Nm_per_arcmin : float
+        Disc torque / mean carrier rotation.
+    duty_cycle : DutyCycleResult or None
+        None if the case has no duty cycle.
+    timings : dict
+        Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*`` and
+        ``cycle_per_angle``.
+    """
+
+    case: Case
+    provenance: CaseProvenance
+    geometry: DiscGeometry
+    mesh: DiscMesh
+    system: DiscSystem
+    theta: np.ndarray
+    rigid: RigidAnalysis
+    classical: rigid.PinForces
+    cycle: CycleResult
+    comparison: Comparison
+    stress: StressResult
+    hertz: dict[str, hertz.RollerHertz]
+    torsional_stiffness_Nm_per_arcmin: float
+    duty_cycle: DutyCycleResult | None = None
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def max_load_index(self) -> tuple[int, int]:
+        """(angle index, bearing index) of the largest FE bearing load of the cycle."""
+        from .postprocess import max_load_index
+
+        return max_load_index(self.cycle.bearing_forces)
+
+    @property
+    def rigid_forces(self) -> np.ndarray:
+        """Handbook force of every bearing on the disc, (n, N, 2), N (the layout of
+        ``cycle.bearing_forces``)."""
+        hb = self.rigid.loads
+        return np.stack([hb.fx.T, hb.fy.T], axis=2)
+
+    @property
+    def pin_centres(self) -> np.ndarray:
+        """Pin centres in the disc frame at every crank angle, (n, Zp, 2), mm."""
+        from .geometry import pin_centres
+
+        return np.stack([pin_centres(self.case, float(th)) for th in self.theta])
+
+
+def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, ...]:
+    """Crank angles (degrees) whose fields a load cycle keeps: the case's ``saved_angles_deg`` and
+    every ``field_step_deg`` degrees if given (checked: in (0°, 360°], else CaseError)."""
+    saved = tuple(case.analysis.saved_angles_deg)
+    if field_step_deg is not None:
+        if not (isinstance(field_step_deg, (int, float)) and 0 < field_step_deg <= 360):
+            raise CaseError(f"the field step must be in (0°, 360°], got {field_step_deg!r}")
+        saved = saved + tuple(np.arange(0.0, 360.0, field_step_deg))
+    return saved
+
+
+def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
+            angle_step_deg: float | None = None, bearing_model: str | None = None, order: int | None = None,
+            field_step_deg: float | None = None, cache_dir: str | os.PathLike = "meshes",
+            progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None) -> Analysis:
+    """Analyse a case completely, in memory.
+
+    Parameters
+    ----------
+    case : Case or path
+        A case or the path of a case file.
+    overrides : tuple of str
+        ``KEY=VALUE`` overrides when ``case`` is a path (:func:`rvfem.case.load_case`).
+    angle_step_deg, bearing_model, order : optional
+        Override ``analysis.angle_step_deg`` (degrees), ``crank_bearing.model`` and
+        ``analysis.element_order`` (see :func:`resolve_case`).
+    field_step_deg : float, optional
+        Also keep the displacement/stress fields every ``field_step_deg`` degrees (by default only
+        the case's ``analysis.saved_angles_deg``, the angle of the largest bearing load and the
+        angles of the stress peaks).
+    cache_dir : path
+        Mesh cache folder.
+    progress : ProgressCallback, optional
+    provenance : CaseProvenance, optional
+        If given, ``case`` is taken as already resolved (by :func:`resolve_case`) and the ``check``
+        stage is skipped.
+
+    Returns
+    -------
+    Analysis
+
+    Raises
+    ------
+    CaseError, GeometryError, MeshError, ContactError
+        From the stages.
+    """
+    from . import compare, postprocess
+    from . import cycle as cycle_module
+    from .geometry import disc_geometry
+    from .mesh import mesh_case
+
+    stages = Stages(progress)
+    if provenance is None:
+        t = stages.start("check")
+        case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
+                                        bearing_model=bearing_model, order=order)
+        saved = kept_field_angles(case, field_step_deg)
+        thetas = cycle_angles(case)
+        stages.end("check", t)
+    else:
+        if not isinstance(case, Case):
+            raise TypeError("analyse(..., provenance=...) needs a resolved Case")
+        saved = kept_field_angles(case, field_step_deg)
+        thetas = cycle_angles(case)
+
+    t = stages.start("mesh")
+    geometry = disc_geometry(case)
+    mesh = mesh_case(case, cache_dir, geometry=geometry)
+    stages.end("mesh", t)
+
+    t = stages.start("model")
+    system = cycle_module.build_system(case, mesh)
+    stages.end("model", t)
+
+    # the rigid model before the cycle: a case outside the handbook's assumptions fails fast
+    t = stages.start("rigid")
+    rigid_analysis = analyse_rigid(case, thetas)
+    classical = rigid.classical_pin_forces(case, thetas, exact_moment=True)
+    stages.end("rigid", t)
+
+    n = len(thetas)
+    t = stages.start("cycle", n)
+
+    def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
+        if i < total:
+            stages.tick("cycle", i, total)
+
+    cycle = cycle_module.load_cycle(system, thetas, progress=report, saved_angles_deg=saved, stress_envelope=True)
+    stages.end("cycle", t, n)
+
+    t = stages.start("evaluation")
+    comparison = compare.rigid_vs_flexible(case, cycle)
+    # peaks over every solved angle (the cycle's stress envelope); their fields are kept too
+    peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
+    band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
+    band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
+    away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
+    snapshots = postprocess.field_snapshots(
+        system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
+    stress = StressResult(
+        peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
+        peak_element_von_mises_MPa=max(float(s.stress.element.von_mises.max()) for s in snapshots))
+    # the first bearing among equals (the handbook curves are exact shifts of each other)
+    rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
+    roller_hertz = hertz.most_loaded_roller_hertz(case, cycle.theta, cycle.bearing_forces, cycle.roller_loads,
+                                                  rigid_max.rigid.max_N, rigid_max.rigid.max_at_deg,
+                                                  rigid_max.bearing)
+    stiffness = cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm)
+    duty = None
+    if case.loads.duty_cycle:
+        duty = DutyCycleResult(
+            rigid=iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings]),
+            flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
+    stages.end("evaluation", t)
+
+    timings = dict(stages.seconds)
+    timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
+    timings["cycle_per_angle"] = stages.seconds["cycle"] / n
+    return Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
+                    theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
+                    comparison=comparison, stress=stress, hertz=roller_hertz,
+                    torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings)

@@ -1,0 +1,812 @@
+"""Writers of an :class:`~rvfem.analysis.Analysis`: one per format, and the atomic result folder.
+
+Every writer has the form ``write_x(analysis, folder) -> list[Path]`` and writes into an existing
+folder (sub-folders it needs are created)::
+
+    write_case_json   case.json           the case as analysed; case_from_dict() reads it back
+    write_tables      bearing_loads.csv, roller_loads.csv (bearing model "rollers"), pin_forces.csv,
+                      cycle.csv
+    write_vtk         vtk/disc.pvd and vtk/disc_theta_<θ>.vtu per kept field (ParaView)
+    write_images      images/stress_theta_<θ>.png, the two stress close-ups (PyVista, off-screen),
+                      images/mesh.png (matplotlib)
+    write_plots       plots/*.png (matplotlib)
+    write_summary     summary.json
+    write_report      report.html (self-contained)
+
+The content of ``summary.json`` is built in one place, :func:`build_summary`, from the typed pieces
+of :data:`SUMMARY_PIECES`; docs/outputs.md documents every key (a test checks that the two agree).
+:func:`result_folder` is the atomic result folder: results are written into a temporary folder next
+to the target and moved into place only when complete.
+
+File formats and keys: docs/outputs.md.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import json
+import logging
+import math
+import os
+import shutil
+import tempfile
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator, Mapping
+
+import numpy as np
+
+from . import __version__
+from .case import case_to_dict
+from .errors import OutputError
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "IMAGE_SIZE",
+    "DEFORMATION_DISPLAY_FRACTION",
+    "SummaryContext",
+    "SUMMARY_PIECES",
+    "json_ready",
+    "check_output_folder",
+    "result_folder",
+    "image_count",
+    "build_summary",
+    "summary_text",
+    "rigid_summary",
+    "rigid_text",
+    "write_case_json",
+    "write_tables",
+    "write_vtk",
+    "write_images",
+    "write_plots",
+    "write_summary",
+    "write_report",
+]
+
+SCHEMA_VERSION = 1
+"""Version of the ``summary.json`` layout (docs/outputs.md); bumped when a key changes meaning or
+disappears (new keys do not bump it)."""
+
+IMAGE_SIZE = (1500, 1100)
+"""Size of the stress images, pixels (width, height)."""
+
+DEFORMATION_DISPLAY_FRACTION = 0.03
+"""The largest deformation of the kept fields is drawn as about this fraction of the pin-circle
+radius (the magnification is rounded down to 1, 2 or 5·10^k and written on the image)."""
+
+TickCallback = Callable[[int, int], None]
+"""``tick(done, total)``: progress within a writer (images, VTK files)."""
+
+
+# --------------------------------------------------------------------------------------------
+# JSON
+# --------------------------------------------------------------------------------------------
+
+
+def json_ready(obj: Any) -> Any:
+    """A copy of ``obj`` that :func:`json.dumps` writes as strict JSON.
+
+    Numpy scalars become Python numbers, tuples lists, dataclasses dicts, and non-finite floats
+    (an infinite life at zero load, a ratio that cannot be formed) become ``None`` (JSON
+    ``null``): ``Infinity`` and ``NaN`` are not JSON and most readers reject them.
+    """
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return json_ready(dataclasses.asdict(obj))
+    if isinstance(obj, dict):
+        return {str(k): json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_ready(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return json_ready(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        v = float(obj)
+        return v if math.isfinite(v) else None
+    return obj
+
+
+def _dump(obj: Any) -> str:
+    return json.dumps(json_ready(obj), indent=2, allow_nan=False) + "\n"
+
+
+# --------------------------------------------------------------------------------------------
+# The atomic result folder
+# --------------------------------------------------------------------------------------------
+
+
+def _is_nonempty_dir(path: Path) -> bool:
+    return path.is_dir() and any(path.iterdir())
+
+
+def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
+    """Raise :class:`~rvfem.errors.OutputError` if ``out_dir`` cannot take the results: it is a file,
+    or a non-empty folder and ``overwrite`` is false."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() or out_dir.is_symlink():
+        if not out_dir.is_dir():
+            raise OutputError(f"{out_dir} exists and is not a folder; choose another output folder")
+        if _is_nonempty_dir(out_dir) and not overwrite:
+            raise OutputError(f"{out_dir} exists and is not empty; choose another output folder or pass "
+                              "--overwrite (overwrite=True) to replace it")
+
+
+def _make_parents(out_dir: Path) -> list[Path]:
+    """Create the missing parents of ``out_dir``; return the ones created (outermost first)."""
+    missing = []
+    p = out_dir.parent
+    while not p.exists():
+        missing.append(p)
+        p = p.parent
+    try:
+        for p in reversed(missing):
+            p.mkdir()
+    except OSError as exc:
+        raise OutputError(f"cannot create the folder {p}: {exc.strerror or exc}") from None
+    return list(reversed(missing))
+
+
+def _remove_created(created: list[Path]) -> None:
+    for p in reversed(created):
+        try:
+            p.rmdir()
+        except OSError:
+            pass
+
+
+def _commit(tmp: Path, out_dir: Path, overwrite: bool) -> None:
+    """Move the complete results into place (atomic rename; an old folder goes only after)."""
+    check_output_folder(out_dir, overwrite)
+    if _is_nonempty_dir(out_dir):
+        old = out_dir.with_name(f".{out_dir.name}.old-{uuid.uuid4().hex[:8]}")
+        os.replace(out_dir, old)
+        try:
+            os.replace(tmp, out_dir)
+        except BaseException:
+            os.replace(old, out_dir)
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(tmp, out_dir)  # also replaces an empty folder
+
+
+@contextlib.contextmanager
+def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False) -> Iterator[Path]:
+    """The atomic result folder: yields a temporary folder to write into, next to ``out_dir``.
+
+    On entry ``out_dir`` is checked (:func:`check_output_folder`) and its missing parents are
+    created. When the block ends normally the temporary folder is renamed to ``out_dir`` (an
+    existing non-empty ``out_dir`` is replaced only then, and only with ``overwrite``). When the
+    block raises (an error, Ctrl-C) the temporary folder and the parents created are removed and
+    an existing ``out_dir`` stays as it was.
+
+    Raises
+    ------
+    OutputError
+        ``out_dir`` is a file, is not empty (without ``overwrite``), or cannot be written.
+
+    Examples
+    --------
+    >>> with result_folder("results/x", overwrite=True) as tmp:    # doctest: +SKIP
+    ...     write_tables(analysis, tmp)
+    """
+    out_dir = Path(out_dir)
+    check_output_folder(out_dir, overwrite)
+    created = _make_parents(out_dir)
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=out_dir.parent))
+    except OSError as exc:
+        _remove_created(created)
+        raise OutputError(f"cannot write into {out_dir.parent}: {exc.strerror or exc}") from None
+    try:
+        umask = os.umask(0o022)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; the results are an ordinary folder
+        try:
+            yield tmp
+        except OSError as exc:
+            raise OutputError(f"cannot write the results: {exc.strerror or exc}") from None
+        try:
+            _commit(tmp, out_dir, overwrite)
+        except OSError as exc:
+            raise OutputError(f"cannot move the results into {out_dir}: {exc.strerror or exc}") from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        _remove_created(created)
+        raise
+
+
+# --------------------------------------------------------------------------------------------
+# summary.json: built in one place from typed pieces
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SummaryContext:
+    """What the summary needs besides the analysis.
+
+    Attributes
+    ----------
+    files : tuple of str
+        Files of the result folder, relative paths (posix).
+    timings : dict
+        Wall time per stage (s), including the writers' and ``total``.
+    """
+
+    files: tuple[str, ...] = ()
+    timings: Mapping[str, float] = dataclasses.field(default_factory=dict)
+
+
+def _stats_dict(s) -> dict:
+    return {
+        "max_load_N": s.max_N,
+        "max_at_deg": s.max_at_deg,
+        "min_load_N": s.min_N,
+        "min_at_deg": s.min_at_deg,
+        "equivalent_load_N": s.equivalent_N,
+        "L10h_h": s.L10h,
+    }
+
+
+def _hertz_dict(h) -> dict:
+    return {
+        "roller_load_N": h.roller_load_N,
+        "bearing": None if h.bearing is None else h.bearing + 1,
+        "roller": None if h.roller is None else h.roller + 1,
+        "theta_deg": h.theta_deg,
+        "inner": dataclasses.asdict(h.inner),
+        "outer": dataclasses.asdict(h.outer),
+    }
+
+
+def _peak_dict(peak) -> dict:
+    return {
+        "x_mm": peak.x_mm,
+        "y_mm": peak.y_mm,
+        "radius_mm": peak.radius_mm,
+        "theta_deg": peak.theta_deg,
+        "feature": peak.feature,
+        "feature_label": peak.feature_label,
+        "distance_to_feature_mm": peak.distance_to_feature_mm,
+    }
+
+
+def _piece_header(a, ctx: SummaryContext) -> dict:
+    p, case = a.provenance, a.case
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "rvfem_version": __version__,
+        "case": {
+            "name": case.name,
+            "description": case.description,
+            "file": p.file,
+            "sha256": p.sha256,
+            "matches_file": p.matches_file,
+            "digest": case.digest(),
+            "overrides": dict(p.overrides),
+            "defaults_used": {k: v for k, v in p.defaults_used},
+        },
+    }
+
+
+def _piece_model(a, ctx: SummaryContext) -> dict:
+    case, model, c = a.case, a.system.model, a.comparison
+    return {"model": {
+        "bearing_model": case.crank_bearing.model,
+        "element_order": model.order,
+        "pin_model": a.system.pin_model,
+        "pin_friction": case.analysis.friction,
+        "nodes": model.n_nodes,
+        "vertices": model.n_vertices,
+        "dofs": model.n_dofs,
+        "elements": model.n_elements,
+        "mesh_file": a.mesh.path.name,
+        "mesh_min_quality": a.mesh.min_quality,
+        "angle_step_deg": 360.0 / len(a.theta),
+        "angles": len(a.theta),
+        "output_torque_Nm": case.loads.torque_Nm,
+        "discs": case.loads.discs,
+        "disc_torque_Nmm": case.loads.disc_torque_Nmm,
+        "torque_convention": "disc torque T_out/discs = moment of the pin forces about the disc centre "
+                             "(handbook: sum P_x = T/(2 e Zc))",
+        "radial_clearance_mm": case.crank_bearing.radial_clearance,
+        "equivalent_load_exponent": c.exponent,
+        "dynamic_load_rating_N": c.rating_N,
+        "bearing_speed_rpm": c.bearing_speed_rpm,
+        "handbook_k_y": c.handbook_k_y,
+        "fe_pin_resultant_ratio": c.pin_resultant_ratio,
+    }}
+
+
+def _piece_bearings(a, ctx: SummaryContext) -> dict:
+    bearings = [{
+        "bearing": bc.bearing + 1,
+        "crank_angle_deg": a.case.cranks.angles_deg[bc.bearing],
+        "rigid": _stats_dict(bc.rigid),
+        "flexible": _stats_dict(bc.flexible),
+        "equal_share": _stats_dict(bc.equal_share),
+        "delta_max_percent": bc.delta_max_percent,
+        "delta_min_percent": bc.delta_min_percent,
+        "delta_equivalent_percent": bc.delta_equivalent_percent,
+        "life_ratio": bc.life_ratio,
+    } for bc in a.comparison.bearings]
+    k, i = a.max_load_index
+    return {
+        "bearings": bearings,
+        "max_bearing_load": {
+            "bearing": i + 1,
+            "theta_deg": math.degrees(float(a.theta[k])),
+            "flexible_N": float(a.cycle.bearing_loads[k, i]),
+        },
+    }
+
+
+def _piece_cycle(a, ctx: SummaryContext) -> dict:
+    cy = a.cycle
+    arcmin = np.degrees(cy.carrier_rotation) * 60.0
+    return {
+        "pins_in_contact": {
+            "min": int(cy.pins_in_contact.min()),
+            "max": int(cy.pins_in_contact.max()),
+            "mean": float(cy.pins_in_contact.mean()),
+            "of": a.case.pins.count,
+        },
+        "torsional_stiffness_Nm_per_arcmin": a.torsional_stiffness_Nm_per_arcmin,
+        "carrier_rotation_arcmin": {"min": float(arcmin.min()), "max": float(arcmin.max()),
+                                    "mean": float(arcmin.mean())},
+        "equilibrium_residual": float(cy.equilibrium_residual.max()),
+        "active_set_iterations": {"max": int(cy.iterations.max()), "mean": float(cy.iterations.mean())},
+    }
+
+
+def _piece_stress(a, ctx: SummaryContext) -> dict:
+    s = a.stress
+    away = s.away_from_contacts
+    return {
+        "peak_von_mises_MPa": s.peak.von_mises_MPa,
+        "peak_von_mises_at": _peak_dict(s.peak),
+        "stress": {
+            "peak_element_von_mises_MPa": s.peak_element_von_mises_MPa,
+            "away_from_contacts": None if away is None else {
+                "peak_von_mises_MPa": away.von_mises_MPa,
+                "at": _peak_dict(away),
+                "profile_band_mm": s.band_mm["profile"],
+                "bore_band_mm": s.band_mm.get("bore_0"),
+            },
+            "field_angles_deg": [snap.theta_deg for snap in s.snapshots],
+        },
+    }
+
+
+def _piece_hertz(a, ctx: SummaryContext) -> dict:
+    from .hertz import STRIBECK_FACTOR
+
+    h = a.hertz
+    return {"hertz": {
+        "stribeck_factor": STRIBECK_FACTOR,
+        "fe_rollers": _hertz_dict(h["fe_rollers"]) if "fe_rollers" in h else None,
+        "stribeck_rigid": _hertz_dict(h["stribeck_rigid"]),
+        "stribeck_flexible": _hertz_dict(h["stribeck_flexible"]),
+    }}
+
+
+def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
+    if a.duty_cycle is None:
+        return {}
+    return {"duty_cycle": {"rigid": dataclasses.asdict(a.duty_cycle.rigid),
+                           "flexible": dataclasses.asdict(a.duty_cycle.flexible)}}
+
+
+def _image_key(rel: str) -> str:
+    return Path(rel).stem
+
+
+def _piece_files(a, ctx: SummaryContext) -> dict:
+    from .vtkio import vtu_name
+
+    files = set(ctx.files)
+    fields = []
+    for snap in a.stress.snapshots:
+        entry = {"theta_deg": snap.theta_deg, "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
+        image = f"images/{_stress_image_name(snap.theta_deg)}"
+        if image in files:
+            entry["image"] = image
+        fields.append(entry)
+    return {
+        "fields": sorted(fields, key=lambda f: f["theta_deg"]),
+        "images": {_image_key(f): f for f in sorted(files) if f.startswith("images/") and f.endswith(".png")},
+        "plots": {_image_key(f): f for f in sorted(files) if f.startswith("plots/") and f.endswith(".png")},
+        "timings_s": dict(ctx.timings),
+        "files": sorted(files),
+    }
+
+
+SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
+    _piece_header,
+    _piece_model,
+    _piece_bearings,
+    _piece_cycle,
+    _piece_stress,
+    _piece_hertz,
+    _piece_duty_cycle,
+    _piece_files,
+)
+"""The pieces of ``summary.json`` in order: each ``piece(analysis, context) -> dict`` of top-level
+keys. A new result of :class:`~rvfem.analysis.Analysis` adds one piece here and its keys to
+docs/outputs.md."""
+
+
+def build_summary(analysis, context: SummaryContext | None = None) -> dict:
+    """The content of ``summary.json`` (JSON-ready: non-finite numbers are None).
+
+    Parameters
+    ----------
+    analysis : rvfem.analysis.Analysis
+    context : SummaryContext, optional
+        Files of the result folder and timings (default: none, e.g. for a summary in memory).
+    """
+    context = context or SummaryContext(timings=dict(analysis.timings))
+    summary: dict[str, Any] = {}
+    for piece in SUMMARY_PIECES:
+        summary.update(piece(analysis, context))
+    return json_ready(summary)
+
+
+def write_summary(analysis, folder: str | os.PathLike, *, summary: dict | None = None) -> list[Path]:
+    """Write ``summary.json`` (the given ``summary``, or :func:`build_summary` with the files
+    found in ``folder``)."""
+    folder = Path(folder)
+    if summary is None:
+        summary = build_summary(analysis, SummaryContext(files=_files_in(folder, ("summary.json",)),
+                                                         timings=dict(analysis.timings)))
+    path = folder / "summary.json"
+    path.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    return [path]
+
+
+def _files_in(folder: Path, extra: Iterable[str] = ()) -> tuple[str, ...]:
+    found = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
+    return tuple(sorted(found | set(extra)))
+
+
+# --------------------------------------------------------------------------------------------
+# case.json and the CSV tables
+# --------------------------------------------------------------------------------------------
+
+
+def write_case_json(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Write ``case.json``: the case as analysed (:func:`rvfem.case.case_from_dict` reads it back)."""
+    path = Path(folder) / "case.json"
+    path.write_text(json.dumps(case_to_dict(analysis.case), indent=2) + "\n", encoding="utf-8")
+    return [path]
+
+
+def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Write the CSV tables of the load cycle (:mod:`rvfem.tables`): ``bearing_loads.csv``,
+    ``roller_loads.csv`` (discrete rollers only), ``pin_forces.csv``, ``cycle.csv``."""
+    from . import tables
+
+    folder = Path(folder)
+    a, cy, th = analysis, analysis.cycle, analysis.theta
+    out = [tables.write_bearing_loads(folder / "bearing_loads.csv", th, cy.bearing_forces, a.rigid_forces)]
+    if cy.roller_loads is not None:
+        out.append(tables.write_roller_loads(folder / "roller_loads.csv", th, cy.roller_angles, cy.roller_loads))
+    out.append(tables.write_pin_forces(folder / "pin_forces.csv", th, a.pin_centres, cy.pin_forces,
+                                       a.classical.magnitude.T))
+    out.append(tables.write_cycle_table(folder / "cycle.csv", th, cy.pins_in_contact, cy.carrier_rotation,
+                                        cy.equilibrium_residual, cy.iterations))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# VTK
+# --------------------------------------------------------------------------------------------
+
+
+def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None) -> list[Path]:
+    """Write ``vtk/disc_theta_<θ>.vtu`` for every kept field and the collection ``vtk/disc.pvd``
+    (:mod:`rvfem.vtkio`)."""
+    from . import vtkio
+
+    vtk = Path(folder) / "vtk"
+    vtk.mkdir(exist_ok=True)
+    model = analysis.system.model
+    snapshots = analysis.stress.snapshots
+    out, entries = [], []
+    for done, snap in enumerate(snapshots, start=1):
+        name = vtkio.vtu_name(snap.theta_deg)
+        out.append(vtkio.write_vtu(vtk / name, model.mesh.p.T, model.mesh.t.T, snap))
+        entries.append((snap.theta_deg, name))
+        if tick is not None and done < len(snapshots):
+            tick(done, len(snapshots))
+    out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Images and plots
+# --------------------------------------------------------------------------------------------
+
+
+def _stress_image_name(theta_deg: float) -> str:
+    return f"stress_theta_{theta_deg % 360:06.2f}.png"
+
+
+def image_count(analysis) -> int:
+    """Number of images :func:`write_images` draws (for a progress bar)."""
+    s = analysis.stress
+    return len(s.snapshots) + sum(pk is not None for pk in (s.peak, s.away_from_contacts)) + 1
+
+
+def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None) -> list[Path]:
+    """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
+    stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.plots.mesh_plot`).
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    from . import render
+    from .geometry import crank_centres
+    from .plots import mesh_plot
+
+    a, case, cy = analysis, analysis.case, analysis.cycle
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    model, mesh, snapshots = a.system.model, a.mesh, a.stress.snapshots
+    peak, away = a.stress.peak, a.stress.away_from_contacts
+    vertices, triangles = model.mesh.p.T, model.mesh.t.T
+    pin_xy, rigid_forces = a.pin_centres, a.rigid_forces
+    k_max, _ = a.max_load_index
+    total = image_count(a)
+    max_def = max(float(np.max(np.hypot(*s.deformation.T))) for s in snapshots)
+    magnification = render.nice_factor(DEFORMATION_DISPLAY_FRACTION * case.pins.circle_radius / max_def)
+    f_ref = max(float(cy.bearing_loads.max()), float(a.rigid.loads.magnitude.max()))
+    # colour range up to the peak away from the contacts (the structural field stays readable);
+    # the contact spots above it are drawn in the "above" colour
+    clim = (0.0, (away or peak).von_mises_MPa)
+    bores = crank_centres(case)
+
+    def scene(snap, label):
+        k = snap.index
+        pf = cy.pin_forces[k]
+        return render.StressScene(
+            points=vertices, triangles=triangles, boundaries=mesh.boundaries,
+            von_mises=snap.stress.nodal.von_mises, deformation=snap.deformation,
+            magnification=magnification, clim=clim,
+            pin_centres=pin_xy[k], pin_radius=case.pins.radius,
+            pin_loaded=pf > 1e-9 * max(float(pf.max()), 1.0),
+            bore_centres=bores, bearing_forces=cy.bearing_forces[k], rigid_forces=rigid_forces[k],
+            force_scale=0.85 * case.crank_bearing.bore_radius / f_ref,
+            title=f"{case.name}   crank angle {snap.theta_deg:.1f}°{label}   von Mises on the disc deformed "
+                  f"×{magnification:g}   bearings '{case.crank_bearing.model}', P{model.order}",
+        )
+
+    out: list[Path] = []
+
+    def done(path: Path) -> None:
+        out.append(path)
+        if tick is not None and len(out) < total:
+            tick(len(out), total)
+
+    for snap in snapshots:
+        label = "  (max. bearing load)" if snap.index == k_max else ""
+        done(render.stress_image(images / _stress_image_name(snap.theta_deg), scene(snap, label),
+                                 window_size=IMAGE_SIZE))
+    half = max(5.0, 12.0 * case.mesh.size_bore)
+    for key, pk in (("stress_peak_closeup", peak), ("stress_away_from_contacts_closeup", away)):
+        if pk is None:
+            continue
+        snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+        close = dataclasses.replace(
+            scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
+            title=f"{case.name}   crank angle {snap.theta_deg:.1f}°   close-up (undeformed): von Mises "
+                  f"{pk.von_mises_MPa:.0f} MPa at the ring, {pk.feature_label}")
+        done(render.stress_image(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
+                                 marker=(pk.x_mm, pk.y_mm), show_edges=True, window_size=IMAGE_SIZE))
+    b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
+    done(mesh_plot(images / "mesh.png", vertices, triangles, mesh.boundaries,
+                   closeup_centre=(float(b0[0]), float(b0[1])),
+                   title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
+                         f"(min quality {mesh.min_quality:.2f})",
+                   closeup_title="close-up: the rim under bore 1"))
+    return out
+
+
+def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Draw ``plots/``: bearing loads over θ (rigid vs flexible), roller loads and pin forces at the
+    angle of the largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
+    from . import plots
+
+    a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
+    folder = Path(folder) / "plots"
+    folder.mkdir(exist_ok=True)
+    k_max, _ = a.max_load_index
+    th_max = math.degrees(float(th[k_max]))
+    classical = a.classical.magnitude
+    out = [plots.bearing_loads_plot(
+        folder / "bearing_loads.png", th, cy.bearing_loads, a.rigid.loads.magnitude.T,
+        title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs rigid handbook")]
+    if cy.roller_loads is not None:
+        out.append(plots.roller_loads_plot(folder / "roller_loads.png", cy.roller_angles[k_max],
+                                           cy.roller_loads[k_max], cy.bearing_forces[k_max], theta_deg=th_max))
+    out.append(plots.pin_forces_plot(folder / "pin_forces.png", np.arange(1, case.pins.count + 1),
+                                     cy.pin_forces[k_max], classical[:, k_max], theta_deg=th_max))
+    out.append(plots.pins_in_contact_plot(folder / "pins_in_contact.png", th, cy.pins_in_contact, case.pins.count,
+                                          classical=np.count_nonzero(classical > 0, axis=0)))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Report
+# --------------------------------------------------------------------------------------------
+
+
+def write_report(analysis, folder: str | os.PathLike, *, summary: dict | None = None) -> list[Path]:
+    """Write ``report.html`` (:mod:`rvfem.report`): the numbers of ``summary`` (default
+    :func:`build_summary` with the files found in ``folder``) with the PNG files of ``folder``
+    embedded."""
+    folder = Path(folder)
+    if summary is None:
+        summary = build_summary(analysis, SummaryContext(
+            files=_files_in(folder, ("report.html", "summary.json")), timings=dict(analysis.timings)))
+    from .report import write_report as _write_html
+
+    return [_write_html(folder / "report.html", summary, analysis.case, folder)]
+
+
+# --------------------------------------------------------------------------------------------
+# Text and JSON for the command line
+# --------------------------------------------------------------------------------------------
+
+
+def _num(value: float | None, fmt: str) -> str:
+    """``format(value, fmt)``, or a dash as wide for a value that could not be computed (None)."""
+    if value is None:
+        width = "".join(c for c in fmt.split(".")[0] if c.isdigit())
+        return "–".rjust(int(width or 0))
+    return format(value, fmt)
+
+
+def summary_text(summary: dict) -> str:
+    """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints)."""
+    c, m = summary["case"], summary["model"]
+    lines = [
+        f"Case {c['name']}" + (f" ({c['file']})" if c.get("file") else "") +
+        (f", overrides: {', '.join(f'{k} = {v}' for k, v in c['overrides'].items())}" if c["overrides"] else ""),
+        f"  model: bearings '{m['bearing_model']}', P{m['element_order']}, {m['nodes']} nodes, {m['dofs']} dofs, "
+        f"{m['elements']} elements; {m['angles']} crank angles (step {m['angle_step_deg']:g}°)",
+        f"  torque {m['output_torque_Nm']:g} N·m on {m['discs']} discs = {m['disc_torque_Nmm'] / 1000:g} N·m per disc "
+        f"about the disc centre; C = {m['dynamic_load_rating_N']:.0f} N, n_b = {m['bearing_speed_rpm']:g} rpm",
+        "",
+        f"  {'bearing':>7} {'model':<9} {'max N':>8} {'at °':>6} {'min N':>8} {'at °':>6} {'F_m N':>8} {'L10h h':>9}",
+    ]
+
+    for b in summary["bearings"]:
+        for key in ("rigid", "flexible"):
+            s = b[key]
+            lines.append(f"  {b['bearing'] if key == 'rigid' else '':>7} {key:<9} {_num(s['max_load_N'], '8.0f')} "
+                         f"{_num(s['max_at_deg'], '6.1f')} {_num(s['min_load_N'], '8.0f')} {_num(s['min_at_deg'], '6.1f')} "
+                         f"{_num(s['equivalent_load_N'], '8.0f')} {_num(s['L10h_h'], '9.0f')}")
+        lines.append(f"  {'':>7} {'delta':<9} {_num(b['delta_max_percent'], '+7.1f')}% {'':>6} "
+                     f"{_num(b['delta_min_percent'], '+7.1f')}% {'':>6} {_num(b['delta_equivalent_percent'], '+7.1f')}%  "
+                     f"life ratio {_num(b['life_ratio'], '.2f')}")
+    at = summary["peak_von_mises_at"]
+    away = summary["stress"]["away_from_contacts"]
+    h = summary["hertz"]
+    fe = h.get("fe_rollers")
+    lines += [
+        "",
+        f"  peak von Mises {summary['peak_von_mises_MPa']:.0f} MPa at ({at['x_mm']:.1f}, {at['y_mm']:.1f}) mm, "
+        f"{at['feature_label']}, θ = {at['theta_deg']:.1f}°"
+        + (f"; away from contacts {away['peak_von_mises_MPa']:.0f} MPa near {away['at']['feature_label']}"
+           if away else ""),
+        f"  pins in contact {summary['pins_in_contact']['min']}–{summary['pins_in_contact']['max']} of "
+        f"{summary['pins_in_contact']['of']}; torsional stiffness {summary['torsional_stiffness_Nm_per_arcmin']:.1f} "
+        f"N·m/arcmin; equilibrium residual {summary['equilibrium_residual']:.1e}",
+    ]
+    sr = h["stribeck_rigid"]
+    hertz = (f"  Hertz, most loaded roller: rigid Stribeck Q = {sr['roller_load_N']:.0f} N, p_in "
+             f"{sr['inner']['peak_pressure_MPa']:.0f} / p_out {sr['outer']['peak_pressure_MPa']:.0f} MPa")
+    if fe:
+        hertz += (f"; FE Q = {fe['roller_load_N']:.0f} N, p_in {fe['inner']['peak_pressure_MPa']:.0f} / p_out "
+                  f"{fe['outer']['peak_pressure_MPa']:.0f} MPa")
+    lines.append(hertz)
+    duty = summary.get("duty_cycle")
+    if duty:
+        lines.append("  duty cycle: service life " + ", ".join(
+            f"{key} {_num(duty[key]['service_life_h'], '.0f')} h" for key in ("rigid", "flexible"))
+            + f" (equivalent torque {duty['rigid']['equivalent_torque_Nm']:.1f} N·m, "
+              f"speed {duty['rigid']['equivalent_speed_rpm']:.2f} rpm)")
+    t = summary["timings_s"]
+    lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
+                 f"{len(summary['files'])} files")
+    return "\n".join(lines)
+
+
+def rigid_summary(result) -> dict:
+    """The rigid handbook evaluation (:class:`rvfem.analysis.RigidAnalysis`) as a JSON-ready dict
+    (what ``rvfem rigid --json`` writes). Loads in N, angles in degrees, speeds in rpm, lives in
+    hours, pressures in MPa, lengths in mm; non-finite numbers are None."""
+    case, comp = result.case, result.loads.components
+    bearings = [{
+        "bearing": b.loads.bearing + 1,
+        "crank_angle_deg": b.crank_angle_deg,
+        "max_load_N": b.loads.max_N,
+        "max_at_deg": b.loads.max_at_deg,
+        "min_load_N": b.loads.min_N,
+        "min_at_deg": b.loads.min_at_deg,
+        "equivalent_load_N": b.loads.equivalent_N,
+        "L10h_h": b.loads.L10h,
+        "max_roller_load_N": b.max_roller_load_N,
+        "hertz_inner": dataclasses.asdict(b.hertz_inner),
+        "hertz_outer": dataclasses.asdict(b.hertz_outer),
+    } for b in result.bearings]
+    report = {
+        "case": case.name,
+        "source": case.source,
+        "overrides": list(case.overrides),
+        "model": "rigid handbook (equal load sharing, zero clearance)",
+        "output_torque_Nm": case.loads.torque_Nm,
+        "disc_torque_Nmm": comp.disc_torque_Nmm,
+        "output_speed_rpm": case.loads.speed_rpm,
+        "bearing_speed_rpm": result.bearing_speed_rpm,
+        "k": comp.k,
+        "k_y": comp.k_y,
+        "sum_px_N": comp.sum_px,
+        "sum_py_N": comp.sum_py,
+        "equivalent_load_exponent": result.exponent,
+        "angle_step_deg": result.angle_step_deg,
+        "dynamic_load_rating_N": result.rating_N,
+        "stribeck_factor": result.stribeck_factor,
+        "bearings": bearings,
+    }
+    if result.duty_cycle is not None:
+        report["duty_cycle"] = dataclasses.asdict(result.duty_cycle)
+    return json_ready(report)
+
+
+def rigid_text(report: dict) -> str:
+    """The rigid handbook evaluation (a :func:`rigid_summary` dict) as a table (``rvfem rigid``)."""
+
+    p = report["equivalent_load_exponent"]
+    p_text = "10/3" if math.isclose(p, 10.0 / 3.0) else f"{p:g}"
+    lines = [
+        f"Case {report['case']} ({report['source']}): {report['model']}",
+        f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {report['disc_torque_Nmm'] / 1000:g} N·m, "
+        f"output speed {report['output_speed_rpm']:g} rpm, bearing speed {report['bearing_speed_rpm']:g} rpm",
+        f"  k = {report['k']:.4f}, k_y = {report['k_y']:.4f}, ΣPx = {report['sum_px_N']:.1f} N, "
+        f"ΣPy = {report['sum_py_N']:.1f} N, crank-angle step {report['angle_step_deg']:g}°",
+        f"  dynamic load rating C = {report['dynamic_load_rating_N']:.1f} N; equivalent load exponent p = {p_text}",
+    ]
+    if report.get("overrides"):
+        lines.append(f"  overrides: {', '.join(report['overrides'])}")
+    header = (f"{'bearing':>7} {'max N':>9} {'at °':>6} {'min N':>9} {'at °':>6} {'F_m N':>9} "
+              f"{'L10h h':>9} {'Q_max N':>8} {'p_in MPa':>9} {'p_out MPa':>9}")
+    lines += ["", header, "-" * len(header)]
+    for b in report["bearings"]:
+        lines.append(
+            f"{b['bearing']:>7d} {b['max_load_N']:9.1f} {b['max_at_deg']:6.1f} {b['min_load_N']:9.1f} "
+            f"{b['min_at_deg']:6.1f} {b['equivalent_load_N']:9.1f} {_num(b['L10h_h'], '9.0f')} "
+            f"{b['max_roller_load_N']:8.1f} {b['hertz_inner']['peak_pressure_MPa']:9.1f} "
+            f"{b['hertz_outer']['peak_pressure_MPa']:9.1f}")
+    lines += [
+        "",
+        "  at °: crank angle θ of the eccentric relative to the carrier; F_m = (mean F^p)^(1/p) over a turn",
+        f"  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Hertz at Q_max = {report['stribeck_factor']:g}·F_max/Z "
+        "(p_in: eccentric, p_out: disc bore)",
+    ]
+    duty = report.get("duty_cycle")
+    if duty:
+        lines.append(
+            f"  duty cycle: equivalent torque {duty['equivalent_torque_Nm']:.1f} N·m, equivalent speed "
+            f"{duty['equivalent_speed_rpm']:.2f} rpm, service life {_num(duty['service_life_h'], '.0f')} h "
+            f"(from the shortest rated life {_num(duty['rated_life_h'], '.0f')} h)")
+    return "\n".join(lines)
