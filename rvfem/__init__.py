@@ -1,6 +1,6 @@
 """rvfem: crank-bearing loads of RV reducers with a flexible cycloid disc.
 
-The package is a set of plain functions over plain data (see the design notes): a validated
+The package is a set of plain functions over plain data (see docs/theory.md): a validated
 :class:`~rvfem.case.Case` goes in, tables of bearing loads, lives and stresses come out. Units are
 mm, N, MPa, rpm and hours throughout; angles are radians inside the code and degrees in case files.
 """

@@ -71,6 +71,7 @@ STAGES: dict[str, str] = {
     "rigid": "rigid handbook model",
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
+    "attribution": "attribution: the reducer-stage models step by step",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
 reports)."""
@@ -472,6 +473,10 @@ class Analysis:
     timings : dict
         Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*`` and
         ``cycle_per_angle``.
+    attribution : rvfem.reducer.Attribution
+        The flexibility effect step by step: handbook → equal share of the FE pin resultant →
+        one disc with T/discs → two discs sharing the carrier → crankshafts (those that apply);
+        ``attribution.final`` is the case's own model (``cycle``).
     """
 
     case: Case
@@ -489,6 +494,7 @@ class Analysis:
     torsional_stiffness_Nm_per_arcmin: float
     duty_cycle: DutyCycleResult | None = None
     timings: dict = field(default_factory=dict)
+    attribution: Any = None
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -558,7 +564,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     CaseError, GeometryError, MeshError, ContactError
         From the stages.
     """
-    from . import compare, postprocess
+    from . import compare, postprocess, reducer
     from . import cycle as cycle_module
     from .geometry import disc_geometry
     from .mesh import mesh_case
@@ -627,10 +633,17 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
     stages.end("evaluation", t)
 
+    # what the flexibility effect is made of: the modelling steps the case's own model does not
+    # already give, on the same angles and the same compliance
+    t = stages.start("attribution")
+    attribution = reducer.attribution(system, thetas, cycles={reducer.case_step(case): cycle})
+    stages.end("attribution", t)
+
     timings = dict(stages.seconds)
     timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
     timings["cycle_per_angle"] = stages.seconds["cycle"] / n
     return Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
                     theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
                     comparison=comparison, stress=stress, hertz=roller_hertz,
-                    torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings)
+                    torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
+                    attribution=attribution)

@@ -1,6 +1,6 @@
 """Contact solve on the condensed disc: pins, crank-bearing rollers and the carrier rotation.
 
-The model (project design notes §4) in the disc's body frame:
+The model (docs/theory.md) in the disc's body frame:
 
 * The disc is a 2D plane-stress body; its stiffness K never changes with the crank angle θ.
 * Every load that can act on the disc enters through a fixed **footprint grid** on its boundary:
@@ -10,7 +10,7 @@ The model (project design notes §4) in the disc's body frame:
   radially outward from the bore centre, i.e. into the disc material). A contact between grid points
   shares its force between the two neighbouring columns (linear interpolation), so its load and
   its displacement are work-conjugate.
-* **Condensation** (design notes §8): the compliance of the disc between grid columns,
+* **Condensation** (docs/theory.md): the compliance of the disc between grid columns,
   C = Bᵀ K_s⁻¹ B, is computed lazily, column by column, the first time a column carries load, and
   reused for every later crank angle. K_s is K with a statically determinate 3-DOF support; for the
   self-equilibrated loads the contact problem produces, it differs from the floating disc only by
@@ -45,7 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .errors import ContactError
-from .evaluation import PALMGREN_COEFFICIENT
+from .hertz import PALMGREN_COEFFICIENT
 
 log = logging.getLogger(__name__)
 

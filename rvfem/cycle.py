@@ -33,7 +33,6 @@ from .errors import CaseError
 from .geometry import crank_centres
 from .models import roller_angles
 
-bore_centres = crank_centres  # kept for the callers of rvfem 0.1 (to be removed)
 
 log = logging.getLogger(__name__)
 

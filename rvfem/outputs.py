@@ -403,6 +403,36 @@ def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
                            "flexible": dataclasses.asdict(a.duty_cycle.flexible)}}
 
 
+def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
+    from .reducer import crankshaft_influence
+
+    cy, case = a.cycle, a.case
+    share = None
+    disc_b = None
+    if cy.disc_torque_Nmm is not None and cy.disc_torque_Nmm.shape[1] == 2:
+        s = cy.disc_torque_Nmm[:, 0] / case.loads.disc_torque_Nmm
+        share = {"min": float(s.min()), "max": float(s.max())}
+        disc_b = float(np.linalg.norm(cy.disc_bearing_forces[:, 1], axis=-1).max())
+    f = crankshaft_influence(case) if a.attribution.final == "crankshafts" else None
+    w = cy.eccentric_displacement
+    return {"reducer_stage": {
+        "model": cy.stage,
+        "step": a.attribution.final,
+        "crank_support_rigid": f is None,
+        "torque_share": share,
+        "disc_b_max_load_N": disc_b,
+        "crankshaft_influence_mm_per_N": None if f is None else f.tolist(),
+        "eccentric_displacement_max_mm": None if (w is None or f is None) else float(np.linalg.norm(w, axis=-1).max()),
+    }}
+
+
+def _piece_attribution(a, ctx: SummaryContext) -> dict:
+    rows = a.attribution.table(a.case.analysis.equivalent_load_exponent)
+    for r in rows:
+        r["final"] = r["step"] == a.attribution.final
+    return {"attribution": rows}
+
+
 def _image_key(rel: str) -> str:
     return Path(rel).stem
 
@@ -435,6 +465,8 @@ SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_stress,
     _piece_hertz,
     _piece_duty_cycle,
+    _piece_reducer_stage,
+    _piece_attribution,
     _piece_files,
 )
 """The pieces of ``summary.json`` in order: each ``piece(analysis, context) -> dict`` of top-level
@@ -698,6 +730,16 @@ def summary_text(summary: dict) -> str:
         lines.append(f"  {'':>7} {'delta':<9} {_num(b['delta_max_percent'], '+7.1f')}% {'':>6} "
                      f"{_num(b['delta_min_percent'], '+7.1f')}% {'':>6} {_num(b['delta_equivalent_percent'], '+7.1f')}%  "
                      f"life ratio {_num(b['life_ratio'], '.2f')}")
+    rs = summary["reducer_stage"]
+    lines += ["", f"  reducer stage: {rs['model']}"]
+    if rs["torque_share"]:
+        lines[-1] += (f"; torque of disc A {rs['torque_share']['min']:.3f}–{rs['torque_share']['max']:.3f} × T/2")
+    lines.append(f"  what the delta of bearing 1 is made of (against the handbook):")
+    for r in summary["attribution"]:
+        if r["bearing"] == 1:
+            lines.append(f"    {r['step']:<12} max {_num(r['delta_max_percent'], '+6.1f')}%  min "
+                         f"{_num(r['delta_min_percent'], '+6.1f')}%  F_m {_num(r['delta_equivalent_percent'], '+6.1f')}%"
+                         f"  life ratio {_num(r['life_ratio'], '.2f')}" + ("   <- this run" if r["final"] else ""))
     at = summary["peak_von_mises_at"]
     away = summary["stress"]["away_from_contacts"]
     h = summary["hertz"]

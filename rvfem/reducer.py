@@ -70,6 +70,10 @@ __all__ = [
     "solve_pair",
     "solve_stage_cycle",
     "SECOND_DISC_MODELS",
+    "Attribution",
+    "AttributionStep",
+    "attribution",
+    "case_step",
 ]
 
 SECOND_DISC_MODELS = ("same_as_first", "half_pitch")
@@ -404,7 +408,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
 
     With :attr:`ReducerStage.mirrored_pairs` and an even number of uniformly spaced angles, only
     the first half of the angles is solved: the pair at θ + 180° is the pair at θ with the discs
-    swapped.
+    swapped. ``progress(done, n)`` counts the crank angles of disc A obtained so far.
 
     Returns
     -------
@@ -432,11 +436,12 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
     log.info("stage compliance prefetch %.2f s", time.perf_counter() - t0)
     pairs: list[PairResult] = []
     prev = None
+    per_solve = 2 if mirrored else 1               # crank angles of disc A each pair solve gives
     for i, th in enumerate(solve_at):
         prev = solve_pair(stage, float(th), prev)
         pairs.append(prev)
         if progress is not None:
-            progress(i + 1, len(solve_at))
+            progress(min(per_solve * (i + 1), n), n)
     if mirrored:
         order = [(j, 0) for j in range(half)] + [(j, 1) for j in range(half)]
     else:
@@ -556,7 +561,8 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     case = system.case
     cycles = dict(cycles or {})
     need = ["one_disc"]
-    if case.loads.discs == 2:
+    discs = 2 if case.loads.discs == 2 else 1
+    if discs == 2:
         need.append("two_discs")
     f = crankshaft_influence(case)
     if f is not None:
@@ -567,7 +573,7 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
         if key == "one_disc":
             stage = None
         else:
-            stage = build_stage(system, discs=2, influence=f if key == "crankshafts" else None)
+            stage = build_stage(system, discs=discs, influence=f if key == "crankshafts" else None)
         cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
     steps = [AttributionStep("handbook", STEP_LABELS["handbook"],
                              handbook_bearing_loads(case, thetas).magnitude)]
@@ -575,5 +581,15 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     steps.append(AttributionStep("equal_share", STEP_LABELS["equal_share"], share))
     for key in need:
         steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
-    final = need[-1] if case.loads.torque_split == "stiffness" or case.loads.discs == 1 else "one_disc"
-    return Attribution(np.asarray(thetas), tuple(steps), final)
+    return Attribution(np.asarray(thetas), tuple(steps), case_step(case))
+
+
+def case_step(case) -> str:
+    """The attribution step that is the case's own model: ``one_disc`` (one disc with T/discs on
+    rigid eccentrics: ``torque_split = "equal"``, or one disc without ``[crank_support]``),
+    ``two_discs`` (two discs on rigid eccentrics) or ``crankshafts``."""
+    if case.loads.discs > 1 and case.loads.torque_split == "equal":
+        return "one_disc"
+    if case.crank_support is not None:
+        return "crankshafts"
+    return "two_discs" if case.loads.discs == 2 else "one_disc"

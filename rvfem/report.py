@@ -81,21 +81,19 @@ def _table(header: list[str], rows: list[list[Any]], left: int = 1, classes: lis
 
 def assumptions(summary: dict, case: Case) -> list[str]:
     """The modelling assumptions of a run, as sentences (HTML-escaped text)."""
+    from .registry import bearing_model, pin_model
+
     m = summary["model"]
-    b = case.crank_bearing
-    if m["bearing_model"] == "rollers":
-        law = ("Palmgren line-contact law δ = 3.84·10⁻⁵·Q^0.9/L^0.8 per raceway, both raceways"
-               if b.stiffness_law == "palmgren" else f"linear stiffness {b.linear_stiffness_N_per_mm:g} N/mm")
-        bearing = (f"Crank bearings: bearing model <b>rollers</b> — {b.rollers} discrete compression-only roller "
-                   f"springs per bearing along their radial lines ({_e(law)}), radial clearance "
-                   f"{b.radial_clearance:g} mm, rollers positioned by the cage angle at each θ, each roller force "
-                   "spread over a short footprint of the bore.")
-    else:
-        bearing = (f"Crank bearings: bearing model <b>rigid_bore</b> — each bore tied to a rigid ring with one "
-                   f"isotropic bearing spring of {b.rigid_bore_stiffness_N_per_mm:g} N/mm (no discrete rollers, "
-                   "so no FE roller loads; Hertz only from the Stribeck estimate).")
-    pin = ("rigid pins (Signorini contact: gap ≥ 0, force ≥ 0)" if m["pin_model"] == "rigid"
-           else "pins with Hertz line-contact compliance")
+    # each model states its own assumptions (rvfem.models)
+    bearing = (f"Crank bearings: bearing model <b>{_e(m['bearing_model'])}</b> — "
+               f"{_e(bearing_model(m['bearing_model'])(case).describe())}.")
+    if m["bearing_model"] != "rollers":
+        bearing += " No discrete rollers, so no FE roller loads; Hertz only from the Stribeck estimate."
+    try:
+        pin = _e(pin_model(m["pin_model"])(case).describe())
+    except Exception:   # a validation-only pin model needs its stiffness: name it only
+        pin = f"pin model {_e(m['pin_model'])}"
+    rs = summary["reducer_stage"]
     overrides = summary["case"].get("overrides") or {}
     stated = ([f"Values set on top of the case file (overrides): "
                f"{', '.join(f'{_e(k)} = {_e(v)}' for k, v in overrides.items())}; case.json holds every value used."]
@@ -105,9 +103,19 @@ def assumptions(summary: dict, case: Case) -> list[str]:
         f"E = {case.material.youngs_modulus:g} MPa, ν = {case.material.poissons_ratio:g}), "
         f"P{m['element_order']} triangles; the disc stiffness is factorised once and each crank angle is "
         "solved on the condensed contact and roller unknowns.",
-        f"Torque convention: each of the {m['discs']} discs carries T_disc = T_out/{m['discs']} = "
-        f"{m['disc_torque_Nmm'] / 1000:g} N·m, applied as the moment of the pin forces about the <b>disc centre</b> "
-        "(the handbook's ΣP_x = T/(2·e·Zc)). About the reducer axis the moment differs by Zp/Zc "
+        f"Reducer stage: <b>{_e(rs['model'])}</b>. "
+        + ("Disc A is solved at θ together with disc B at θ + 180°; one carrier rotation, so the output torque "
+           f"divides between the discs by their stiffness (disc A carries {rs['torque_share']['min']:.3f}–"
+           f"{rs['torque_share']['max']:.3f} × T/2 over the cycle). " if rs["torque_share"] else
+           f"Each of the {m['discs']} discs carries T_disc = T_out/{m['discs']} = {m['disc_torque_Nmm'] / 1000:g} N·m "
+           "(the handbook's equal share). ")
+        + ("The eccentrics are rigid: the flexibility effect reported is an <b>upper bound</b>."
+           if rs["crank_support_rigid"] else
+           "Each crankshaft is a beam on two elastic support bearings (case table crank_support) carrying both "
+           "discs' eccentrics; the eccentrics move relative to the carrier by its influence matrix times the "
+           "bearing forces."),
+        "Torque convention: a disc's torque is the moment of its pin forces about the <b>disc centre</b> "
+        "(the handbook's ΣP_x = T/(2·e·Zc) for T/2). About the reducer axis the moment differs by Zp/Zc "
         f"({100 * (case.pins.count / case.cycloid.teeth - 1):.1f} % here).",
         f"Pins: {pin}; " + (f"Coulomb friction μ = {case.analysis.friction:g} along the sliding direction."
                              if case.analysis.friction > 0 else "no friction (μ = 0)."),
@@ -246,6 +254,17 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
                                   f"{summary['active_set_iterations']['mean']:.1f}"],
     ]
     parts.append("<h2>Other results</h2>" + _table(["quantity", "value"], other, left=2))
+
+    rows = [[r["step"] + (" (this run)" if r["final"] else ""), r["bearing"], _num(r["max_N"], ".0f"),
+             _num(r["delta_max_percent"], "+.1f"), _num(r["min_N"], ".0f"), _num(r["delta_min_percent"], "+.1f"),
+             _num(r["equivalent_N"], ".0f"), _num(r["delta_equivalent_percent"], "+.1f"), _num(r["life_ratio"], ".3f")]
+            for r in summary["attribution"]]
+    labels = dict.fromkeys((r["step"], r["label"]) for r in summary["attribution"])
+    parts.append(
+        "<h2>What the flexibility delta is made of</h2><p>Each step adds one modelling effect, on the same "
+        "crank angles and the same disc model; deltas are against the handbook. "
+        + "; ".join(f"<b>{_e(k)}</b>: {_e(v)}" for k, v in labels) + ".</p>"
+        + _table(["step", "bearing", "max N", "Δmax %", "min N", "Δmin %", "F_m N", "ΔF_m %", "life ratio"], rows))
 
     h = summary["hertz"]
     hrows = []

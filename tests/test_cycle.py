@@ -112,7 +112,7 @@ def test_equilibrium_closes_to_round_off(solid_cycle):
     case, system, result = solid_cycle
     assert result.equilibrium_residual.max() < 1e-9
     # carrier: the bearings' moment about the disc centre is the disc torque at every angle
-    c = cycle.bore_centres(case)
+    c = cycle.crank_centres(case)
     moment = (c[None, :, 0] * result.bearing_forces[..., 1] - c[None, :, 1] * result.bearing_forces[..., 0]).sum(axis=1)
     assert np.allclose(moment, case.loads.disc_torque_Nmm, rtol=1e-9)
     # pins + bearings of one solution: no net force and no net moment on the disc
