@@ -224,13 +224,38 @@ def test_pin_forces_act_through_the_pitch_point_on_the_loaded_half(crv80e):
     # pushing from the pin centre towards P
     dot = (px - pins.x) * pins.fx + (py - pins.y) * pins.fy
     assert np.all(dot >= 0)
-    loaded = pins.magnitude > 0
-    np.testing.assert_array_equal(loaded, np.sin(pins.phi) > 0)
-    assert np.all(loaded.sum(axis=0) == crv80e.pins.count // 2)
+    # which pins push: those on the half of the pin circle with 0 < φ < π, φ measured from the
+    # eccentricity direction about the pin-circle centre (taken here from the pin positions)
+    e_x, e_y = -e * np.cos(theta), -e * np.sin(theta)               # pin-circle centre
+    phi = np.mod(np.arctan2(pins.y - e_y, pins.x - e_x) - theta, 2 * np.pi)
+    on_loaded_half = (phi > 1e-9) & (phi < np.pi - 1e-9)
+    loaded = pins.magnitude > 1e-9 * pins.f_max
+    np.testing.assert_array_equal(loaded, on_loaded_half)
+    assert np.all((pins.magnitude <= 2e-16 * pins.f_max)[~loaded])   # measured 7.0e-17·F_max (φ = π)
     np.testing.assert_allclose(np.hypot(pins.fx, pins.fy), pins.magnitude, rtol=1e-13)
     # pins sit on the pin circle, whose centre is at −e·u from the disc centre
     np.testing.assert_allclose(np.hypot(pins.x + e * np.cos(theta), pins.y + e * np.sin(theta)),
                                crv80e.pins.circle_radius, rtol=1e-14)
+
+
+def test_about_half_the_pins_are_loaded(crv80e):
+    """Classically (zero clearance, rigid disc, unmodified profile) a pin pushes on the disc only
+    on the half of the pin circle where the disc's rolling motion about the pitch point closes the
+    contact: 0 < φ < π measured from the eccentricity direction. The two pins on the line of
+    centres (φ = 0 and φ = π) touch but carry nothing: their line of action through the pitch point
+    runs through the disc centre, so it cannot transmit torque. With Zp = 40 pins that is 20
+    loaded pins at a generic crank angle, and 19 when the ring puts a pin exactly on the line of
+    centres (θ·Zc/Zp a multiple of the pin pitch 2π/Zp, e.g. θ = 0), never more than Zp/2."""
+    zp, zc = crv80e.pins.count, crv80e.cycloid.teeth
+    pitch = 2 * np.pi / zp
+    # φ_j = 2πj/Zp − θ(1 − (Zp − Zc)/Zp): a pin lies on the line of centres when θ·Zc/Zp is a
+    # multiple of the pin pitch
+    on_line = np.array([0.0, pitch * zp / zc, 2 * pitch * zp / zc])
+    generic = on_line + 0.37 * pitch * zp / zc
+    for theta, expected in ((on_line, zp // 2 - 1), (generic, zp // 2)):
+        pins = classical_pin_forces(crv80e, theta)
+        count = np.sum(pins.magnitude > 1e-9 * pins.f_max, axis=0)
+        np.testing.assert_array_equal(count, expected)
 
 
 def test_pin_force_peak_follows_the_textbook_amplitude(crv80e):
