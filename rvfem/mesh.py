@@ -55,7 +55,6 @@ __all__ = [
     "mesh_geometry",
     "read_msh",
     "mesh_preview_png",
-    "to_skfem",
     "QUALITY_MEASURE",
 ]
 
@@ -516,31 +515,3 @@ def mesh_preview_png(mesh: DiscMesh, path: str | os.PathLike, *, title: str | No
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     fig.savefig(path, dpi=dpi)
     return path
-
-
-def to_skfem(mesh: DiscMesh, named_boundaries: bool = True):
-    """The mesh as a scikit-fem ``MeshTri`` (p (2, n) and t (3, m), C-contiguous).
-
-    With ``named_boundaries`` the boundaries are attached as facet index sets under their names
-    (``m.boundaries["bore_0"]``…). scikit-fem may reorder the nodes of each triangle; node indices
-    are those of ``mesh.points``.
-    """
-    from skfem import MeshTri
-
-    m = MeshTri(np.ascontiguousarray(mesh.points.T, dtype=np.float64),
-                np.ascontiguousarray(mesh.triangles.T, dtype=np.int64))
-    if not named_boundaries:
-        return m
-    f = np.sort(m.facets, axis=0)
-    n = m.p.shape[1]
-    keys = f[0].astype(np.int64) * n + f[1]
-    order = np.argsort(keys)
-    skeys = keys[order]
-    named = {}
-    for name, e in mesh.boundaries.items():
-        ek = np.minimum(e[:, 0], e[:, 1]) * n + np.maximum(e[:, 0], e[:, 1])
-        pos = np.searchsorted(skeys, ek)
-        if np.any(pos >= len(skeys)) or np.any(skeys[np.minimum(pos, len(skeys) - 1)] != ek):
-            raise MeshError(f"boundary {name!r} has edges that are not mesh facets")
-        named[name] = order[pos]
-    return m.with_boundaries(named)

@@ -286,7 +286,7 @@ def test_build_model_rejects_bad_input():
         fem.build_model(pts, tris, E, 0.5, THICK)
 
 
-def test_vertex_dofs_and_p2_midpoint_nodes():
+def test_node_numbering_vertices_first_then_p2_midpoints():
     pts, tris, _, _ = annulus(5.0, 9.0, 2, 12)
     m1 = fem.build_model(pts, tris, E, NU, THICK, 1)
     m2 = fem.build_model(pts, tris, E, NU, THICK, 2)
