@@ -152,11 +152,13 @@ def test_pin_centres_ring_offset_and_rotation(solid):
         c = pin_centres(solid, theta)
         assert c.shape == (zp, 2)
         centre = c.mean(axis=0)
-        np.testing.assert_allclose(centre, [-e * math.cos(theta), -e * math.sin(theta)], rtol=0, atol=2e-14)  # measured 6.9e-15 mm
+        # measured 6.9e-15 mm
+        np.testing.assert_allclose(centre, [-e * math.cos(theta), -e * math.sin(theta)], rtol=0, atol=2e-14)
         rel = c[0] - centre
         assert math.hypot(*rel) == pytest.approx(Rp, abs=3e-14)      # measured 1.4e-14 mm
         turned = math.atan2(rel[1], rel[0])
-        assert math.remainder(turned - theta * (zp - zc) / zp, 2 * math.pi) == pytest.approx(0, abs=2e-16)  # measured 8.6e-17 rad
+        # measured 8.6e-17 rad
+        assert math.remainder(turned - theta * (zp - zc) / zp, 2 * math.pi) == pytest.approx(0, abs=2e-16)
     # θ = 0: pin 0 sits deepest in the tooth space on the +x axis, at Rp − e
     np.testing.assert_allclose(pin_centres(solid, 0.0)[0], [Rp - e, 0.0], rtol=0, atol=1e-14)   # measured 0
 
@@ -298,7 +300,8 @@ def test_rotation_modification_rotates_the_profile(solid):
     # the roots (minimum radius, where s = 0) moved by +0.05°
     zc = solid.cycloid.teeth
     roots = np.angle(z1[np.isclose(np.abs(z1), np.abs(z1).min(), atol=1e-12, rtol=0)])
-    np.testing.assert_allclose(np.mod(roots - d + np.pi / zc, 2 * np.pi / zc) - np.pi / zc, 0, atol=3e-15)   # measured 9.7e-16 rad
+    # measured 9.7e-16 rad
+    np.testing.assert_allclose(np.mod(roots - d + np.pi / zc, 2 * np.pi / zc) - np.pi / zc, 0, atol=3e-15)
     # turning the profile counter-clockwise at θ = 0 presses the flanks into the pins on one side
     # of the eccentric line and opens the gaps on the other
     pc = pin_profile_contacts(disc_geometry(with_modification(solid, rotation_deg=0.05)), 0.0)
@@ -409,7 +412,8 @@ def test_fan_holes_from_ligament(fan):
     geom = disc_geometry(fan)
     assert [h.name for h in geom.holes] == ["hole_0", "hole_1", "hole_2"]
     # centred between the cranks (90°, 210°, 330°) → 150°, 270°, 30°
-    np.testing.assert_allclose(np.degrees([h.centre_angle for h in geom.holes]) % 360, [150, 270, 30], atol=1.5e-13)  # measured 5.7e-14°
+    np.testing.assert_allclose(np.degrees([h.centre_angle for h in geom.holes]) % 360, [150, 270, 30],
+                               atol=1.5e-13)                               # measured 5.7e-14°
     # the straight side is nearest the bore: r0·sin(Δ) − R_b = ligament, Δ = 60° − half span
     r0, rb, lig = 36.0, 18.0, 4.5
     expected_half = math.radians(60.0) - math.asin((rb + lig) / r0)

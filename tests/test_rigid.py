@@ -107,7 +107,8 @@ def test_exact_extremes_bound_the_sampled_curve(crv80e):
     alpha0 = math.radians(crv80e.cranks.angles_deg[0])
     at_max = handbook_bearing_loads(crv80e, beta_max + alpha0).magnitude[0, 0]
     at_min = handbook_bearing_loads(crv80e, beta_min + alpha0).magnitude[0, 0]
-    assert (at_max, at_min) == (pytest.approx(f_max, rel=3e-16), pytest.approx(f_min, rel=5e-16))   # measured 1.1e-16, 2.2e-16
+    # measured 1.1e-16, 2.2e-16
+    assert (at_max, at_min) == (pytest.approx(f_max, rel=3e-16), pytest.approx(f_min, rel=5e-16))
 
 
 # --------------------------------------------------------------------------------------------

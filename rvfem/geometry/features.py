@@ -1,11 +1,21 @@
 """The disc's features (holes and bores), the Feature protocol and the checked DiscGeometry.
 
+Everything is in the disc's body frame (origin at the disc centre), lengths mm, angles radians.
+
 Features
 --------
 A central hole, N crank-bearing bores (radius ``crank_bearing.bore_radius``) at r0·u(α_i), optional
-fan-shaped holes (annular sectors with filleted corners) and round holes. :func:`disc_geometry`
-builds a :class:`DiscGeometry` and checks it (undercut, overlaps, thin walls) before anything is
-meshed; every problem is a :class:`~rvfem.errors.GeometryError` that says what to change.
+fan-shaped holes (annular sectors with filleted corners) and round holes. Every one of them is a
+:class:`Feature`: a name, a closed outline of lines and arcs, an exact signed distance, samples, an
+exact area and a self-check. :class:`Circle` and :class:`FanHole` implement it; a new hole shape is
+one more frozen dataclass with the same members, and neither the checks here nor the mesher
+(:mod:`rvfem.mesh`) need to know its type.
+
+:func:`disc_geometry` builds a :class:`DiscGeometry` and checks it (undercut, overlaps, thin walls)
+before anything is meshed; every problem is a :class:`~rvfem.errors.GeometryError` that says what
+to change. Areas follow from Green's theorem over the outline, ½∮(x dy − y dx); walls are the
+minimum of the exact signed distance of one feature over dense samples of the other's outline
+(docs/theory.md, "Features").
 """
 
 from __future__ import annotations

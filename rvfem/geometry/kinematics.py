@@ -6,8 +6,8 @@ and the pins move around it. Lengths are mm, angles radians.
 Kinematics
 ----------
 The crank angle θ is the angle of the eccentric relative to the carrier, counted counter-clockwise
-(docs/theory.md, "Kinematics"). The disc is carried by the cranks, so it translates with the eccentric but keeps
-the carrier's orientation. With the pin housing fixed, its pin ``j`` at ``Rp·u(2πj/Zp)`` (pin 0 on
+(docs/theory.md, "Kinematics"). The disc is carried by the cranks, so it translates with the
+eccentric but keeps the carrier's orientation. With the pin housing fixed, its pin ``j`` at ``Rp·u(2πj/Zp)`` (pin 0 on
 the housing's x axis), the disc centre at ``e·u(β)`` and the disc turned by ψ, the rolling condition
 of the internal gear pair relative to the eccentric gives ψ = −β·(Zp − Zc)/Zc, and θ = β − ψ =
 β·Zp/Zc. Expressing the pin centres in the disc frame, ``R(−ψ)·(p_j − e·u(β))``, gives
