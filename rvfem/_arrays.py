@@ -1,4 +1,4 @@
-"""Small array helpers shared by the modules: read-only arrays and the ordering of mesh edges."""
+"""Small array utilities shared by the modules: read-only arrays and the ordering of mesh edges."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Shared helpers for the tests: paths of the shipped cases, a small TOML line editor, and the
+"""Shared test utilities: paths of the shipped cases, a small TOML line editor, and the
 ``slow`` marker of the end-to-end modules."""
 
 from __future__ import annotations
