@@ -65,6 +65,7 @@ import scipy.sparse.linalg as spla
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rvfem import fem  # noqa: E402
+from rvfem.fem.solve import _FACTORIZERS  # noqa: E402
 
 
 def annulus_mesh(n_vertices: int, r_in: float = 20.0, r_out: float = 90.0) -> tuple[np.ndarray, np.ndarray]:
@@ -119,7 +120,7 @@ def _factorized(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
 def solvers() -> dict[str, Callable[[sp.csc_matrix], Callable[[np.ndarray], np.ndarray]]]:
     out: dict[str, Callable] = {}
     for name in fem.available_solvers():
-        out[name] = fem._FACTORIZERS[name]
+        out[name] = _FACTORIZERS[name]
     out["superlu-colamd"] = _superlu_colamd
     out["factorized"] = _factorized
     return out

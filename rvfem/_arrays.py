@@ -1,8 +1,10 @@
-"""Small array helpers shared by the modules."""
+"""Small array utilities shared by the modules: read-only arrays and the ordering of mesh edges."""
 
 from __future__ import annotations
 
 import numpy as np
+
+from .errors import MeshError
 
 
 def readonly(a, dtype=None) -> np.ndarray:
@@ -10,3 +12,67 @@ def readonly(a, dtype=None) -> np.ndarray:
     a = np.ascontiguousarray(a, dtype=dtype)
     a.setflags(write=False)
     return a
+
+
+def chain_edges(edges) -> tuple[tuple[np.ndarray, bool], ...]:
+    """Order undirected edges into connected chains of vertices.
+
+    Parameters
+    ----------
+    edges : array_like of int
+        ``(k, 2)`` vertex pairs, any order and orientation; repeated edges count once.
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, bool)
+        One ``(vertices, closed)`` pair per connected component, sorted by their smallest vertex.
+        A closed chain (a loop) starts and ends at its smallest vertex (``vertices[0] ==
+        vertices[-1]``) and runs first towards the smaller of that vertex's two neighbours; an
+        open chain runs from its end with the smaller index to the other end. The direction is
+        therefore a convention: callers orient the chains (body on the left, say) themselves.
+
+    Raises
+    ------
+    MeshError
+        If three or more edges meet at a vertex (the edges do not form simple curves).
+    """
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    e = np.unique(np.sort(e, axis=1), axis=0)
+    e = e[e[:, 0] != e[:, 1]]
+    neighbours: dict[int, list[int]] = {}
+    for a, b in e.tolist():
+        neighbours.setdefault(a, []).append(b)
+        neighbours.setdefault(b, []).append(a)
+    branching = [v for v, n in neighbours.items() if len(n) > 2]
+    if branching:
+        raise MeshError(f"boundary branches at vertex {min(branching)} ({len(neighbours[min(branching)])} edges meet)")
+    chains = []
+    unvisited = set(neighbours)
+    while unvisited:
+        first = min(unvisited)
+        ends = [v for v in _component(neighbours, first) if len(neighbours[v]) == 1]
+        start = min(ends) if ends else first
+        seq = [start]
+        prev, cur = None, start
+        while True:
+            nxt = [v for v in sorted(neighbours[cur]) if v != prev]
+            if not nxt:                                   # the other end of an open chain
+                break
+            prev, cur = cur, nxt[0]
+            seq.append(cur)
+            if cur == start:                              # once round a loop
+                break
+        unvisited.difference_update(seq)
+        chains.append((np.asarray(seq, dtype=np.int64), bool(not ends)))
+    return tuple(chains)
+
+
+def _component(neighbours: dict[int, list[int]], start: int) -> set[int]:
+    """Vertices connected to ``start``."""
+    seen, todo = {start}, [start]
+    while todo:
+        for w in neighbours[todo.pop()]:
+            if w not in seen:
+                seen.add(w)
+                todo.append(w)
+    return seen

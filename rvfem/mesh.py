@@ -20,7 +20,9 @@ first, then round holes) and the surface ``disc``.
 Cache: the ``.msh`` is written to ``cache_dir/<case name>-<key>.msh`` where ``key`` hashes only the
 inputs that shape the mesh (profile and feature geometry, mesh sizes, the mesher version); loads,
 material, thickness and analysis options do not invalidate it. A cached file is read back through
-Gmsh, so a cache hit returns exactly the arrays a fresh mesh would.
+Gmsh, so a cache hit returns exactly the arrays a fresh mesh would. Files appear atomically (a
+unique temporary file in the cache folder, then :func:`os.replace`), so processes that build the
+same mesh at the same time never see or leave a partial file.
 
 Gmsh's global state is only ever touched inside :func:`gmsh_session`.
 """
@@ -32,16 +34,17 @@ import hashlib
 import json
 import math
 import os
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import gmsh
 import numpy as np
 
+from ._arrays import chain_edges
 from .case import Case, case_to_dict
 from .errors import MeshError
-from .geometry import (SPLINE_POINTS_PER_SEGMENT, Arc, Circle, DiscGeometry, FanHole, LineSegment,
-                       disc_geometry)
+from .geometry import SPLINE_POINTS_PER_SEGMENT, Arc, DiscGeometry, Feature, LineSegment, disc_geometry
 
 __all__ = [
     "DiscMesh",
@@ -52,7 +55,6 @@ __all__ = [
     "mesh_geometry",
     "read_msh",
     "mesh_preview_png",
-    "to_skfem",
     "QUALITY_MEASURE",
 ]
 
@@ -215,13 +217,16 @@ def _add_point(g, xy) -> int:
     return g.model.occ.addPoint(float(xy[0]), float(xy[1]), 0.0)
 
 
-def _add_outline(g, feature) -> list[int]:
-    """Curves of one hole outline; returns the curve tags (in order)."""
+def _add_outline(g, feature: Feature) -> list[int]:
+    """Curves of one hole outline (:meth:`~rvfem.geometry.Feature.outline`); returns the curve tags
+    in order. A full circle becomes one OCC circle; otherwise consecutive primitives share their
+    end points, and arcs are split into pieces below 135° (OCC arcs must be below π)."""
     occ = g.model.occ
-    if isinstance(feature, Circle):
-        return [occ.addCircle(feature.centre[0], feature.centre[1], 0.0, feature.radius)]
-    assert isinstance(feature, FanHole)
-    prims = feature.primitives()
+    prims = feature.outline()
+    if len(prims) == 1 and isinstance(prims[0], Arc) and prims[0].sweep >= 2 * math.pi:
+        c = prims[0]
+        return [occ.addCircle(c.centre[0], c.centre[1], 0.0, c.radius,
+                              angle1=c.start_angle, angle2=c.start_angle + c.sweep)]
     # shared end points: the start of every primitive (closed loop)
     starts = [_add_point(g, p.start) for p in prims]
     tags = []
@@ -229,8 +234,7 @@ def _add_outline(g, feature) -> list[int]:
         a, b = starts[i], starts[(i + 1) % len(prims)]
         if isinstance(p, LineSegment):
             tags.append(occ.addLine(a, b))
-        else:
-            assert isinstance(p, Arc)
+        elif isinstance(p, Arc):
             n = max(1, int(math.ceil(abs(p.sweep) / (0.75 * math.pi))))  # arcs below π
             c = _add_point(g, p.centre)
             prev = a
@@ -238,6 +242,8 @@ def _add_outline(g, feature) -> list[int]:
                 nxt = b if k == n else _add_point(g, p.point(p.start_angle + p.sweep * k / n))
                 tags.append(occ.addCircleArc(prev, c, nxt))
                 prev = nxt
+        else:
+            raise MeshError(f"{feature.name}: cannot mesh an outline piece of type {type(p).__name__}")
     return tags
 
 
@@ -294,9 +300,7 @@ def _build_model(g, geom: DiscGeometry) -> dict[str, list[int]]:
     fields.append(_threshold(g, bore_curves, ms.size_bore, hmax,
                              max(20, int(math.ceil(4 * 2 * math.pi * geom.bores[0].radius / ms.size_bore)))))
     other = [c for f in (geom.central_hole,) + geom.holes for c in groups[f.name]]
-    longest = max(2 * math.pi * geom.central_hole.radius,
-                  *[h.outer_radius * 2 * h.half_span if isinstance(h, FanHole) else 2 * math.pi * h.radius
-                    for h in geom.holes] or [0.0])
+    longest = max(f.sampling_length for f in (geom.central_hole,) + geom.holes)
     fields.append(_threshold(g, other, h_hole, hmax, max(20, int(math.ceil(4 * longest / h_hole)))))
     fmin = g.model.mesh.field.add("Min")
     g.model.mesh.field.setNumbers(fmin, "FieldsList", fields)
@@ -318,32 +322,6 @@ def _build_model(g, geom: DiscGeometry) -> dict[str, list[int]]:
 # ------------------------------------------------------------------------------------------------
 # Reading the mesh out of Gmsh
 # ------------------------------------------------------------------------------------------------
-
-
-def _chain(edges: np.ndarray, name: str) -> np.ndarray:
-    """Order undirected edges into one closed loop; returns the node sequence."""
-    nbr: dict[int, list[int]] = {}
-    for a, b in edges:
-        nbr.setdefault(int(a), []).append(int(b))
-        nbr.setdefault(int(b), []).append(int(a))
-    bad = [n for n, v in nbr.items() if len(v) != 2]
-    if bad:
-        raise MeshError(f"boundary {name!r} is not a closed curve ({len(bad)} nodes with ≠ 2 edges)")
-    start = min(nbr)
-    order = [start]
-    prev, cur = None, start
-    while True:
-        a, b = nbr[cur]
-        nxt = a if a != prev else b
-        if nxt == start:
-            break
-        order.append(nxt)
-        prev, cur = cur, nxt
-        if len(order) > len(edges):
-            break
-    if len(order) != len(edges):
-        raise MeshError(f"boundary {name!r} is not one closed loop ({len(order)} of {len(edges)} edges)")
-    return np.asarray(order, dtype=np.int64)
 
 
 def _extract(g, path: Path, from_cache: bool) -> DiscMesh:
@@ -398,11 +376,18 @@ def _extract(g, path: Path, from_cache: bool) -> DiscMesh:
         e = index[np.concatenate(edges)]
         if np.any(e < 0):
             raise MeshError(f"{path}: boundary {name!r} has nodes that belong to no triangle")
-        loop = _chain(e, name)
+        try:
+            chains = chain_edges(e)
+        except MeshError as exc:
+            raise MeshError(f"{path}: boundary {name!r}: {exc}") from None
+        if len(chains) != 1 or not chains[0][1] or len(chains[0][0]) - 1 != len(e):
+            raise MeshError(f"boundary {name!r} is not one closed loop ({len(chains)} pieces, "
+                            f"{sum(len(c) - 1 for c, _ in chains)} of {len(e)} edges in order)")
+        loop = chains[0][0][:-1]                    # starts at the smallest node index
         xy = points[loop]
         signed = 0.5 * np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1])
         if (signed < 0) == (name == "profile"):     # profile CCW, holes CW (disc on the left)
-            loop = loop[::-1]
+            loop = np.concatenate([loop[:1], loop[:0:-1]])
         boundaries[name] = np.ascontiguousarray(np.stack([loop, np.roll(loop, -1)], axis=1))
 
     q = g.model.mesh.getElementQualities(tri_tags, QUALITY_MEASURE)
@@ -426,11 +411,18 @@ def read_msh(path: str | os.PathLike, from_cache: bool = True) -> DiscMesh:
 
 
 def mesh_geometry(geom: DiscGeometry, path: str | os.PathLike) -> DiscMesh:
-    """Mesh a checked :class:`~rvfem.geometry.DiscGeometry` and write the ``.msh`` to ``path``
-    (written to a temporary name first and renamed, so a crash never leaves a half file)."""
+    """Mesh a checked :class:`~rvfem.geometry.DiscGeometry` and write the ``.msh`` to ``path``.
+
+    The file is written under a unique temporary name in the same folder and moved into place with
+    :func:`os.replace` (atomic on POSIX and Windows), so a crash never leaves a half file, and
+    several processes meshing the same case at once each publish a complete file: a reader sees
+    either no file or a whole one (the last writer wins; the meshes are identical).
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.stem}.{os.getpid()}.tmp.msh")
+    fd, tmp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp.msh")
+    os.close(fd)
+    tmp = Path(tmp_name)
     try:
         with gmsh_session() as g:
             _build_model(g, geom)
@@ -440,10 +432,10 @@ def mesh_geometry(geom: DiscGeometry, path: str | os.PathLike) -> DiscMesh:
                 raise MeshError(f"Gmsh produced inverted or degenerate triangles "
                                 f"(min {QUALITY_MEASURE} = {mesh.min_quality:.3g})")
             g.write(str(tmp))
+        os.chmod(tmp, 0o644)                 # mkstemp creates 0600; a cache is shared
         os.replace(tmp, path)
     finally:
-        if tmp.exists():
-            tmp.unlink()
+        tmp.unlink(missing_ok=True)
     return mesh
 
 
@@ -479,7 +471,7 @@ def mesh_case(case: Case, cache_dir: str | os.PathLike = "meshes", *, use_cache:
         try:
             return read_msh(path, from_cache=True)
         except MeshError:
-            path.unlink(missing_ok=True)   # unreadable cache entry: re-mesh
+            pass     # unreadable cache entry: re-mesh; the new file replaces it atomically
     return mesh_geometry(geom, path)
 
 
@@ -504,30 +496,3 @@ def mesh_preview_png(mesh: DiscMesh, path: str | os.PathLike, *, title: str | No
                               f"min {mesh.quality_measure} = {mesh.min_quality:.3f}",
                      closeup_title="close-up: rim under bore_0 and teeth", dpi=dpi)
 
-
-def to_skfem(mesh: DiscMesh, named_boundaries: bool = True):
-    """The mesh as a scikit-fem ``MeshTri`` (p (2, n) and t (3, m), C-contiguous).
-
-    With ``named_boundaries`` the boundaries are attached as facet index sets under their names
-    (``m.boundaries["bore_0"]``…). scikit-fem may reorder the nodes of each triangle; node indices
-    are those of ``mesh.points``.
-    """
-    from skfem import MeshTri
-
-    m = MeshTri(np.ascontiguousarray(mesh.points.T, dtype=np.float64),
-                np.ascontiguousarray(mesh.triangles.T, dtype=np.int64))
-    if not named_boundaries:
-        return m
-    f = np.sort(m.facets, axis=0)
-    n = m.p.shape[1]
-    keys = f[0].astype(np.int64) * n + f[1]
-    order = np.argsort(keys)
-    skeys = keys[order]
-    named = {}
-    for name, e in mesh.boundaries.items():
-        ek = np.minimum(e[:, 0], e[:, 1]) * n + np.maximum(e[:, 0], e[:, 1])
-        pos = np.searchsorted(skeys, ek)
-        if np.any(pos >= len(skeys)) or np.any(skeys[np.minimum(pos, len(skeys) - 1)] != ek):
-            raise MeshError(f"boundary {name!r} has edges that are not mesh facets")
-        named[name] = order[pos]
-    return m.with_boundaries(named)

@@ -1,4 +1,5 @@
-"""Shared helpers for the tests: paths of the shipped cases and a small TOML line editor."""
+"""Shared test utilities: paths of the shipped cases, a small TOML line editor, and the
+``slow`` marker of the end-to-end modules."""
 
 from __future__ import annotations
 
@@ -79,3 +80,16 @@ class CaseText:
 def case_text() -> CaseText:
     """An editable copy of the shipped RV-40E case."""
     return CaseText.shipped("rv40e")
+
+
+END_TO_END_MODULES = ("test_run.py", "test_notebooks.py")
+"""Test modules that run the whole job (result folders, images, the notebook) rather than one stage
+of the science core: every test in them counts as ``slow``."""
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark the tests of :data:`END_TO_END_MODULES` ``slow`` (tests elsewhere carry the marker
+    themselves), so that ``pytest -m "not slow"`` runs the science core only."""
+    for item in items:
+        if item.path.name in END_TO_END_MODULES:
+            item.add_marker(pytest.mark.slow)

@@ -8,6 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import gmsh
@@ -18,12 +21,13 @@ from scipy.integrate import quad
 from rvfem.case import load_case
 from rvfem.errors import MeshError
 from rvfem.geometry import closest_points, disc_geometry
-from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, mesh_preview_png, read_msh, to_skfem
+from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, mesh_preview_png, read_msh
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 
-MIN_QUALITY = 0.5
-"""Accepted smallest minSICN (1 = equilateral). Frontal-Delaunay gives about 0.65-0.7 here."""
+MIN_QUALITY = 0.6
+"""Accepted smallest minSICN (1 = equilateral). Measured: 0.684 (coarse fan-hole mesh), 0.660
+(the default fan-hole case)."""
 
 
 def coarse(case, flank=0.6, bore=0.6, interior=3.0):
@@ -96,8 +100,8 @@ def test_mesh_area_equals_exact_area(fan_case, fan_mesh):
     hole = filleted_sector_area(fan.inner_radius, fan.outer_radius, half, fan.fillet_radius)
     exact = (classical_profile_area(64.0, 1.3, 3.0, 40) - math.pi * 12.0**2 - 3 * math.pi * 18.0**2
              - 3 * hole)
-    assert fan_mesh.area == pytest.approx(exact, rel=1e-3)
-    assert geom.area == pytest.approx(exact, rel=1e-5)
+    assert fan_mesh.area == pytest.approx(exact, rel=4e-4)    # measured 1.5e-4 (straight edges)
+    assert geom.area == pytest.approx(exact, rel=6e-7)        # measured 2.2e-7 (profile samples)
 
 
 def test_arrays_layout_and_orientation(fan_mesh):
@@ -137,22 +141,23 @@ def test_boundary_nodes_lie_on_their_features(fan_case, fan_mesh):
     centres = [(36 * math.cos(math.radians(a)), 36 * math.sin(math.radians(a))) for a in (90, 210, 330)]
     for i, c in enumerate(centres):
         xy = fan_mesh.points[fan_mesh.boundary_nodes(f"bore_{i}")]
-        np.testing.assert_allclose(np.hypot(xy[:, 0] - c[0], xy[:, 1] - c[1]), 18.0, atol=1e-9)
+        np.testing.assert_allclose(np.hypot(xy[:, 0] - c[0], xy[:, 1] - c[1]), 18.0, rtol=0,
+                                   atol=2e-14)                                  # measured 7.1e-15 mm
     xy = fan_mesh.points[fan_mesh.boundary_nodes("central_hole")]
-    np.testing.assert_allclose(np.hypot(xy[:, 0], xy[:, 1]), 12.0, atol=1e-9)
+    np.testing.assert_allclose(np.hypot(xy[:, 0], xy[:, 1]), 12.0, rtol=0, atol=5e-15)   # measured 1.8e-15 mm
     # profile nodes: on the spline through the analytical profile (< 0.1 µm off), radius between
     # root and tip
     xy = fan_mesh.points[fan_mesh.boundary_nodes("profile")]
     rad = np.hypot(xy[:, 0], xy[:, 1])
-    assert rad.min() >= 59.7 - 1e-6 and rad.max() <= 62.3 + 1e-6
+    assert rad.min() >= 59.7 - 1e-13 and rad.max() <= 62.3 + 3e-14   # measured +2.2e-8, +1.4e-14 mm
     geom = disc_geometry(fan_case)
     _, _, P, _ = closest_points(geom.profile, xy)       # Newton-refined distance to the profile
-    assert np.max(np.linalg.norm(xy - P, axis=1)) < 1e-4
+    assert np.max(np.linalg.norm(xy - P, axis=1)) < 3e-6   # measured 1.2e-6 mm (spline vs profile)
     # fan-hole nodes: inside the annulus [17, 49]
     for name in ("hole_0", "hole_1", "hole_2"):
         xy = fan_mesh.points[fan_mesh.boundary_nodes(name)]
         rad = np.hypot(xy[:, 0], xy[:, 1])
-        assert rad.min() >= 17.0 - 1e-9 and rad.max() <= 49.0 + 1e-9
+        assert rad.min() >= 17.0 - 1e-14 and rad.max() <= 49.0 + 3e-14   # measured −3.6e-15, +1.4e-14 mm
 
 
 def test_min_quality_above_threshold(fan_mesh):
@@ -160,6 +165,7 @@ def test_min_quality_above_threshold(fan_mesh):
     assert fan_mesh.min_quality > MIN_QUALITY
 
 
+@pytest.mark.slow
 def test_cache_hit_and_miss(fan_case, fan_mesh, cache):
     path = mesh_path(fan_case, cache)
     assert fan_mesh.path == path and path.is_file()
@@ -170,7 +176,7 @@ def test_cache_hit_and_miss(fan_case, fan_mesh, cache):
     assert np.array_equal(again.triangles, fan_mesh.triangles)
     for name, edges in fan_mesh.boundaries.items():
         assert np.array_equal(again.boundaries[name], edges)
-    assert again.min_quality == pytest.approx(fan_mesh.min_quality, abs=1e-12)
+    assert again.min_quality == fan_mesh.min_quality          # binary .msh: read back exactly
     # loads, material, thickness, min_wall do not shape the mesh: same file, still a hit
     other = fan_case.replace(loads=dataclasses.replace(fan_case.loads, torque_Nm=99.0),
                              material=dataclasses.replace(fan_case.material, youngs_modulus=1e5),
@@ -206,19 +212,13 @@ def test_preview_png_is_not_blank(fan_mesh, tmp_path):
     assert np.std(rgb) > 0.05
 
 
-def test_to_skfem(fan_mesh):
-    m = to_skfem(fan_mesh)
-    assert m.p.shape == (2, fan_mesh.n_nodes) and m.t.shape == (3, fan_mesh.n_elements)
-    assert m.p.flags.c_contiguous and m.t.flags.c_contiguous
-    for name, edges in fan_mesh.boundaries.items():
-        facets = m.boundaries[name]
-        assert len(facets) == len(edges)
-        got = {tuple(x) for x in np.sort(m.facets[:, facets], axis=0).T.tolist()}
-        assert got == {tuple(sorted(x)) for x in edges.tolist()}
-    # skfem's own area
-    from skfem import Basis, ElementTriP1
-    basis = Basis(m, ElementTriP1())
-    assert float(np.sum(basis.dx)) == pytest.approx(fan_mesh.area, rel=1e-12)
+def test_area_agrees_with_scikit_fem(fan_mesh):
+    """The arrays feed scikit-fem as they are (C-contiguous, every node used), and its quadrature
+    gives the same area as the mesh's own sum of triangle areas."""
+    from skfem import Basis, ElementTriP1, MeshTri
+
+    m = MeshTri(fan_mesh.points.T.copy(), fan_mesh.triangles.T.copy())
+    assert float(np.sum(Basis(m, ElementTriP1()).dx)) == pytest.approx(fan_mesh.area, rel=1e-15)   # measured 0
 
 
 def test_gmsh_session_finalizes_on_error_and_is_silent(capfd, tmp_path):
@@ -241,6 +241,7 @@ def test_gmsh_session_finalizes_on_error_and_is_silent(capfd, tmp_path):
     assert out == "" and err == ""
 
 
+@pytest.mark.slow
 def test_default_fanholes_case_size_and_quality(tmp_path):
     """The project's default case at its own sizes: 10-20k nodes (the load cycle budget), good
     quality, and the fine size really is applied along the flanks and the bores."""
@@ -251,10 +252,11 @@ def test_default_fanholes_case_size_and_quality(tmp_path):
     for name, h in (("profile", case.mesh.size_flank), ("bore_0", case.mesh.size_bore)):
         e = m.boundaries[name]
         length = np.linalg.norm(m.points[e[:, 1]] - m.points[e[:, 0]], axis=1)
-        assert np.median(length) == pytest.approx(h, rel=0.15)
-        assert length.max() < 1.5 * h
+        assert np.median(length) == pytest.approx(h, rel=0.06)   # measured −2.4 % (profile), −0.1 % (bore)
+        assert length.max() < 1.05 * h                            # measured 0.976 h, 0.999 h
 
 
+@pytest.mark.slow
 def test_cli_mesh_subcommand(tmp_path, capsys):
     from rvfem.cli import main
 
@@ -280,3 +282,91 @@ def test_cli_mesh_subcommand(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "rvfem mesh: error:" in err and "mesh.min_wall" in err
     assert not (tmp_path / "none").exists()
+
+
+@pytest.mark.slow
+def test_two_processes_building_the_same_mesh_share_one_complete_file(tmp_path):
+    """Two processes start meshing the same case into the same cache at the same moment (both
+    miss the cache): both succeed, one complete .msh is left, no temporary file, and it reads back
+    as the mesh both of them built."""
+    script = (
+        "import sys, time, pathlib\n"
+        "from rvfem.case import load_case\n"
+        "from rvfem.mesh import mesh_case\n"
+        "import dataclasses\n"
+        "case = load_case(sys.argv[1])\n"
+        "case = case.replace(mesh=dataclasses.replace(case.mesh, size_flank=0.8, size_bore=0.8, size_interior=4.0))\n"
+        "go = pathlib.Path(sys.argv[3])\n"
+        "while not go.exists():\n"
+        "    time.sleep(0.01)\n"
+        "m = mesh_case(case, sys.argv[2])\n"
+        "print(m.n_nodes, m.from_cache)\n"
+    )
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
+    cache, go = tmp_path / "cache", tmp_path / "go"
+    args = [sys.executable, "-c", script, str(CASES / "rv40e_solid.toml"), str(cache), str(go)]
+    procs = [subprocess.Popen(args, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]
+    go.touch()
+    outs = [p.communicate(timeout=300) for p in procs]
+    assert [p.returncode for p in procs] == [0, 0], [err for _, err in outs]
+    files = sorted(x.name for x in cache.iterdir())
+    assert len(files) == 1 and files[0].endswith(".msh") and not files[0].startswith("."), files
+    n_nodes = {int(out.split()[0]) for out, _ in outs}
+    mesh = read_msh(cache / files[0])
+    assert n_nodes == {mesh.n_nodes}
+
+
+@dataclasses.dataclass(frozen=True)
+class Slot:
+    """A new hole shape written only against the Feature protocol: a slot (stadium) along x, two
+    straight sides and two half circles. Nothing in rvfem knows this class."""
+
+    name: str
+    centre: tuple[float, float]
+    length: float          # distance between the two arc centres, mm
+    radius: float          # half the width, mm
+
+    def validate(self) -> None:
+        assert self.length > 0 and self.radius > 0
+
+    def outline(self):
+        from rvfem.geometry import Arc, LineSegment
+
+        (cx, cy), h, r = self.centre, 0.5 * self.length, self.radius
+        return (LineSegment((cx - h, cy - r), (cx + h, cy - r)),
+                Arc((cx + h, cy), r, -math.pi / 2, math.pi),
+                LineSegment((cx + h, cy + r), (cx - h, cy + r)),
+                Arc((cx - h, cy), r, math.pi / 2, math.pi))
+
+    def signed_distance(self, p):
+        (cx, cy), h = self.centre, 0.5 * self.length
+        x = np.clip(p[:, 0], cx - h, cx + h)
+        return np.hypot(p[:, 0] - x, p[:, 1] - cy) - self.radius
+
+    def sample(self, spacing=0.02):
+        return np.concatenate([q.sample(spacing)[:-1] for q in self.outline()])
+
+    @property
+    def area(self):
+        return 2 * self.radius * self.length + math.pi * self.radius**2
+
+    @property
+    def sampling_length(self):
+        return 2 * self.length + 2 * math.pi * self.radius
+
+
+def test_a_new_feature_class_is_meshed_through_the_protocol(tmp_path):
+    """The Feature protocol is all the mesher needs: a disc with a slot-shaped hole meshes, the
+    slot's boundary is named after it, its nodes lie on the slot, and the area is the disc's."""
+    from rvfem.mesh import mesh_geometry
+
+    case = coarse(load_case(CASES / "rv40e_solid.toml"), 0.8, 0.8, 4.0)
+    slot = Slot("hole_slot", (0.0, -30.0), 6.0, 2.0)
+    geom = dataclasses.replace(disc_geometry(case), holes=(slot,))
+    mesh = mesh_geometry(geom, tmp_path / "slot.msh")
+    assert "hole_slot" in mesh.boundaries
+    xy = mesh.points[mesh.boundary_nodes("hole_slot")]
+    assert np.abs(slot.signed_distance(xy)).max() < 3e-15        # measured 8.9e-16 mm
+    assert mesh.area == pytest.approx(geom.area, rel=1e-3)       # measured 4.1e-4 (straight edges)

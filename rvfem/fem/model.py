@@ -1,0 +1,331 @@
+"""The plane-stress finite-element model of a disc: mesh, basis, stiffness, node and DOF maps.
+
+The cycloid disc is a 2D linear-elastic body in plane stress (thickness *b*, Young's modulus *E*,
+Poisson's ratio ν), discretised with Lagrange triangles of order 1 (P1, linear) or 2 (P2, quadratic,
+straight-sided) through scikit-fem. Units follow the project convention: lengths in mm, forces in N,
+moduli and stresses in MPa. The stiffness matrix is multiplied by the thickness, so ``K @ u`` is a
+nodal *force* in N for a displacement ``u`` in mm. The derivation and the expected convergence rates
+are in docs/theory.md ("Plane-stress finite elements").
+
+Nodes and degrees of freedom
+----------------------------
+A *node* here is a Lagrange interpolation node of the scalar element:
+
+* P1: the mesh vertices, node ``i`` = vertex ``i``;
+* P2: the mesh vertices first (node ``i`` = vertex ``i``, ``i < n_vertices``), then one node at the
+  midpoint of every mesh edge (node ``n_vertices + f`` sits on edge ``f`` of
+  :attr:`FEModel.edges`).
+
+Every node has an x and a y degree of freedom; :attr:`FEModel.node_dofs` maps node → (x DOF, y DOF)
+in the global numbering of the stiffness matrix. The displacement of node ``i`` is
+``u[model.node_dofs[i]]``. The mesh vertices are numbered exactly as the ``points`` passed to
+:func:`build_model`, so ``model.node_dofs[vertices]`` translates a mesh's vertex indices (for
+instance its boundary edges) into DOFs for P1 and P2 alike.
+
+References
+----------
+.. [1] O. C. Zienkiewicz, R. L. Taylor, J. Z. Zhu, *The Finite Element Method: Its Basis and
+   Fundamentals*, 7th ed., Butterworth-Heinemann, 2013 (plane stress, isoparametric triangles).
+.. [2] S. P. Timoshenko, J. N. Goodier, *Theory of Elasticity*, 3rd ed., McGraw-Hill, 1970
+   (plane-stress constitutive law).
+.. [3] T. Gustafsson, G. D. McBain, "scikit-fem: A Python package for finite element assembly",
+   JOSS 5(52), 2369, 2020.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector, MeshTri, asm
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from .._arrays import readonly as _readonly
+from ..errors import MeshError
+
+__all__ = [
+    "FEModel",
+    "build_model",
+    "plane_stress_constants",
+    "edge_indices",
+    "edge_outward_normals",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class FEModel:
+    """Assembled plane-stress finite-element model of one disc.
+
+    Build it with :func:`build_model`; the stiffness is assembled once and never changes.
+
+    Attributes
+    ----------
+    mesh : skfem.MeshTri
+        The triangle mesh (vertices numbered as the ``points`` given to :func:`build_model`).
+    basis : skfem.CellBasis
+        Vector Lagrange basis (P1 or P2) used to assemble ``stiffness``.
+    order : int
+        Element order, 1 or 2.
+    youngs_modulus : float
+        E, MPa.
+    poissons_ratio : float
+        ν, dimensionless.
+    thickness : float
+        Disc thickness b, mm.
+    stiffness : scipy.sparse.csr_matrix
+        Global stiffness K, N/mm, shape ``(n_dofs, n_dofs)``, symmetric positive semi-definite
+        (three rigid-body modes).
+    node_coords : numpy.ndarray
+        ``(n_nodes, 2)`` coordinates of the Lagrange nodes, mm (vertices, then edge midpoints for
+        P2).
+    node_dofs : numpy.ndarray
+        ``(n_nodes, 2)`` global x and y DOF index of every node.
+    edges : numpy.ndarray
+        ``(n_edges, 2)`` vertex indices of every mesh edge (sorted within a row); for P2, node
+        ``n_vertices + f`` is the midpoint of edge ``f``.
+    """
+
+    mesh: MeshTri
+    basis: Any
+    order: int
+    youngs_modulus: float
+    poissons_ratio: float
+    thickness: float
+    stiffness: sp.csr_matrix
+    node_coords: np.ndarray
+    node_dofs: np.ndarray
+    edges: np.ndarray
+    _stress_basis: Any = field(repr=False)
+
+    @property
+    def n_vertices(self) -> int:
+        """Number of mesh vertices."""
+        return int(self.mesh.p.shape[1])
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of Lagrange nodes (vertices, plus edge midpoints for P2)."""
+        return int(self.node_coords.shape[0])
+
+    @property
+    def n_dofs(self) -> int:
+        """Number of degrees of freedom (2 per node)."""
+        return int(self.stiffness.shape[0])
+
+    @property
+    def n_elements(self) -> int:
+        """Number of triangles."""
+        return int(self.mesh.t.shape[1])
+
+
+def plane_stress_constants(youngs_modulus: float, poissons_ratio: float) -> tuple[float, float]:
+    """Lamé constants of the plane-stress constitutive law.
+
+    Plane stress (σ_zz = 0) eliminates ε_zz, which replaces the first Lamé constant λ by
+    λ* = 2λμ/(λ + 2μ) = Eν/(1 − ν²); μ = E/(2(1 + ν)) is unchanged ([2]_ §§ 7, 15).
+    :func:`skfem.models.elasticity.lame_parameters` gives the 3D (λ, μ); the correction is applied
+    here.
+
+    Parameters
+    ----------
+    youngs_modulus : float
+        E, MPa.
+    poissons_ratio : float
+        ν.
+
+    Returns
+    -------
+    (float, float)
+        (λ*, μ) in MPa.
+    """
+    lam, mu = lame_parameters(float(youngs_modulus), float(poissons_ratio))
+    return 2.0 * lam * mu / (lam + 2.0 * mu), mu
+
+
+def build_model(
+    points: np.ndarray,
+    triangles: np.ndarray,
+    youngs_modulus: float,
+    poissons_ratio: float,
+    thickness: float,
+    order: int = 1,
+) -> FEModel:
+    """Assemble the plane-stress stiffness of a triangle mesh.
+
+    Parameters
+    ----------
+    points : numpy.ndarray
+        ``(n, 2)`` vertex coordinates, mm. Every vertex must belong to a triangle.
+    triangles : numpy.ndarray
+        ``(m, 3)`` vertex indices of the triangles (either orientation).
+    youngs_modulus : float
+        E, MPa.
+    poissons_ratio : float
+        ν, 0 ≤ ν < 0.5.
+    thickness : float
+        Disc thickness b, mm. Multiplies the stiffness: ``K`` is in N/mm.
+    order : int, optional
+        1 (linear P1 triangles) or 2 (quadratic P2 triangles with straight sides).
+
+    Returns
+    -------
+    FEModel
+
+    Raises
+    ------
+    ValueError
+        For non-physical material data or an unknown order.
+    MeshError
+        For malformed arrays, unused vertices or degenerate triangles.
+
+    Notes
+    -----
+    ``K = b ∫ ε(v) : C ε(u) dA`` with the plane-stress law σ = λ* tr(ε) I + 2μ ε
+    (:func:`plane_stress_constants`). scikit-fem's default quadrature (degree 2·order) integrates
+    it exactly on straight-sided triangles.
+    """
+    if order not in (1, 2):
+        raise ValueError(f"element order must be 1 or 2, got {order!r}")
+    if not (youngs_modulus > 0.0):
+        raise ValueError(f"Young's modulus must be positive, got {youngs_modulus!r} MPa")
+    if not (0.0 <= poissons_ratio < 0.5):
+        raise ValueError(f"Poisson's ratio must be in [0, 0.5), got {poissons_ratio!r}")
+    if not (thickness > 0.0):
+        raise ValueError(f"thickness must be positive, got {thickness!r} mm")
+
+    points = np.asarray(points, dtype=np.float64)
+    triangles = np.asarray(triangles)
+    if points.ndim != 2 or points.shape[1] != 2 or len(points) < 3:
+        raise MeshError(f"points must have shape (n, 2) with n >= 3, got {points.shape}")
+    if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) < 1:
+        raise MeshError(f"triangles must have shape (m, 3), got {triangles.shape}")
+    if not np.issubdtype(triangles.dtype, np.integer):
+        raise MeshError("triangles must hold integer vertex indices")
+    if triangles.min() < 0 or triangles.max() >= len(points):
+        raise MeshError("triangle vertex index out of range")
+    used = np.zeros(len(points), dtype=bool)
+    used[triangles.ravel()] = True
+    if not used.all():
+        raise MeshError(
+            f"{int((~used).sum())} vertices belong to no triangle (e.g. vertex "
+            f"{int(np.flatnonzero(~used)[0])}); remove them before building the model"
+        )
+    a, b, c = (points[triangles[:, k]] for k in range(3))
+    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    scale2 = np.ptp(points, axis=0).max() ** 2
+    bad = np.abs(area2) <= 1e-14 * scale2
+    if bad.any():
+        raise MeshError(f"{int(bad.sum())} degenerate (zero-area) triangles, e.g. #{int(np.flatnonzero(bad)[0])}")
+
+    mesh = MeshTri(
+        np.ascontiguousarray(points.T),
+        np.ascontiguousarray(triangles.T.astype(np.int64)),
+    )
+    scalar = ElementTriP1() if order == 1 else ElementTriP2()
+    basis = Basis(mesh, ElementVector(scalar))
+    lam, mu = plane_stress_constants(youngs_modulus, poissons_ratio)
+    stiffness = asm(linear_elasticity(lam * thickness, mu * thickness), basis).tocsr()
+    stiffness.sort_indices()
+
+    edges = np.ascontiguousarray(mesh.facets.T.astype(np.int64))
+    if order == 1:
+        node_coords = mesh.p.T.copy()
+        node_dofs = basis.nodal_dofs.T.astype(np.int64)
+    else:
+        mid = 0.5 * (mesh.p[:, mesh.facets[0]] + mesh.p[:, mesh.facets[1]])
+        node_coords = np.vstack([mesh.p.T, mid.T])
+        node_dofs = np.vstack([basis.nodal_dofs.T, basis.facet_dofs.T]).astype(np.int64)
+    if not np.array_equal(np.sort(node_dofs.ravel()), np.arange(basis.N)):
+        raise AssertionError("node/DOF map does not cover the DOFs exactly once")  # pragma: no cover
+
+    # Local points (reference triangle vertices 0, 1, 2 and the centroid) for stress recovery.
+    xi = np.array([[0.0, 1.0, 0.0, 1.0 / 3.0], [0.0, 0.0, 1.0, 1.0 / 3.0]])
+    stress_basis = Basis(mesh, ElementVector(scalar), quadrature=(xi, np.full(4, 0.125)))
+
+    return FEModel(
+        mesh=mesh,
+        basis=basis,
+        order=order,
+        youngs_modulus=float(youngs_modulus),
+        poissons_ratio=float(poissons_ratio),
+        thickness=float(thickness),
+        stiffness=stiffness,
+        node_coords=_readonly(node_coords),
+        node_dofs=_readonly(node_dofs),
+        edges=_readonly(edges),
+        _stress_basis=stress_basis,
+    )
+
+
+def edge_indices(model: FEModel, edges: np.ndarray) -> np.ndarray:
+    """Index into :attr:`FEModel.edges` of each given vertex pair.
+
+    Parameters
+    ----------
+    model : FEModel
+    edges : array_like of int
+        ``(k, 2)`` vertex pairs, either orientation.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(k,)`` edge indices (for P2, node ``n_vertices + index`` is the edge's midpoint).
+
+    Raises
+    ------
+    MeshError
+        If a pair is not an edge of the mesh.
+    """
+    e = np.sort(np.asarray(edges, dtype=np.int64).reshape(-1, 2), axis=1)
+    nv = model.n_vertices
+    keys = model.edges[:, 0] * nv + model.edges[:, 1]
+    order = np.argsort(keys)
+    q = e[:, 0] * nv + e[:, 1]
+    pos = np.searchsorted(keys, q, sorter=order)
+    pos = np.minimum(pos, len(keys) - 1)
+    idx = order[pos]
+    missing = keys[idx] != q
+    if missing.any():
+        j = int(np.flatnonzero(missing)[0])
+        raise MeshError(f"vertex pair {tuple(int(x) for x in e[j])} is not an edge of the mesh")
+    return idx
+
+
+def edge_outward_normals(model: FEModel, edges: np.ndarray) -> np.ndarray:
+    """Outward unit normals of boundary edges.
+
+    Parameters
+    ----------
+    model : FEModel
+    edges : array_like of int
+        ``(k, 2)`` vertex pairs of boundary edges.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(k, 2)`` unit normals pointing out of the body (away from the edge's only triangle).
+
+    Raises
+    ------
+    MeshError
+        If an edge is not on the boundary of the mesh.
+    """
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    f = edge_indices(model, e)
+    f2t = model.mesh.f2t
+    if (f2t[1, f] != -1).any():
+        j = int(np.flatnonzero(f2t[1, f] != -1)[0])
+        raise MeshError(f"edge {tuple(int(x) for x in e[j])} is interior, not on the boundary")
+    tri = model.mesh.t[:, f2t[0, f]]                      # (3, k)
+    third = tri.sum(axis=0) - e[:, 0] - e[:, 1]
+    p = model.mesh.p.T
+    d = p[e[:, 1]] - p[e[:, 0]]
+    n = np.column_stack([d[:, 1], -d[:, 0]])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    inward = np.einsum("ij,ij->i", n, p[third] - p[e[:, 0]]) > 0.0
+    n[inward] *= -1.0
+    return n
+
+

@@ -1,0 +1,180 @@
+"""Stresses of a displacement field: per element, at the vertices, and as a linear operator.
+
+σ = λ* tr(ε) I + 2μ ε with ε = sym ∇u and the plane-stress constants λ*, μ of
+:func:`~rvfem.fem.model.plane_stress_constants` ([1]_ § 4.2, [2]_ § 15). Element stresses are
+evaluated with scikit-fem (``CellBasis.interpolate(u).grad``) at the reference vertices and the
+centroid of every triangle. Vertex stresses are recovered by area-weighted averaging of the element
+values at the vertex over the triangles sharing it: for P1 (constant element stress) this is the
+lumped-mass L2 projection onto continuous P1 ([1]_ § 14.3); for P2 the element stress is linear and
+its vertex values are averaged. :func:`stress_fields` and :func:`nodal_stress_operator` share one
+implementation of that average (:func:`_vertex_weights`) and of the constitutive law
+(:func:`_plane_stress`), so the envelope over a load cycle and the saved fields agree to round-off.
+
+References
+----------
+.. [1] O. C. Zienkiewicz, R. L. Taylor, J. Z. Zhu, *The Finite Element Method: Its Basis and
+   Fundamentals*, 7th ed., Butterworth-Heinemann, 2013 (stress recovery).
+.. [2] S. P. Timoshenko, J. N. Goodier, *Theory of Elasticity*, 3rd ed., McGraw-Hill, 1970
+   (plane stress, principal stresses).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._arrays import readonly as _readonly
+from .model import FEModel, plane_stress_constants
+
+__all__ = [
+    "StressState",
+    "StressFields",
+    "stress_fields",
+    "nodal_stress_operator",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class StressState:
+    """Plane-stress state (σ_zz = τ_xz = τ_yz = 0) at a set of points, MPa.
+
+    Attributes
+    ----------
+    sxx, syy, sxy : numpy.ndarray
+        Cartesian components.
+    von_mises : numpy.ndarray
+        √(σxx² − σxx σyy + σyy² + 3 τxy²).
+    s1, s2 : numpy.ndarray
+        In-plane principal stresses, s1 ≥ s2 (the third principal stress is σ_zz = 0).
+    angle1 : numpy.ndarray
+        Direction of s1 from the x axis, rad, in (−π/2, π/2].
+    """
+
+    sxx: np.ndarray
+    syy: np.ndarray
+    sxy: np.ndarray
+    von_mises: np.ndarray
+    s1: np.ndarray
+    s2: np.ndarray
+    angle1: np.ndarray
+
+    @classmethod
+    def from_components(cls, sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray) -> "StressState":
+        """Derive von Mises and principal stresses from the Cartesian components (MPa): Mohr's
+        circle with centre (σxx + σyy)/2 and radius √(((σxx − σyy)/2)² + τxy²) ([2]_ § 15)."""
+        centre = 0.5 * (sxx + syy)
+        radius = np.hypot(0.5 * (sxx - syy), sxy)
+        vm = np.sqrt(np.maximum(sxx**2 - sxx * syy + syy**2 + 3.0 * sxy**2, 0.0))
+        angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
+        return cls(*(_readonly(a) for a in (sxx, syy, sxy, vm, centre + radius, centre - radius, angle)))
+
+
+@dataclass(frozen=True, eq=False)
+class StressFields:
+    """Stresses of a displacement field.
+
+    Attributes
+    ----------
+    nodal : StressState
+        At the mesh vertices (``n_vertices`` values): recovered by area-weighted averaging of the
+        element stresses evaluated at the vertex over the triangles sharing it. For P1 (constant
+        element stress) this is the lumped-mass L2 projection onto continuous P1; for P2 the
+        element stress is linear and its vertex values are averaged. Derived quantities (von
+        Mises, principal) are computed from the averaged components.
+    element : StressState
+        One value per triangle: the (constant) element stress for P1, the value at the
+        centroid (= element mean of the linear field) for P2.
+    """
+
+    nodal: StressState
+    element: StressState
+
+
+def _plane_stress(model: FEModel, g: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(σxx, σyy, σxy), MPa, from displacement gradients ``g[i, j] = ∂u_i/∂x_j`` (any trailing
+    shape)."""
+    lam, mu = plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
+    exx, eyy = g[0, 0], g[1, 1]
+    exy = 0.5 * (g[0, 1] + g[1, 0])
+    tr = exx + eyy
+    return lam * tr + 2.0 * mu * exx, lam * tr + 2.0 * mu * eyy, 2.0 * mu * exy
+
+
+def _vertex_weights(model: FEModel) -> tuple[np.ndarray, np.ndarray]:
+    """Weights of the vertex average: ``(w, denominator)`` with ``w[k, e]`` the area of triangle
+    ``e`` (for its local vertex k) and ``denominator[v]`` the area of all triangles at vertex v,
+    mm². The vertex value is Σ_(k,e at v) w[k, e]·σ_e(vertex k) / denominator[v]."""
+    t = model.mesh.t                                        # (3, n_elements)
+    p = model.mesh.p
+    area = 0.5 * np.abs(
+        (p[0, t[1]] - p[0, t[0]]) * (p[1, t[2]] - p[1, t[0]])
+        - (p[1, t[1]] - p[1, t[0]]) * (p[0, t[2]] - p[0, t[0]])
+    )
+    w = np.tile(area, (3, 1))
+    denom = np.bincount(t.ravel(), weights=w.ravel(), minlength=model.n_vertices)
+    return w, denom
+
+
+def nodal_stress_operator(model: FEModel) -> sp.csr_matrix:
+    """The linear map from displacements to the vertex stresses of :func:`stress_fields`.
+
+    ``S @ u`` stacks (σxx, σyy, σxy) at the mesh vertices — area-averaged element values, exactly
+    as ``stress_fields(model, u).nodal`` — for many fields at the cost of one sparse product each
+    (the load cycle's stress envelope uses it at every crank angle).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+        ``(3·n_vertices, n_dofs)``, MPa/mm; rows ``[0, nv)`` σxx, ``[nv, 2nv)`` σyy, ``[2nv, 3nv)`` σxy.
+    """
+    basis = model._stress_basis
+    t = model.mesh.t
+    nv = model.n_vertices
+    w, denom = _vertex_weights(model)
+    rows, cols, vals = [], [], []
+    for i, (field_i,) in enumerate(basis.basis):
+        comps = _plane_stress(model, field_i.grad[:, :, :, :3])   # each (n_elements, 3 vertices)
+        dof = basis.element_dofs[i]
+        for c, sc in enumerate(comps):
+            for k in range(3):
+                v = t[k]
+                rows.append(c * nv + v)
+                cols.append(dof)
+                vals.append(sc[:, k] * w[k] / denom[v])
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(3 * nv, model.n_dofs))
+
+
+def stress_fields(model: FEModel, u: np.ndarray) -> StressFields:
+    """Plane stresses of a displacement field, per element and at the vertices.
+
+    Parameters
+    ----------
+    model : FEModel
+    u : numpy.ndarray
+        ``(n_dofs,)`` displacement, mm. Rigid-body motions produce no stress (to first order).
+
+    Returns
+    -------
+    StressFields
+        MPa.
+    """
+    u = np.asarray(u, dtype=np.float64)
+    if u.shape != (model.n_dofs,):
+        raise ValueError(f"u must have shape ({model.n_dofs},), got {u.shape}")
+    g = model._stress_basis.interpolate(u).grad           # (2, 2, n_elements, 4)
+    sxx, syy, sxy = _plane_stress(model, g)
+
+    element = StressState.from_components(sxx[:, 3].copy(), syy[:, 3].copy(), sxy[:, 3].copy())
+
+    idx = model.mesh.t.ravel()                              # vertex of (local k, element e)
+    w, denom = _vertex_weights(model)
+    wts = w.ravel()
+
+    def avg(f: np.ndarray) -> np.ndarray:
+        return np.bincount(idx, weights=wts * f[:, :3].T.ravel(), minlength=model.n_vertices) / denom
+
+    nodal = StressState.from_components(avg(sxx), avg(syy), avg(sxy))
+    return StressFields(nodal=nodal, element=element)

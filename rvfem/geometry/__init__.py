@@ -1,0 +1,71 @@
+"""Disc geometry: the cycloid profile, the drive kinematics and the disc's holes.
+
+Everything is in the **disc's body frame**: the disc centre is the origin, the disc does not move,
+and the pins move around it. Lengths are mm, angles radians (the case file's degrees are converted
+on reading). One module per concern, every public name re-exported here
+(``from rvfem.geometry import disc_geometry``):
+
+:mod:`rvfem.geometry.profile`
+    The cycloid profile (envelope of the pin circles, equidistant/shift/rotation modifications,
+    pitch errors), its curvature and the undercut check.
+:mod:`rvfem.geometry.kinematics`
+    Pin centres and crank centres at a crank angle, pin–profile gaps, closest points on the
+    profile.
+:mod:`rvfem.geometry.features`
+    The :class:`Feature` protocol, its implementations (:class:`Circle`, :class:`FanHole`) and the
+    checked :class:`DiscGeometry` (:func:`disc_geometry`: overlaps, thin walls).
+
+The derivations are in docs/theory.md ("Kinematics", "Profile envelope and modifications").
+"""
+
+from __future__ import annotations
+
+from .features import (
+    WALL_SPACING,
+    Arc,
+    Circle,
+    DiscGeometry,
+    FanHole,
+    Feature,
+    LineSegment,
+    Wall,
+    disc_geometry,
+)
+from .kinematics import PinContacts, closest_points, crank_centres, pin_centres, pin_profile_contacts
+from .profile import (
+    PITCH_BLEND_FRACTION,
+    SAMPLES_PER_SEGMENT,
+    SPLINE_POINTS_PER_SEGMENT,
+    Profile,
+    build_profile,
+    check_undercut,
+    pitch_errors,
+    profile_eval,
+    trochoid_curvature,
+)
+
+__all__ = [
+    "Profile",
+    "Feature",
+    "Circle",
+    "LineSegment",
+    "Arc",
+    "FanHole",
+    "Wall",
+    "DiscGeometry",
+    "PinContacts",
+    "build_profile",
+    "profile_eval",
+    "pin_centres",
+    "crank_centres",
+    "pin_profile_contacts",
+    "closest_points",
+    "disc_geometry",
+    "check_undercut",
+    "trochoid_curvature",
+    "pitch_errors",
+    "SAMPLES_PER_SEGMENT",
+    "SPLINE_POINTS_PER_SEGMENT",
+    "PITCH_BLEND_FRACTION",
+    "WALL_SPACING",
+]

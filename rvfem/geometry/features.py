@@ -1,0 +1,560 @@
+"""The disc's features (holes and bores), the Feature protocol and the checked DiscGeometry.
+
+Everything is in the disc's body frame (origin at the disc centre), lengths mm, angles radians.
+
+Features
+--------
+A central hole, N crank-bearing bores (radius ``crank_bearing.bore_radius``) at r0·u(α_i), optional
+fan-shaped holes (annular sectors with filleted corners) and round holes. Every one of them is a
+:class:`Feature`: a name, a closed outline of lines and arcs, an exact signed distance, samples, an
+exact area and a self-check. :class:`Circle` and :class:`FanHole` implement it; a new hole shape is
+one more frozen dataclass with the same members, and neither the checks here nor the mesher
+(:mod:`rvfem.mesh`) need to know its type.
+
+:func:`disc_geometry` builds a :class:`DiscGeometry` and checks it (undercut, overlaps, thin walls)
+before anything is meshed; every problem is a :class:`~rvfem.errors.GeometryError` that says what
+to change. Areas follow from Green's theorem over the outline, ½∮(x dy − y dx); walls are the
+minimum of the exact signed distance of one feature over dense samples of the other's outline
+(docs/theory.md, "Features").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Protocol, Union
+
+import numpy as np
+from matplotlib.path import Path as _MplPath
+from scipy.optimize import brentq
+
+from ..case import Case
+from ..errors import GeometryError
+from .kinematics import crank_centres
+from .profile import Profile, build_profile
+
+__all__ = [
+    "Feature",
+    "LineSegment",
+    "Arc",
+    "Circle",
+    "FanHole",
+    "Wall",
+    "DiscGeometry",
+    "disc_geometry",
+    "WALL_SPACING",
+]
+
+WALL_SPACING = 0.02
+"""Spacing (mm) of the points used to measure walls between features."""
+
+
+@dataclass(frozen=True)
+class LineSegment:
+    """A straight piece of a hole outline from ``start`` to ``end`` (mm)."""
+
+    start: tuple[float, float]
+    end: tuple[float, float]
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        """Distance from points (n, 2) to the segment, mm."""
+        a, b = np.asarray(self.start), np.asarray(self.end)
+        ab = b - a
+        L2 = float(ab @ ab)
+        t = np.clip(((p - a) @ ab) / L2, 0.0, 1.0) if L2 > 0 else np.zeros(len(p))
+        return np.linalg.norm(p - (a + t[:, None] * ab), axis=1)
+
+    def sample(self, spacing: float) -> np.ndarray:
+        n = max(2, int(math.ceil(self.length / spacing)) + 1)
+        t = np.linspace(0, 1, n)[:, None]
+        return (1 - t) * np.asarray(self.start) + t * np.asarray(self.end)
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(self.end[0] - self.start[0], self.end[1] - self.start[1]))
+
+    def area_term(self) -> float:
+        """½∮(x dy − y dx) over this piece (Green's theorem)."""
+        return 0.5 * (self.start[0] * self.end[1] - self.start[1] * self.end[0])
+
+
+@dataclass(frozen=True)
+class Arc:
+    """A circular arc of a hole outline: centre, radius (mm), start angle and signed sweep (rad,
+    positive counter-clockwise)."""
+
+    centre: tuple[float, float]
+    radius: float
+    start_angle: float
+    sweep: float
+
+    def point(self, angle: float) -> tuple[float, float]:
+        return (self.centre[0] + self.radius * math.cos(angle),
+                self.centre[1] + self.radius * math.sin(angle))
+
+    @property
+    def start(self) -> tuple[float, float]:
+        return self.point(self.start_angle)
+
+    @property
+    def end(self) -> tuple[float, float]:
+        return self.point(self.start_angle + self.sweep)
+
+    @property
+    def length(self) -> float:
+        return abs(self.sweep) * self.radius
+
+    def distance(self, p: np.ndarray) -> np.ndarray:
+        """Distance from points (n, 2) to the arc, mm (exact)."""
+        c = np.asarray(self.centre)
+        v = p - c
+        ang = np.arctan2(v[:, 1], v[:, 0])
+        lo = self.start_angle if self.sweep >= 0 else self.start_angle + self.sweep
+        inside = np.mod(ang - lo, 2 * np.pi) <= abs(self.sweep)
+        d_arc = np.abs(np.linalg.norm(v, axis=1) - self.radius)
+        d_end = np.minimum(np.linalg.norm(p - np.asarray(self.start), axis=1),
+                           np.linalg.norm(p - np.asarray(self.end), axis=1))
+        return np.where(inside, d_arc, d_end)
+
+    def sample(self, spacing: float) -> np.ndarray:
+        n = max(2, int(math.ceil(self.length / spacing)) + 1)
+        a = self.start_angle + self.sweep * np.linspace(0, 1, n)
+        return np.stack([self.centre[0] + self.radius * np.cos(a),
+                         self.centre[1] + self.radius * np.sin(a)], axis=1)
+
+    def area_term(self) -> float:
+        """½∮(x dy − y dx) over this arc: ½[R·(c_x·Δsin − c_y·Δcos) + R²·sweep]."""
+        a1, a2 = self.start_angle, self.start_angle + self.sweep
+        cx, cy = self.centre
+        R = self.radius
+        return 0.5 * (R * (cx * (math.sin(a2) - math.sin(a1)) - cy * (math.cos(a2) - math.cos(a1)))
+                      + R * R * self.sweep)
+
+
+Primitive = Union[LineSegment, Arc]
+"""A piece of an outline: a straight segment or a circular arc."""
+
+
+class Feature(Protocol):
+    """What the geometry checks and the mesher need to know about a hole cut out of the disc.
+
+    A new hole shape is one frozen dataclass with these members; :func:`disc_geometry` checks it
+    and :mod:`rvfem.mesh` meshes it without knowing its type (it builds the Gmsh curves from
+    :meth:`outline`, one per primitive, and sizes the distance field by :attr:`sampling_length`).
+
+    Attributes
+    ----------
+    name : str
+        Name of the feature and of the mesh boundary (physical group) along its outline, e.g.
+        ``"bore_0"``, ``"hole_2"``.
+    """
+
+    name: str
+
+    def validate(self) -> None:
+        """Raise :class:`~rvfem.errors.GeometryError` (naming the feature and the case key to
+        change) if the shape is impossible by itself, before it is compared with the others."""
+
+    def outline(self) -> tuple[Primitive, ...]:
+        """The boundary as a closed chain of lines and arcs, counter-clockwise around the hole
+        (each primitive starts where the previous ends; a full circle is one :class:`Arc` of sweep
+        2π). The mesher makes one Gmsh curve per primitive (arcs above 135° split in pieces)."""
+
+    def signed_distance(self, p: np.ndarray) -> np.ndarray:
+        """Exact distance from points ``(n, 2)`` (mm) to the outline, negative inside the hole."""
+
+    def sample(self, spacing: float = ...) -> np.ndarray:
+        """Points along the outline, at most ``spacing`` mm apart, ``(m, 2)``, mm (closed polygon,
+        last point not repeated); used to measure walls and to test containment in the profile."""
+
+    @property
+    def area(self) -> float:
+        """Exact area of the hole, mm²."""
+
+    @property
+    def sampling_length(self) -> float:
+        """A length of the outline, mm, by which the mesher sets how densely its distance field
+        samples the hole's curves (about four points per element size along this length)."""
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A circular hole (central hole, crank-bearing bore, round lightening hole).
+
+    Attributes
+    ----------
+    name : str
+    centre : (float, float)
+        mm.
+    radius : float
+        mm.
+    """
+
+    name: str
+    centre: tuple[float, float]
+    radius: float
+
+    def validate(self) -> None:
+        """Raise GeometryError for a non-positive radius."""
+        if not self.radius > 0:
+            raise GeometryError(f"{self.name}: the radius must be positive, got {self.radius} mm")
+
+    def outline(self) -> tuple["Arc"]:
+        """One full counter-clockwise circle (start angle 0, sweep 2π)."""
+        return (Arc(self.centre, self.radius, 0.0, 2 * math.pi),)
+
+    def signed_distance(self, p: np.ndarray) -> np.ndarray:
+        """Distance from points (n, 2) to the hole, mm; negative inside the hole."""
+        return np.hypot(p[:, 0] - self.centre[0], p[:, 1] - self.centre[1]) - self.radius
+
+    def sample(self, spacing: float = WALL_SPACING) -> np.ndarray:
+        """Points along the circle (closed polygon, last point not repeated, at least 16), mm."""
+        n = max(16, int(math.ceil(2 * math.pi * self.radius / spacing)))
+        a = 2 * np.pi * np.arange(n) / n
+        return np.stack([self.centre[0] + self.radius * np.cos(a),
+                         self.centre[1] + self.radius * np.sin(a)], axis=1)
+
+    @property
+    def area(self) -> float:
+        """πR², mm²."""
+        return math.pi * self.radius**2
+
+    @property
+    def sampling_length(self) -> float:
+        """The circumference 2πR, mm."""
+        return 2 * math.pi * self.radius
+
+
+@dataclass(frozen=True)
+class FanHole:
+    """A fan-shaped hole: the annular sector r_i ≤ ρ ≤ r_o, |φ − φ_c| ≤ half_span with its four
+    corners rounded by fillets of radius f (tangent to the arcs and to the radial sides).
+
+    Attributes
+    ----------
+    name : str
+    inner_radius, outer_radius : float
+        mm.
+    centre_angle, half_span : float
+        Angle of the centre line and half the angular span between the radial sides, rad.
+    fillet_radius : float
+        mm (0 = sharp corners).
+    """
+
+    name: str
+    inner_radius: float
+    outer_radius: float
+    centre_angle: float
+    half_span: float
+    fillet_radius: float
+
+    @property
+    def fillet_angles(self) -> tuple[float, float]:
+        """(γ_o, γ_i): angular offsets of the outer/inner fillet centres from the sides,
+        sin γ_o = f/(r_o − f), sin γ_i = f/(r_i + f)."""
+        f = self.fillet_radius
+        return (math.asin(f / (self.outer_radius - f)), math.asin(f / (self.inner_radius + f)))
+
+    def validate(self) -> None:
+        """Raise GeometryError if the fillets do not fit the sector."""
+        f, ri, ro, al = self.fillet_radius, self.inner_radius, self.outer_radius, self.half_span
+        if ro - ri <= 2 * f:
+            raise GeometryError(
+                f"{self.name}: fillet radius {f} mm does not fit the radial height "
+                f"{ro - ri:.3g} mm of the fan hole (needs fillet < half the height); reduce "
+                "fan_holes.fillet_radius or widen the hole")
+        go, gi = self.fillet_angles
+        if al <= max(go, gi) or (ro - f) * math.cos(go) <= (ri + f) * math.cos(gi):
+            raise GeometryError(
+                f"{self.name}: span {math.degrees(2 * al):.3g}° is too narrow for fillets of "
+                f"{f} mm (needs more than {math.degrees(2 * max(go, gi)):.3g}°); widen the hole "
+                "or reduce fan_holes.fillet_radius")
+
+    def outline(self) -> tuple:
+        """The outline as lines and arcs, counter-clockwise around the hole (hole on the left)."""
+        f, ri, ro = self.fillet_radius, self.inner_radius, self.outer_radius
+        bc, al = self.centre_angle, self.half_span
+        bp, bm = bc + al, bc - al            # the two radial sides
+        if f == 0:
+            ul = (math.cos(bp), math.sin(bp))
+            ur = (math.cos(bm), math.sin(bm))
+            return (
+                Arc((0.0, 0.0), ro, bm, 2 * al),
+                LineSegment((ro * ul[0], ro * ul[1]), (ri * ul[0], ri * ul[1])),
+                Arc((0.0, 0.0), ri, bp, -2 * al),
+                LineSegment((ri * ur[0], ri * ur[1]), (ro * ur[0], ro * ur[1])),
+            )
+        go, gi = self.fillet_angles
+        rco, rci = ro - f, ri + f
+        co_p = (rco * math.cos(bp - go), rco * math.sin(bp - go))
+        ci_p = (rci * math.cos(bp - gi), rci * math.sin(bp - gi))
+        ci_m = (rci * math.cos(bm + gi), rci * math.sin(bm + gi))
+        co_m = (rco * math.cos(bm + go), rco * math.sin(bm + go))
+        lo, li = rco * math.cos(go), rci * math.cos(gi)   # tangent points on the sides
+        return (
+            Arc((0.0, 0.0), ro, bm + go, 2 * (al - go)),
+            Arc(co_p, f, bp - go, math.pi / 2 + go),
+            LineSegment((lo * math.cos(bp), lo * math.sin(bp)), (li * math.cos(bp), li * math.sin(bp))),
+            Arc(ci_p, f, bp + math.pi / 2, math.pi / 2 - gi),
+            Arc((0.0, 0.0), ri, bp - gi, -2 * (al - gi)),
+            Arc(ci_m, f, bm + gi + math.pi, math.pi / 2 - gi),
+            LineSegment((li * math.cos(bm), li * math.sin(bm)), (lo * math.cos(bm), lo * math.sin(bm))),
+            Arc(co_m, f, bm - math.pi / 2, math.pi / 2 + go),
+        )
+
+    def sample(self, spacing: float = WALL_SPACING) -> np.ndarray:
+        """Points along the outline (closed polygon, last point not repeated), mm."""
+        return np.concatenate([p.sample(spacing)[:-1] for p in self.outline()])
+
+    @property
+    def area(self) -> float:
+        """Exact area from Green's theorem over the outline, mm²."""
+        return sum(p.area_term() for p in self.outline())
+
+    @property
+    def sampling_length(self) -> float:
+        """The outer arc of the unfilleted sector, r_o·2α, mm."""
+        return self.outer_radius * 2 * self.half_span
+
+    def signed_distance(self, p: np.ndarray) -> np.ndarray:
+        """Distance from points (n, 2) to the hole, mm; negative inside."""
+        prims = self.outline()
+        d = np.min([q.distance(p) for q in prims], axis=0)
+        return np.where(self.contains(p), -d, d)
+
+    def contains(self, p: np.ndarray) -> np.ndarray:
+        """True for points (n, 2) inside the hole: inside the annular sector and not in one of
+        the corner regions cut off by the fillets (a corner region is the part of the sector seen
+        from a fillet centre within the fillet arc's sweep, beyond the fillet radius)."""
+        rho = np.hypot(p[:, 0], p[:, 1])
+        dphi = np.angle(np.exp(1j * (np.arctan2(p[:, 1], p[:, 0]) - self.centre_angle)))
+        inside = (rho >= self.inner_radius) & (rho <= self.outer_radius) & (np.abs(dphi) <= self.half_span)
+        if self.fillet_radius > 0:
+            for q in self.outline():
+                if isinstance(q, Arc) and q.centre != (0.0, 0.0):
+                    v = p - np.asarray(q.centre)
+                    a = np.mod(np.arctan2(v[:, 1], v[:, 0]) - q.start_angle, 2 * np.pi)
+                    corner = (a <= q.sweep) & (np.hypot(v[:, 0], v[:, 1]) > q.radius)
+                    inside &= ~corner
+        return inside
+
+
+@dataclass(frozen=True)
+class Wall:
+    """The thinnest wall between two features (negative: they overlap)."""
+
+    first: str
+    second: str
+    thickness: float
+    location: tuple[float, float]
+
+
+@dataclass(frozen=True, eq=False)
+class DiscGeometry:
+    """Everything the mesher and the contact model need to know about the disc.
+
+    Attributes
+    ----------
+    case : Case
+    profile : Profile
+    central_hole : Circle
+    bores : tuple of Circle
+        ``bore_0`` … ``bore_{N−1}`` at r0·u(α_i).
+    holes : tuple of Feature
+        Lightening holes ``hole_0`` …: the fan holes (:class:`FanHole`) first, then the round
+        holes (:class:`Circle`).
+    walls : tuple of Wall
+        The thinnest wall between every pair of features (and each feature and the profile),
+        thinnest first.
+    """
+
+    case: Case
+    profile: Profile
+    central_hole: Circle
+    bores: tuple[Circle, ...]
+    holes: tuple[Feature, ...]
+    walls: tuple[Wall, ...]
+
+    @property
+    def features(self) -> tuple[Feature, ...]:
+        """Central hole, bores and holes (everything cut out of the profile)."""
+        return (self.central_hole,) + self.bores + self.holes
+
+    @property
+    def area(self) -> float:
+        """Disc area, mm²: profile polygon (dense samples) minus the exact hole areas."""
+        x, y = self.profile.points[:, 0], self.profile.points[:, 1]
+        a = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+        return a - sum(f.area for f in self.features)
+
+
+def _fan_hole(name: str, fan, angle: float, half_span: float) -> FanHole:
+    return FanHole(name, fan.inner_radius, fan.outer_radius, angle, half_span, fan.fillet_radius)
+
+
+def _default_offset(case: Case) -> float:
+    """Midway between the first two cranks (circular mean), rad."""
+    a = np.radians(case.cranks.angles_deg[:2])
+    return float(np.angle(np.exp(1j * a[0]) + np.exp(1j * a[1])))
+
+
+def _fan_holes(case: Case, bores: tuple[Circle, ...]) -> list[FanHole]:
+    fan = case.fan_holes
+    if fan is None:
+        return []
+    offset = _default_offset(case) if fan.angle_offset_deg is None else math.radians(fan.angle_offset_deg)
+    angles = [offset + 2 * math.pi * i / fan.count for i in range(fan.count)]
+    if fan.span_deg is not None:
+        holes = [_fan_hole(f"hole_{i}", fan, a, math.radians(fan.span_deg) / 2) for i, a in enumerate(angles)]
+        for h in holes:
+            h.validate()
+        return holes
+    if fan.outer_radius - fan.inner_radius <= 2 * fan.fillet_radius:
+        _fan_hole("hole_0", fan, angles[0], math.pi / fan.count).validate()   # raises the message
+    # span from the ligament: the widest hole whose wall to every bore is ≥ ligament
+    L = fan.ligament
+
+    def wall(half_span: float, angle: float) -> float:
+        return _hole_bore_wall(_fan_hole("probe", fan, angle, half_span), bores)
+
+    holes = []
+    for i, a in enumerate(angles):
+        lo = _min_valid_half_span(fan, a)
+        hi = math.pi / fan.count
+        if wall(lo, a) < L:
+            raise GeometryError(
+                f"hole_{i}: the fan-hole ligament of {L} mm cannot be kept: even the narrowest "
+                f"hole with fillets of {fan.fillet_radius} mm leaves only {wall(lo, a):.3g} mm to "
+                "the nearest bore; reduce fan_holes.ligament, move the hole radially, or shrink "
+                "the bores")
+        if wall(hi, a) >= L:
+            raise GeometryError(
+                f"hole_{i}: with fan_holes.ligament = {L} mm the fan holes would meet each other "
+                "before they come that close to a bore; give fan_holes.span_deg instead")
+        half = brentq(lambda x: wall(x, a) - L, lo, hi, xtol=1e-12)
+        h = _fan_hole(f"hole_{i}", fan, a, half)
+        h.validate()
+        holes.append(h)
+    return holes
+
+
+def _min_valid_half_span(fan, angle: float) -> float:
+    """Smallest half-span for which the fillets fit (bisection on FanHole.validate)."""
+    lo, hi = 0.0, math.pi / fan.count
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        try:
+            _fan_hole("probe", fan, angle, mid).validate()
+            hi = mid
+        except GeometryError:
+            lo = mid
+    return hi
+
+
+def _hole_bore_wall(hole: Feature, bores) -> float:
+    """Smallest wall between a hole and the bores, mm: the hole's exact signed distance to each bore
+    centre minus the bore radius (negative when they overlap)."""
+    centres = np.array([b.centre for b in bores], dtype=float)
+    return float(np.min(hole.signed_distance(centres) - np.array([b.radius for b in bores])))
+
+
+def _round_holes(case: Case, first_index: int) -> list[Circle]:
+    rh = case.round_holes
+    if rh is None:
+        return []
+    offset = _default_offset(case) if rh.angle_offset_deg is None else math.radians(rh.angle_offset_deg)
+    out = []
+    for i in range(rh.count):
+        a = offset + 2 * math.pi * i / rh.count
+        out.append(Circle(f"hole_{first_index + i}", (rh.circle_radius * math.cos(a),
+                                                       rh.circle_radius * math.sin(a)), rh.radius))
+    return out
+
+
+def _wall(a, b) -> Wall:
+    """Thinnest wall between features a and b: min over dense points on a's outline of b's exact
+    signed distance (and the other way round)."""
+    best = None
+    for f, g in ((a, b), (b, a)):
+        pts = f.sample(WALL_SPACING)
+        d = g.signed_distance(pts)
+        i = int(np.argmin(d))
+        if best is None or d[i] < best[0]:
+            best = (float(d[i]), (float(pts[i, 0]), float(pts[i, 1])))
+    return Wall(a.name, b.name, best[0], best[1])
+
+
+def _profile_wall(profile: Profile, f) -> Wall:
+    """Thinnest wall between the profile (its dense samples) and a feature (exact distance). A
+    feature entirely outside the profile is caught separately in :func:`disc_geometry`."""
+    pts = profile.points
+    d = f.signed_distance(pts)
+    i = int(np.argmin(d))
+    return Wall("profile", f.name, float(d[i]), (float(pts[i, 0]), float(pts[i, 1])))
+
+
+def disc_geometry(case: Case) -> DiscGeometry:
+    """Build the disc geometry of a case and check it before any meshing.
+
+    Checks (each failure is a GeometryError naming the features and what to change):
+
+    * the profile has no undercut (see :func:`build_profile`);
+    * fan holes: fillets fit, the ligament to the bores can be kept;
+    * every feature lies inside the profile and no two features (or a feature and the profile)
+      overlap;
+    * no wall (feature–feature or feature–profile) is thinner than ``mesh.min_wall``; the message
+      gives the thinnest wall, its thickness and the two features.
+
+    Parameters
+    ----------
+    case : Case
+
+    Returns
+    -------
+    DiscGeometry
+    """
+    profile = build_profile(case)
+    central = Circle("central_hole", (0.0, 0.0), case.cycloid.central_hole_radius)
+    bores = tuple(Circle(f"bore_{i}", (float(x), float(y)), case.crank_bearing.bore_radius)
+                  for i, (x, y) in enumerate(crank_centres(case)))
+    fans = _fan_holes(case, bores)
+    holes = tuple(fans) + tuple(_round_holes(case, len(fans)))
+    features = (central,) + bores + holes
+    for f in features:
+        f.validate()
+
+    # every feature inside the profile
+    outline = _MplPath(profile.points)
+    for f in features:
+        pts = f.sample(0.5)
+        outside = ~outline.contains_points(pts)
+        if np.all(outside):
+            raise GeometryError(
+                f"{f.name} lies entirely outside the cycloid profile (root radius "
+                f"{profile.root_radius:.3f} mm); check its position and size")
+
+    walls = [_profile_wall(profile, f) for f in features]
+    for i, f in enumerate(features):
+        for g in features[i + 1:]:
+            walls.append(_wall(f, g))
+    walls.sort(key=lambda w: w.thickness)
+    thinnest = walls[0]
+    min_wall = case.mesh.min_wall
+    if thinnest.thickness <= 0:
+        if thinnest.first == "profile":
+            msg = (f"{thinnest.second} cuts the cycloid profile (overlap {-thinnest.thickness:.3f} mm; "
+                   f"root radius {profile.root_radius:.3f} mm)")
+        else:
+            msg = f"{thinnest.second} overlaps {thinnest.first} (overlap {-thinnest.thickness:.3f} mm)"
+        raise GeometryError(
+            f"{msg} near ({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm; move or "
+            "shrink the features (fan_holes / round_holes / crank_bearing.bore_radius / "
+            "cranks.circle_radius / cycloid.central_hole_radius)")
+    if thinnest.thickness < min_wall:
+        raise GeometryError(
+            f"the wall between {thinnest.first} and {thinnest.second} is only "
+            f"{thinnest.thickness:.3f} mm thick (mesh.min_wall = {min_wall} mm), near "
+            f"({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm; move or shrink the "
+            "features, or lower mesh.min_wall if such a thin wall is intended")
+    return DiscGeometry(case=case, profile=profile, central_hole=central, bores=bores,
+                        holes=holes, walls=tuple(walls))

@@ -1,0 +1,219 @@
+"""Drive kinematics in the disc frame: pin and crank centres, pin–profile gaps, closest points.
+
+Everything is in the **disc's body frame**: the disc centre is the origin, the disc does not move,
+and the pins move around it. Lengths are mm, angles radians.
+
+Kinematics
+----------
+The crank angle θ is the angle of the eccentric relative to the carrier, counted counter-clockwise
+(docs/theory.md, "Kinematics"). The disc is carried by the cranks, so it translates with the
+eccentric but keeps the carrier's orientation. With the pin housing fixed, its pin ``j`` at ``Rp·u(2πj/Zp)`` (pin 0 on
+the housing's x axis), the disc centre at ``e·u(β)`` and the disc turned by ψ, the rolling condition
+of the internal gear pair relative to the eccentric gives ψ = −β·(Zp − Zc)/Zc, and θ = β − ψ =
+β·Zp/Zc. Expressing the pin centres in the disc frame, ``R(−ψ)·(p_j − e·u(β))``, gives
+
+    c_j(θ) = Rp·u(2πj/Zp + θ·(Zp − Zc)/Zp) − e·u(θ),      u(a) = (cos a, sin a),
+
+i.e. seen from the disc the pin-circle centre sits at −e·u(θ) (opposite the eccentric) and the pin
+ring has turned by **+θ·(Zp − Zc)/Zp** (counter-clockwise for a counter-clockwise crank angle).
+:func:`pin_centres` implements this; the tests check the sign through the envelope property.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from matplotlib.path import Path as _MplPath
+
+from ..case import Case
+from .._arrays import readonly as _readonly
+from .profile import Profile, _c2xy, _u, build_profile, profile_eval
+
+__all__ = [
+    "pin_centres",
+    "crank_centres",
+    "PinContacts",
+    "pin_profile_contacts",
+    "closest_points",
+]
+
+
+def pin_centres(case: Case, theta: float) -> np.ndarray:
+    """Pin centres in the disc frame at crank angle θ.
+
+    c_j(θ) = Rp·u(2πj/Zp + θ·(Zp − Zc)/Zp) − e·u(θ), j = 0…Zp − 1 (see the module docstring for
+    the derivation; pin 0 is the pin on the housing's x axis).
+
+    Parameters
+    ----------
+    case : Case
+    theta : float
+        Crank angle θ, rad (eccentric relative to the carrier, counter-clockwise).
+
+    Returns
+    -------
+    ndarray (Zp, 2)
+        mm.
+    """
+    zp, zc = case.pins.count, case.cycloid.teeth
+    j = np.arange(zp)
+    c = case.pins.circle_radius * _u(2 * np.pi * j / zp + theta * (zp - zc) / zp) \
+        - case.cycloid.eccentricity * _u(theta)
+    return _c2xy(c)
+
+
+def crank_centres(case: Case) -> np.ndarray:
+    """Centres of the crank-bearing bores in the disc frame, r0·u(α_i), (N, 2), mm."""
+    a = np.radians(np.asarray(case.cranks.angles_deg, dtype=float))
+    return _c2xy(case.cranks.circle_radius * _u(a))
+
+
+@dataclass(frozen=True, eq=False)
+class PinContacts:
+    """Pin–profile geometry at one crank angle (disc frame).
+
+    Attributes
+    ----------
+    theta : float
+        Crank angle, rad.
+    centres : ndarray (Zp, 2)
+        Pin centres, mm.
+    gap : ndarray (Zp,)
+        Signed gap, mm: signed distance from the pin centre to the actual profile (positive
+        outside the disc) minus the pin radius r_rp. Negative = overlap.
+    point : ndarray (Zp, 2)
+        Closest point on the profile, mm.
+    normal : ndarray (Zp, 2)
+        Unit outward normal of the profile at that point (towards the pin centre when the gap is
+        above −r_rp).
+    segment, param : ndarray (Zp,)
+        Profile segment and base-curve parameter of the closest point.
+    """
+
+    theta: float
+    centres: np.ndarray
+    gap: np.ndarray
+    point: np.ndarray
+    normal: np.ndarray
+    segment: np.ndarray
+    param: np.ndarray
+
+
+def closest_points(profile: Profile, xy: np.ndarray):
+    """Closest points on the actual profile to arbitrary points.
+
+    Parameters
+    ----------
+    profile : Profile
+    xy : ndarray (n, 2)
+        Points, mm.
+
+    Returns
+    -------
+    segment, param : ndarray (n,)
+        Segment and base-curve parameter of each closest point.
+    points, normals : ndarray (n, 2)
+        The closest points (mm) and the unit outward normals there.
+
+    Notes
+    -----
+    Start at the nearest dense sample, then Newton iterations on the stationarity condition
+    f(s) = (P(s) − x)·P'(s) = 0 with f' = |P'|² + (P − x)·P'' (analytic derivatives), continuing
+    across segment ends for Zp − Zc = 1 and stopping at the tip corners for Zp − Zc > 1. Converges
+    to round-off.
+    """
+    xy = np.asarray(xy, dtype=float)
+    seg, s, P, P1 = _closest_points(profile, xy[:, 0] + 1j * xy[:, 1])
+    return seg, s, _c2xy(P), _c2xy(-1j * P1 / np.abs(P1))
+
+
+def _closest_points(profile: Profile, c: np.ndarray, tol: float = 1e-15, max_iter: int = 50):
+    """Closest points on the profile to complex points c (see :func:`closest_points`).
+    Returns (segment, s, P, P1) with complex P, P1."""
+    if profile.tree is not None:
+        idx = profile.tree.query(_c2xy(c))[1]
+    else:
+        pts = profile.points[:, 0] + 1j * profile.points[:, 1]
+        idx = np.argmin(np.abs(c[:, None] - pts[None, :]), axis=1)
+    seg = profile.segment[idx].copy()
+    s = profile.param[idx].copy()
+    s_h = profile.half_range
+    smooth = profile.tooth_difference == 1
+    active = np.ones(len(c), bool)
+    for _ in range(max_iter):
+        P, P1, P2 = profile_eval(profile, seg, s, derivatives=True)
+        diff = P - c
+        f = np.real(np.conj(diff) * P1)
+        fp = np.abs(P1) ** 2 + np.real(np.conj(diff) * P2)
+        fp = np.where(fp > 0, fp, np.abs(P1) ** 2)
+        step = np.clip(-f / fp, -0.25 * s_h, 0.25 * s_h)
+        step[~active] = 0.0
+        s = s + step
+        if smooth:
+            up = s > s_h
+            seg[up] += 1
+            s[up] -= 2 * s_h
+            dn = s < -s_h
+            seg[dn] -= 1
+            s[dn] += 2 * s_h
+            seg %= profile.teeth
+        else:
+            s = np.clip(s, -s_h, s_h)
+        active &= np.abs(step) > tol
+        if not active.any():
+            break
+    P, P1, _ = profile_eval(profile, seg, s, derivatives=True)
+    return seg, s, P, P1
+
+
+def pin_profile_contacts(geom_or_case, theta: float) -> PinContacts:
+    """Gaps between every pin and the actual (modified, pitch-error) profile at crank angle θ.
+
+    Parameters
+    ----------
+    geom_or_case : rvfem.geometry.DiscGeometry or Case
+        Pass a :class:`~rvfem.geometry.features.DiscGeometry` when calling this for many angles; a Case is turned into a
+        profile first (which repeats the profile construction and checks on every call).
+    theta : float
+        Crank angle, rad.
+
+    Returns
+    -------
+    PinContacts
+        Accuracy: the closest point is refined with Newton iterations on the parametric profile
+        to round-off (≈1e-12 mm), not taken from the samples. For d > 1 a closest point beyond a
+        tip corner is the corner itself.
+    """
+    if isinstance(geom_or_case, Case):
+        case = geom_or_case
+        profile = build_profile(case)
+    elif isinstance(getattr(geom_or_case, "profile", None), Profile) and isinstance(
+            getattr(geom_or_case, "case", None), Case):
+        profile, case = geom_or_case.profile, geom_or_case.case     # a DiscGeometry
+    else:
+        raise TypeError("pin_profile_contacts needs a DiscGeometry or a Case")
+    cxy = pin_centres(case, theta)
+    c = cxy[:, 0] + 1j * cxy[:, 1]
+    seg, s, P, P1 = _closest_points(profile, c)
+    n = -1j * P1 / np.abs(P1)
+    diff = c - P
+    dist = np.abs(diff)
+    # signed distance: positive on the outward side. At a d > 1 corner the normal is undefined;
+    # use the direction to the pin there.
+    sd = np.real(np.conj(diff) * n)
+    if profile.tooth_difference > 1:
+        corner = np.abs(np.abs(s) - profile.half_range) < 1e-12
+        if np.any(corner):
+            inside = _MplPath(profile.points).contains_points(_c2xy(c[corner]))
+            sgn = np.where(inside, -1.0, 1.0)
+            u = diff[corner] / np.where(dist[corner] > 0, dist[corner], 1.0)
+            n = n.copy()
+            n[corner] = sgn * u
+            sd = sd.copy()
+            sd[corner] = sgn * dist[corner]
+    return PinContacts(
+        theta=float(theta), centres=_readonly(cxy), gap=_readonly(sd - case.pins.radius),
+        point=_readonly(_c2xy(P)), normal=_readonly(_c2xy(n)), segment=_readonly(seg),
+        param=_readonly(s),
+    )
