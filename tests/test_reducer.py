@@ -132,6 +132,7 @@ def fan_pair_cycle(fan_system):
     return stage, cycle.load_cycle(fan_system, THETA, saved_angles_deg=(), stage=stage)
 
 
+@pytest.mark.slow
 def test_pair_equilibrium_of_both_discs_and_the_carrier(fan_pair_cycle):
     stage, result = fan_pair_cycle
     case = stage.first.case
@@ -151,6 +152,7 @@ def test_pair_equilibrium_of_both_discs_and_the_carrier(fan_pair_cycle):
     assert 0.02 < share.max() - 1 < 0.15 and 0.02 < 1 - share.min() < 0.15
 
 
+@pytest.mark.slow
 def test_mirrored_pairs_equal_direct_pair_solves(fan_system):
     """The second half of the cycle comes from disc B of the first half's pairs; solving those
     angles directly gives the same state to the solver's tolerance. Exact without rollers: the
@@ -167,6 +169,7 @@ def test_mirrored_pairs_equal_direct_pair_solves(fan_system):
         assert direct.torque_Nmm[0] == pytest.approx(result.disc_torque_Nmm[j, 0], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_mirrored_pairs_with_rollers_differ_only_by_the_cage_phase(fan_pair_cycle):
     stage, result = fan_pair_cycle
     for j in (20, 35):
@@ -174,6 +177,7 @@ def test_mirrored_pairs_with_rollers_differ_only_by_the_cage_phase(fan_pair_cycl
         assert np.abs(direct.bearing_forces[0] - result.bearing_forces[j]).max() < 1e-3 * result.bearing_loads.max()
 
 
+@pytest.mark.slow
 def test_pair_keeps_the_n_fold_symmetry(fan_pair_cycle):
     """Bearing i + 1 at θ + 120° carries what bearing i carries at θ (within the unstructured
     mesh's asymmetry; 0.11 % for one disc)."""
@@ -184,6 +188,7 @@ def test_pair_keeps_the_n_fold_symmetry(fan_pair_cycle):
         assert np.abs(np.roll(F[:, i], shift) - F[:, i + 1]).max() < 0.005 * F.max()
 
 
+@pytest.mark.slow
 def test_two_discs_lower_the_fan_hole_peak_against_one_disc_with_half_the_torque(fan_system, fan_pair_cycle):
     """Sharing the carrier lets the stiffer disc take more torque: on the fan-hole disc the
     maximum bearing load falls (an independent full-system solver: +20.3 % → +13.8 % over the
@@ -195,6 +200,7 @@ def test_two_discs_lower_the_fan_hole_peak_against_one_disc_with_half_the_torque
     assert 0.08 < pair.bearing_loads.max() / hb - 1 < 0.20
 
 
+@pytest.mark.slow
 def test_stiff_discs_share_the_torque_equally_and_give_the_handbook_loads(tmp_path_factory):
     """The rigid limit of the pair: discs 10⁶× stiffer, bearings 1000× stiffer, linear pins."""
     case = coarse("rv40e_solid")
@@ -210,6 +216,7 @@ def test_stiff_discs_share_the_torque_equally_and_give_the_handbook_loads(tmp_pa
     assert np.abs(result.bearing_loads.T - hb.magnitude).max() <= 0.03 * hb.magnitude.max()
 
 
+@pytest.mark.slow
 def test_very_stiff_crankshafts_give_the_rigid_support_result(fan_system, fan_pair_cycle):
     _, rigid_support = fan_pair_cycle
     f = 1e-14 * np.array([[2.0, 1.0], [1.0, 2.0]])     # mm/N: 10¹⁴ N/mm
@@ -219,6 +226,7 @@ def test_very_stiff_crankshafts_give_the_rigid_support_result(fan_system, fan_pa
     assert np.abs(result.bearing_forces - ref).max() <= 1e-6 * np.abs(ref).max()
 
 
+@pytest.mark.slow
 def test_crankshaft_deflection_follows_the_influence_matrix(fan_system):
     """The reported eccentric displacements are −f·F of the forces on both discs, and a softer
     crank support moves the eccentrics more."""
