@@ -54,7 +54,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .contact import AngleSolution, Body, solve_bodies
+from .contact import Body, solve_bodies
 from .errors import CaseError
 
 log = logging.getLogger(__name__)

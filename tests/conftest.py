@@ -12,6 +12,19 @@ ROOT = Path(__file__).resolve().parents[1]
 CASES_DIR = ROOT / "cases"
 
 
+def coarse_case(name: str, **changes):
+    """A shipped case on a coarse mesh (0.6 mm at the flanks and bores, 4 mm inside) with the given
+    tables updated (``coarse_case("rv40e_solid", crank_bearing={"stiffness_law": "linear", ...})``):
+    fast enough for the science-core tests."""
+    from rvfem.case import case_from_dict, case_to_dict, load_case
+
+    data = case_to_dict(load_case(CASES_DIR / f"{name}.toml"))
+    data["mesh"].update(size_flank=0.6, size_bore=0.6, size_interior=4.0)
+    for table, values in changes.items():
+        data[table].update(values)
+    return case_from_dict(data, source=f"{name} (coarse)")
+
+
 class CaseText:
     """Edits a case file's text line by line (keys addressed by table), for validation tests."""
 

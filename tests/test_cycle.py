@@ -12,22 +12,14 @@ import numpy as np
 import pytest
 
 from rvfem import compare, cycle, rigid
-from rvfem.case import Case, case_from_dict, case_to_dict, load_case
+from rvfem.case import case_from_dict, case_to_dict
 from rvfem.errors import ContactError
 from rvfem.mesh import mesh_case
 
-from conftest import CASES_DIR
+from conftest import coarse_case as coarse
 
 STEP = np.radians(10.0)
 THETA = np.arange(36) * STEP   # 10° steps: the 120° shifts of three cranks are whole samples
-
-
-def coarse(name: str, **changes) -> Case:
-    data = case_to_dict(load_case(CASES_DIR / f"{name}.toml"))
-    data["mesh"].update(size_flank=0.6, size_bore=0.6, size_interior=4.0)
-    for table, values in changes.items():
-        data[table].update(values)
-    return case_from_dict(data, source=f"{name} (coarse)")
 
 
 @pytest.fixture(scope="module")

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from rvfem import cycle, reducer, rigid
-from rvfem.case import Case, case_from_dict, case_to_dict, load_case
+from rvfem.case import load_case
 from rvfem.mesh import mesh_case
 
-from conftest import CASES_DIR
+from conftest import CASES_DIR, coarse_case as coarse
 
 STEP = np.radians(10.0)
 THETA = np.arange(36) * STEP   # 10° steps: 180° and the 120° crank spacing are whole samples
@@ -110,14 +110,6 @@ def test_second_disc_phase_is_half_a_tooth_pitch_for_one_tooth_difference():
 # ------------------------------------------------------------------------------------------------
 # two discs on one carrier
 # ------------------------------------------------------------------------------------------------
-
-
-def coarse(name: str, **changes) -> Case:
-    data = case_to_dict(load_case(CASES_DIR / f"{name}.toml"))
-    data["mesh"].update(size_flank=0.6, size_bore=0.6, size_interior=4.0)
-    for table, values in changes.items():
-        data[table].update(values)
-    return case_from_dict(data, source=f"{name} (coarse)")
 
 
 @pytest.fixture(scope="module")
