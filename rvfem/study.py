@@ -461,6 +461,30 @@ class VariantTask:
     cache_dir: str
 
 
+class _Cancelled(Exception):
+    """The client cancelled the variant while it ran (raised from run_case's progress callback)."""
+
+
+def _cancellation_check() -> Callable[[str, int, int], None] | None:
+    """A progress callback for :func:`~rvfem.run.run_case` that aborts the run once the client has
+    cancelled its Dask task (Ctrl-C, or the client went away): run_case then removes its temporary
+    folder, so a cancelled variant leaves nothing behind. None outside a Dask worker."""
+    try:
+        from distributed import get_worker
+        from distributed.worker import thread_state
+
+        worker, key = get_worker(), thread_state.key
+    except (ImportError, ValueError, AttributeError):
+        return None
+
+    def check(stage: str, done: int, total: int) -> None:
+        ts = worker.state.tasks.get(key)
+        if ts is None or ts.state in ("cancelled", "released", "forgotten"):
+            raise _Cancelled(f"cancelled during stage {stage}")
+
+    return check
+
+
 def run_variant(task: VariantTask) -> dict:
     """Run one variant into its result folder and return a small record.
 
@@ -484,8 +508,11 @@ def run_variant(task: VariantTask) -> dict:
         if case.digest() != task.digest:
             raise CaseError(f"{task.base_case}: the case file changed since the study was checked "
                             "(the variant's case digest differs); run the study again")
-        result = run_case(case, task.out_dir, images=False, overwrite=True, cache_dir=task.cache_dir)
+        result = run_case(case, task.out_dir, images=False, overwrite=True, cache_dir=task.cache_dir,
+                          progress=_cancellation_check())
         record["summary"] = result.summary
+    except _Cancelled as exc:
+        record.update(status="cancelled", error=str(exc))
     except RvfemError as exc:
         record.update(status="failed", error=_one_line(f"{type(exc).__name__}: {exc}"))
     except Exception as exc:  # a bug: keep the study going, log the traceback where it happened
@@ -723,15 +750,19 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
     _write_atomic(out_dir / "study.json", json.dumps(_study_dict(study), indent=2, allow_nan=False) + "\n")
     records: dict[str, dict] = {}
     todo: list[Variant] = []
+    first_of: dict[str, str] = {}  # case digest -> id of the variant that computes it
     for v in study.variants:
+        if v.digest in first_of:  # the same case as an earlier variant (e.g. the base in a grid)
+            continue
+        first_of[v.digest] = v.id
         earlier = _existing_record(v, variants_dir / v.id)
         if earlier is not None:
             records[v.id] = earlier
         else:
             todo.append(v)
     if records:
-        log.info("study %s: %d of %d variants reused from an earlier run", study.name, len(records), len(study.variants))
-    total = len(study.variants)
+        log.info("study %s: %d of %d variants reused from an earlier run", study.name, len(records), len(first_of))
+    total = len(first_of)
     interrupted = False
     if todo:
         try:
@@ -742,11 +773,14 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
             raise
         finally:
             for v in study.variants:
-                records.setdefault(v.id, {"id": v.id, "status": "cancelled" if interrupted else "not run",
-                                          "error": "interrupted before it finished" if interrupted else "",
-                                          "computed": False, "summary": None, "wall_time_s": float("nan")})
+                records.setdefault(first_of[v.digest], {
+                    "id": v.id, "status": "cancelled" if interrupted else "not run",
+                    "error": "interrupted before it finished" if interrupted else "",
+                    "computed": False, "summary": None, "wall_time_s": float("nan")})
+            _same_case_records(study, records, first_of)
             rows = study_rows(study, records)
             _write_atomic(out_dir / "study.csv", _csv_text(rows))
+    _same_case_records(study, records, first_of)
     rows = study_rows(study, records)
     files = {"csv": out_dir / "study.csv", "json": out_dir / "study.json"}
     _write_atomic(files["csv"], _csv_text(rows))
@@ -758,8 +792,17 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
     computed = sum(1 for r in records.values() if r["computed"])
     failed = sum(1 for r in records.values() if r["status"] != "ok")
     return StudyResult(out_dir=out_dir, study=study, rows=tuple(rows), computed=computed,
-                       reused=sum(1 for r in records.values() if not r["computed"] and r["status"] == "ok"),
+                       reused=sum(1 for r in records.values()
+                                  if not r["computed"] and r["status"] == "ok" and not r.get("same_as")),
                        failed=failed, files=files, wall_time_s=wall)
+
+
+def _same_case_records(study: Study, records: dict, first_of: dict) -> None:
+    """Records of the variants whose case another variant computed (same digest)."""
+    for v in study.variants:
+        first = first_of[v.digest]
+        if first != v.id:
+            records[v.id] = {**records[first], "id": v.id, "computed": False, "same_as": first}
 
 
 def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path, records: dict, total: int, *,
@@ -866,7 +909,8 @@ def study_rows(study: Study, records: dict[str, dict]) -> list[dict]:
                                "varied": ",".join(k for k, _ in v.settings)}
         for p in study.parameters:
             row[p.key] = settings.get(p.key, p.base_value)
-        row.update(status=r.get("status", "not run"), computed=r.get("computed", False), error=r.get("error", ""),
+        row.update(status=r.get("status", "not run"), computed=r.get("computed", False),
+                   same_as=r.get("same_as", ""), error=r.get("error", ""),
                    wall_time_s=r.get("wall_time_s"), digest=v.digest,
                    overrides=";".join(f"{k}={toml_literal(val)}" for k, val in v.settings))
         bearings = s["bearings"] if s else []
