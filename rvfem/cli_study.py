@@ -88,15 +88,22 @@ def _run_compare(args: argparse.Namespace) -> int:
 
     if args.overrides and not (_is_case_file(args.a) or _is_case_file(args.b)):
         raise CaseError("--set applies to case files; A and B are result folders")
+    from .case import load_case
+
+    inputs = []  # validate both before running either
+    for given in (args.a, args.b):
+        if _is_case_file(given) and not Path(given).is_dir():
+            inputs.append((given, load_case(given, args.overrides)))
+        else:
+            inputs.append((given, read_result(given)))
     with tempfile.TemporaryDirectory(prefix="rvfem-compare-") as tmp:
         results = []
-        for tag, given in (("A", args.a), ("B", args.b)):
-            if _is_case_file(given) and not Path(given).is_dir():
-                print(f"rvfem compare: running {given} ({tag}) …", file=sys.stderr)
-                results.append(result_from_case(given, Path(tmp) / tag, overrides=args.overrides,
-                                                cache_dir=args.cache_dir))
+        for tag, (given, item) in zip("AB", inputs):
+            if hasattr(item, "summary"):
+                results.append(item)
             else:
-                results.append(read_result(given))
+                print(f"rvfem compare: running {given} ({tag}) …", file=sys.stderr)
+                results.append(result_from_case(item, Path(tmp) / tag, cache_dir=args.cache_dir))
         a, b = results
         comparison = compare_results(a, b)
         if args.output:

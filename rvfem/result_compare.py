@@ -96,13 +96,15 @@ def read_result(folder: str | os.PathLike) -> ResultFolder:
     return ResultFolder(folder, label, summary, theta, flex.reshape(len(rows), n), rigid.reshape(len(rows), n))
 
 
-def result_from_case(case_path: str | os.PathLike, out_dir: str | os.PathLike, *, overrides: Sequence[str] = (),
+def result_from_case(case, out_dir: str | os.PathLike, *, overrides: Sequence[str] = (),
                      cache_dir: str | os.PathLike = "meshes") -> ResultFolder:
-    """Run a case file (images off) into ``out_dir`` and read the result back."""
-    from .case import load_case
+    """Run a case (a :class:`~rvfem.case.Case`, or a case file read with ``overrides``; images
+    off) into ``out_dir`` and read the result back."""
+    from .case import Case, load_case
     from .run import run_case
 
-    case = load_case(case_path, tuple(overrides))
+    if not isinstance(case, Case):
+        case = load_case(case, tuple(overrides))
     run_case(case, out_dir, images=False, overwrite=True, cache_dir=cache_dir)
     return read_result(out_dir)
 
