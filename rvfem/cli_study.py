@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import math
 import sys
 import tempfile
@@ -206,6 +207,8 @@ def _run_study(args: argparse.Namespace) -> int:
     from .study import load_study, run_study
 
     study = load_study(args.study, extra_overrides=args.overrides)
+    # Dask configures its loggers at INFO; follow rvfem's verbosity (-v, -vv) instead
+    logging.getLogger("distributed").setLevel(max(logging.getLogger().getEffectiveLevel(), logging.DEBUG))
     if args.check:
         _print_variants(study)
         return EXIT_OK

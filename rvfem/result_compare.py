@@ -188,7 +188,7 @@ def comparison_plot(a: ResultFolder, b: ResultFolder, path: str | os.PathLike) -
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = plt.subplots(figsize=(8, 5.5))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i in range(a.flexible_N.shape[1]):
         ax.plot(a.theta_deg, a.flexible_N[:, i], "-", color=colours[i % len(colours)], lw=1.2,
@@ -205,7 +205,7 @@ def comparison_plot(a: ResultFolder, b: ResultFolder, path: str | os.PathLike) -
     ax.set_xticks(range(0, 361, 60))
     ax.grid(alpha=0.3)
     ax.set_title(f"A = {a.label} (solid lines) vs B = {b.label} (dashed)", fontsize=10)
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.14), frameon=False)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
