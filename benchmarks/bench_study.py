@@ -46,16 +46,13 @@ def _study_file(folder: Path, n: int, step: float) -> Path:
 
 
 def _run(study_path: Path, workers: int, out: Path, cache: Path) -> dict:
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
-    from rvfem.study import BLAS_THREAD_VARIABLES, load_study, run_study
+    from rvfem.study import load_study, local_cluster, run_study
 
     study = load_study(study_path)
     t0 = time.perf_counter()
-    env = {name: "1" for name in BLAS_THREAD_VARIABLES}
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                      env=env, host="127.0.0.1") as cluster, Client(cluster) as client:
+    with local_cluster(workers) as cluster, Client(cluster) as client:
         client.run(__import__, "rvfem.run")  # warm the workers: imports are paid once per worker
         client.run(__import__, "rvfem.study")
         startup = time.perf_counter() - t0

@@ -88,6 +88,8 @@ __all__ = [
     "load_study",
     "run_variant",
     "run_study",
+    "local_cluster",
+    "SingleThreadedBlas",
     "study_rows",
     "read_study_csv",
     "toml_literal",
@@ -606,11 +608,21 @@ except ImportError:  # pragma: no cover
 
 
 class SingleThreadedBlas(_WorkerPluginBase):
-    """Worker plugin: limit the BLAS/OpenMP thread pools of every worker to one thread (also in
-    workers started by hand, without the nanny's environment)."""
+    """Worker plugin: one worker, one core.
+
+    Limits the BLAS/OpenMP thread pools of the worker to one thread (also in workers started by
+    hand, without the nanny's environment). With ``pin_core=True`` (the workers of
+    :func:`local_cluster`) it also pins the worker process to one core of the machine, worker
+    ``i`` to the ``i``-th allowed core, so that the few threads an analysis starts itself (the
+    parallel back-substitutions of the contact columns) share that core instead of competing with
+    the other workers (Linux; elsewhere a no-op).
+    """
 
     name = "rvfem-single-threaded-blas"
     idempotent = True
+
+    def __init__(self, pin_core: bool = False):
+        self.pin_core = pin_core
 
     def setup(self, worker) -> None:
         try:
@@ -619,9 +631,26 @@ class SingleThreadedBlas(_WorkerPluginBase):
             self._limits = threadpool_limits(limits=1)
         except Exception:  # a library threadpoolctl cannot control: leave it
             log.debug("threadpoolctl could not limit the thread pools", exc_info=True)
+        if self.pin_core and isinstance(worker.name, int) and hasattr(os, "sched_setaffinity"):
+            try:
+                cores = sorted(os.sched_getaffinity(0))
+                core = {cores[worker.name % len(cores)]}
+                for tid in os.listdir("/proc/self/task"):  # every thread of the process, and the
+                    os.sched_setaffinity(int(tid), core)   # threads started later inherit it
+            except OSError:
+                log.debug("could not pin worker %s to a core", worker.name, exc_info=True)
 
 
-def _local_cluster(workers: int | None):
+def local_cluster(workers: int | None = None):
+    """A :class:`distributed.LocalCluster` for studies: ``workers`` processes (default: one per
+    core), one thread each, BLAS/OpenMP pinned to one thread and each worker to its own core,
+    listening on 127.0.0.1 only, no dashboard.
+
+    Raises
+    ------
+    ClusterError
+        The cluster cannot be started.
+    """
     from distributed import LocalCluster
 
     n = workers or os.cpu_count() or 1
@@ -630,9 +659,10 @@ def _local_cluster(workers: int | None):
         env["PYTHONPATH"] = os.environ["PYTHONPATH"]
     try:
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                            env=env, silence_logs=logging.ERROR, host="127.0.0.1")
+                            env=env, silence_logs=logging.ERROR, host="127.0.0.1",
+                            plugins=(SingleThreadedBlas(pin_core=True),))
     except Exception as exc:
-        raise ClusterError(f"cannot start a local Dask cluster of {n} workers: {exc}") from None
+        raise ClusterError(f"cannot start a local Dask cluster of {n} workers: {_one_line(exc)}") from None
 
 
 def _connect(scheduler: str, timeout_s: float):
@@ -815,7 +845,7 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
         if scheduler:
             client = _connect(scheduler, connect_timeout_s)
         else:
-            cluster = _local_cluster(workers)
+            cluster = local_cluster(workers)
             from distributed import Client
 
             client = Client(cluster, set_as_default=False)

@@ -375,3 +375,15 @@ def test_notebook_runs_from_its_own_folder(tmp_path, monkeypatch):
         ratio = by[(lig, torques[-1])] / by[(lig, torques[0])]
         assert ratio == pytest.approx(torques[-1] / torques[0], rel=0.05)
     assert checks["cwd"] == str(path.parent) and Path(checks["root"]) == ROOT
+
+
+def test_an_unreachable_scheduler_is_one_line(tmp_path):
+    from rvfem.study import ClusterError
+
+    study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
+    address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
+    with pytest.raises(ClusterError, match=f"cannot connect to the Dask scheduler at {address}") as info:
+        run_study(study_file, tmp_path / "out", scheduler=address, connect_timeout_s=1.0)
+    assert "\n" not in str(info.value)
+    assert not (tmp_path / "out" / LOCK_NAME).exists()
+    assert not [p for p in (tmp_path / "out" / "variants").iterdir()]
