@@ -875,7 +875,7 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
                 record.update(status="failed", error=f"the worker wrote its results, but {variants_dir / v.id} is "
                               "not visible here: the study folder must be on a file system shared by the workers")
             if record["status"] != "ok":
-                log.warning("variant %s failed: %s", v.id, record["error"])
+                log.info("variant %s failed: %s", v.id, record["error"])
             records[v.id] = record
             done += 1
             if progress is not None:

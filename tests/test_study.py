@@ -387,3 +387,51 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path):
     assert "\n" not in str(info.value)
     assert not (tmp_path / "out" / LOCK_NAME).exists()
     assert not [p for p in (tmp_path / "out" / "variants").iterdir()]
+
+
+def _fake_summary(max_n: float, fm_n: float, life_h: float) -> dict:
+    bearing = {"flexible": {"max_load_N": max_n, "min_load_N": 0.1 * max_n, "equivalent_load_N": fm_n,
+                            "L10h_h": life_h},
+               "rigid": {"max_load_N": 1000.0, "min_load_N": 100.0, "equivalent_load_N": 800.0, "L10h_h": 5e4},
+               "delta_max_percent": 100 * (max_n / 1000.0 - 1), "delta_equivalent_percent": 100 * (fm_n / 800.0 - 1),
+               "life_ratio": life_h / 5e4}
+    return {"bearings": [bearing, bearing], "max_bearing_load": {"bearing": 1}, "peak_von_mises_MPa": 50.0,
+            "stress": {"away_from_contacts": {"peak_von_mises_MPa": 40.0}}}
+
+
+def test_rows_and_plots_of_a_sensitivity_study(tmp_path):
+    """Deltas against the handbook and the base from known numbers; the tornado and bar charts."""
+    from rvfem.study import _plots, study_rows
+
+    path = _write(tmp_path / "s.toml", _study_text("sensitivity", """
+[[parameter]]
+key = "fan_holes.ligament"
+low = 3.5
+high = 5.5
+
+[[parameter]]
+key = "crank_bearing.model"
+low = "rollers"
+high = "rigid_bore"
+"""))
+    study = load_study(path)
+    assert [v.id for v in study.variants] == ["base", "fan_holes.ligament=3.5", "fan_holes.ligament=5.5",
+                                               "crank_bearing.model=rigid_bore"]  # 'rollers' is the base
+    loads = {"base": 1100.0, "fan_holes.ligament=3.5": 1210.0, "fan_holes.ligament=5.5": 1045.0,
+             "crank_bearing.model=rigid_bore": 990.0}
+    records = {vid: {"id": vid, "status": "ok", "error": "", "computed": True, "wall_time_s": 1.0,
+                     "summary": _fake_summary(f, 0.8 * f, 4e4 * (1100.0 / f) ** (10 / 3))} for vid, f in loads.items()}
+    records["fan_holes.ligament=5.5"] = {"id": "fan_holes.ligament=5.5", "status": "failed", "computed": True,
+                                         "error": "GeometryError: too thin", "summary": None, "wall_time_s": 0.1}
+    rows = {r["id"]: r for r in study_rows(study, records)}
+    thin = rows["fan_holes.ligament=3.5"]
+    assert thin["max_vs_base_percent"] == pytest.approx(10.0, rel=1e-12)
+    assert thin["max_vs_handbook_percent"] == pytest.approx(21.0, rel=1e-12)
+    assert thin["life_ratio_vs_base"] == pytest.approx(1.1 ** (-10 / 3), rel=1e-12)
+    assert thin["bearing2_Fm_vs_base_percent"] == pytest.approx(10.0, rel=1e-12)
+    assert thin["fan_holes.ligament"] == 3.5 and thin["crank_bearing.model"] == "rollers"
+    assert rows["fan_holes.ligament=5.5"]["max_load_N"] is None
+    assert rows["fan_holes.ligament=5.5"]["error"] == "GeometryError: too thin"
+    files = _plots(study, list(rows.values()), tmp_path / "plots")
+    assert set(files) == {"tornado", "variants"}
+    assert all(p.stat().st_size > 5000 for p in files.values())
