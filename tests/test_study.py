@@ -1,0 +1,437 @@
+"""Design studies on Dask distributed: a real scheduler and two workers on localhost, the study
+against the same variants run one by one in-process, failing variants, resume, Ctrl-C, the lock,
+study-file and override errors, and the notebook executed from its own folder."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT
+from rvfem import cli
+from rvfem.case import load_case
+from rvfem.cli_study import COMPARE, STUDY
+from rvfem.errors import CaseError, OutputError
+from rvfem.run import run_case
+from rvfem.study import LOCK_NAME, load_study, read_study_csv, run_study
+
+BIN = Path(sys.executable).parent
+BASE_CASE = ROOT / "cases" / "rv40e_fanholes.toml"
+
+#: Coarse mesh and 30° steps: a variant in about 2 s; enough for the physics the tests check.
+COARSE = {"mesh.size_flank": 1.2, "mesh.size_bore": 1.5, "mesh.size_interior": 6.0, "mesh.size_hole": 2.0,
+          "analysis.angle_step_deg": 30.0}
+
+
+def _study_text(kind: str, body: str, name: str = "test_study") -> str:
+    overrides = "\n".join(f'"{k}" = {v!r}' for k, v in COARSE.items())
+    return (f'name = "{name}"\nbase_case = "{BASE_CASE.as_posix()}"\nkind = "{kind}"\n\n'
+            f"[overrides]\n{overrides}\n\n{body}\n")
+
+
+def _write(path: Path, text: str) -> Path:
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def _subcommands():
+    names = {s.name for s in cli.SUBCOMMANDS}
+    return cli.SUBCOMMANDS + tuple(c for c in (COMPARE, STUDY) if c.name not in names)
+
+
+def _main(argv, monkeypatch) -> int:
+    """``rvfem ARGV`` with the study subcommands registered."""
+    build = cli.build_parser
+    monkeypatch.setattr(cli, "build_parser", lambda subcommands=None: build(_subcommands()))
+    return cli.main([str(a) for a in argv])
+
+
+# A runner for subprocesses: `rvfem` with the study subcommands (until they are in cli.SUBCOMMANDS).
+RUNNER = """
+import sys
+from rvfem import cli
+from rvfem.cli_study import COMPARE, STUDY
+names = {s.name for s in cli.SUBCOMMANDS}
+subs = cli.SUBCOMMANDS + tuple(c for c in (COMPARE, STUDY) if c.name not in names)
+build = cli.build_parser
+cli.build_parser = lambda subcommands=None: build(subs)
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def _env() -> dict:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
+    return env
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def meshes(tmp_path_factory) -> Path:
+    """Mesh cache shared by the cluster tests (the variants of one base case share meshes)."""
+    return tmp_path_factory.mktemp("meshes")
+
+
+@pytest.fixture(scope="module")
+def scheduler(tmp_path_factory):
+    """A real Dask scheduler and two single-threaded workers, each its own process on 127.0.0.1."""
+    from distributed import Client
+
+    logs = tmp_path_factory.mktemp("dask-logs")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    procs = []
+    try:
+        procs.append(subprocess.Popen(
+            [str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
+             "--no-dashboard"], env=_env(), stdout=subprocess.DEVNULL, stderr=open(logs / "scheduler.log", "w")))
+        for i in range(2):
+            procs.append(subprocess.Popen(
+                [str(BIN / "dask"), "worker", address, "--nworkers", "1", "--nthreads", "1", "--host", "127.0.0.1",
+                 "--no-dashboard", "--name", f"test-worker-{i}", "--local-directory", str(logs / f"w{i}")],
+                env={**_env(), "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
+                stdout=subprocess.DEVNULL, stderr=open(logs / f"worker{i}.log", "w")))
+        with Client(address, timeout=30, set_as_default=False) as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address
+    finally:
+        for p in reversed(procs):
+            _stop(p)
+
+
+def _wait_for_no_partials(variants: Path, timeout_s: float = 30.0) -> None:
+    """A variant cancelled while it runs on an external worker stops at its next crank angle and
+    removes its temporary folder; wait for that (bounded)."""
+    end = time.monotonic() + timeout_s
+    while list(variants.glob(".*")):
+        assert time.monotonic() < end, f"temporary folders left: {[p.name for p in variants.glob('.*')]}"
+        time.sleep(0.1)
+
+
+LIST_BODY = """
+[[variant]]
+id = "thin-ligament"
+set = { "fan_holes.ligament" = 3.5 }
+
+[[variant]]
+id = "low-torque"
+set = { "loads.torque_Nm" = 300.0 }
+
+[[variant]]
+set = { "crank_bearing.model" = "rigid_bore" }
+"""
+
+
+@pytest.fixture(scope="module")
+def cluster_study(scheduler, meshes, tmp_path_factory):
+    """A 4-variant study (the base and three variants, one a model choice) through ``rvfem study
+    --scheduler``; the study folder and the time it took."""
+    tmp = tmp_path_factory.mktemp("cluster-study")
+    study_file = _write(tmp / "four.toml", _study_text("list", LIST_BODY, name="four"))
+    out = tmp / "out"
+    mp = pytest.MonkeyPatch()
+    try:
+        started = time.perf_counter()
+        code = _main(["study", study_file, "-o", out, "--scheduler", scheduler, "--cache-dir", meshes], mp)
+        elapsed = time.perf_counter() - started
+    finally:
+        mp.undo()
+    assert code == 0
+    return study_file, out, elapsed
+
+
+def test_study_on_a_real_cluster_equals_the_variants_run_in_process(cluster_study, tmp_path):
+    study_file, out, _ = cluster_study
+    study = load_study(study_file)
+    assert [v.id for v in study.variants] == ["base", "thin-ligament", "low-torque", "crank_bearing.model=rigid_bore"]
+    rows = {r["id"]: r for r in read_study_csv(out / "study.csv")}
+    assert set(rows) == {v.id for v in study.variants}
+    for v in study.variants:
+        row = rows[v.id]
+        assert row["status"] == "ok" and row["computed"] == "yes", row
+        # the same variant, run here one by one, with its own mesh cache
+        summary = run_case(load_case(study.base_case, v.overrides), tmp_path / v.id, images=False,
+                           cache_dir=tmp_path / "meshes").summary
+        assert row["digest"] == summary["case"]["digest"]
+        for i, b in enumerate(summary["bearings"], start=1):
+            assert row[f"bearing{i}_max_N"] == b["flexible"]["max_load_N"]          # bit-identical
+            assert row[f"bearing{i}_min_N"] == b["flexible"]["min_load_N"]
+            assert row[f"bearing{i}_Fm_N"] == b["flexible"]["equivalent_load_N"]
+            assert row[f"bearing{i}_L10h_h"] == b["flexible"]["L10h_h"]
+            assert row[f"bearing{i}_handbook_max_N"] == b["rigid"]["max_load_N"]
+            assert row[f"bearing{i}_life_ratio"] == b["life_ratio"]
+        assert row["peak_von_mises_MPa"] == summary["peak_von_mises_MPa"]
+        # the worker's result folder holds the same summary numbers
+        stored = json.loads((out / "variants" / v.id / "summary.json").read_text())
+        assert stored["bearings"] == summary["bearings"]
+    # deltas against the base are the base's own numbers
+    base = rows["base"]
+    assert rows["low-torque"]["max_vs_base_percent"] == pytest.approx(
+        100 * (rows["low-torque"]["max_load_N"] / base["max_load_N"] - 1), rel=1e-12)
+    assert base["max_vs_base_percent"] == 0.0
+    # physics: a thinner ligament raises the largest load; less torque lowers it about in proportion
+    assert rows["thin-ligament"]["max_load_N"] > base["max_load_N"]
+    assert rows["low-torque"]["max_load_N"] / base["max_load_N"] == pytest.approx(300 / 412, rel=0.05)
+    assert (out / "report.html").is_file() and (out / "plots" / "variants.png").is_file()
+    assert not (out / LOCK_NAME).exists()
+
+
+def test_rerun_recomputes_nothing(cluster_study, monkeypatch, capsys):
+    study_file, out, first_s = cluster_study
+    before = {p.name: (p / "summary.json").stat().st_mtime_ns for p in (out / "variants").iterdir()}
+    started = time.perf_counter()
+    result = run_study(study_file, out, scheduler="tcp://127.0.0.1:1")  # never contacted: nothing to do
+    assert (result.computed, result.reused, result.failed) == (0, 4, 0)
+    assert time.perf_counter() - started < first_s
+    after = {p.name: (p / "summary.json").stat().st_mtime_ns for p in (out / "variants").iterdir()}
+    assert after == before
+    assert all(r["computed"] == "no" and r["status"] == "ok" for r in read_study_csv(out / "study.csv"))
+
+
+def test_a_failing_variant_is_recorded_and_the_study_goes_on(scheduler, cluster_study, meshes, tmp_path):
+    _, done, _ = cluster_study
+    out = tmp_path / "out"
+    shutil.copytree(done / "variants" / "base", out / "variants" / "base")  # same base case: reused
+    study_file = _write(tmp_path / "fail.toml", _study_text("list", """
+[[variant]]
+id = "too-thin"
+set = { "fan_holes.ligament" = 1.0 }
+
+[[variant]]
+id = "also-thin"
+set = { "fan_holes.ligament" = 1.5 }
+"""))
+    result = run_study(study_file, out, scheduler=scheduler, cache_dir=meshes)
+    rows = {r["id"]: r for r in result.rows}
+    assert rows["base"]["status"] == "ok" and not rows["base"]["computed"]
+    for vid, thickness in (("too-thin", "1.000"), ("also-thin", "1.500")):
+        assert rows[vid]["status"] == "failed"
+        assert rows[vid]["error"].startswith("GeometryError: ") and f"only {thickness} mm thick" in rows[vid]["error"]
+        assert rows[vid]["max_load_N"] is None
+        assert not (out / "variants" / vid).exists()
+    assert result.failed == 2
+    csv_rows = {r["id"]: r for r in read_study_csv(out / "study.csv")}
+    assert csv_rows["too-thin"]["status"] == "failed" and "GeometryError" in csv_rows["too-thin"]["error"]
+
+
+def test_ctrl_c_cancels_and_leaves_no_partial_variant(scheduler, meshes, tmp_path):
+    study_file = _write(tmp_path / "grid.toml", _study_text("grid", """
+[[parameter]]
+key = "loads.torque_Nm"
+values = [250.0, 300.0, 350.0, 450.0, 500.0, 550.0]
+"""))
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-c", RUNNER, "study", str(study_file), "-o", str(out),
+                             "--scheduler", scheduler, "--cache-dir", str(meshes)],
+                            env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        end = time.monotonic() + 90
+        while not list((out / "variants").glob("*/summary.json")):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < end, "no variant finished in time"
+            time.sleep(0.1)
+        proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+    finally:
+        _stop(proc)
+    assert proc.returncode == 130, stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    _wait_for_no_partials(out / "variants")
+    folders = list((out / "variants").iterdir())
+    assert len(folders) < 7
+    for folder in folders:
+        assert not folder.name.startswith("."), f"temporary folder left: {folder.name}"
+        summary = json.loads((folder / "summary.json").read_text())   # complete, or not there at all
+        assert summary["case"]["digest"]
+    rows = read_study_csv(out / "study.csv")
+    assert {r["status"] for r in rows} <= {"ok", "cancelled"} and "cancelled" in {r["status"] for r in rows}
+    assert not (out / LOCK_NAME).exists()
+
+
+def test_a_second_study_into_the_same_folder_is_refused(tmp_path):
+    study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
+    out = tmp_path / "out"
+    out.mkdir()
+    lock = out / LOCK_NAME
+    lock.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "started": "now"}))
+    with pytest.raises(OutputError, match=r"in use by another study \(lock file .*\.study\.lock"):
+        run_study(study_file, out)
+    assert lock.exists()
+    # a lock left by a process that no longer runs is taken over (here: nothing to compute is not
+    # reachable without a cluster, so only the lock logic is checked)
+    from rvfem.study import _acquire_lock
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    lock.write_text(json.dumps({"pid": dead.pid, "host": socket.gethostname(), "started": "then"}))
+    assert _acquire_lock(out) == lock
+    assert json.loads(lock.read_text())["pid"] == os.getpid()
+
+
+@pytest.mark.parametrize("body, message", [
+    ('[[parameter]]\nkey = "fan_holes.ligamnt"\nvalues = [3.5]',
+     r"parameter\[1\] \(key fan_holes\.ligamnt\)|'fan_holes\.ligamnt' is not a known key \(did you mean 'fan_holes\.ligament'\?\)"),
+    ('[[parameter]]\nkey = "fan_holes.ligament"\nvalues = [-1.0]', r"fan_holes\.ligament"),
+    ('[[parameter]]\nkey = "crank_bearing.model"\nvalues = ["rollers", "ball"]', r"crank_bearing\.model"),
+    ('[[parameter]]\nkey = "fan_holes.ligament"\nlow = 3.5\nhigh = 5.5', r"parameter\[1\]\.low: unknown key"),
+    ('[[parameter]]\nkey = "fan_holes.ligament"', r"parameter\[1\]\.values: missing"),
+    ('[[parameter]]\nkey = "fan_holes.ligament"\nvalues = [3.5, 3.5]', r"parameter\[1\]\.values: a value appears twice"),
+    ('[[variant]]\nset = { "fan_holes.ligament" = 4.0 }', r"variant: only a study of kind 'list'"),
+    ('[[parametre]]\nkey = "x"', r"study\.parametre: unknown key \(did you mean 'parameter'\?\)"),
+])
+def test_study_file_errors_name_the_key(tmp_path, body, message):
+    path = _write(tmp_path / "bad.toml", _study_text("grid", body))
+    with pytest.raises(CaseError, match=message) as info:
+        load_study(path)
+    assert "\n" not in str(info.value) and str(path) in str(info.value)
+
+
+def test_study_file_errors_on_the_top_level(tmp_path):
+    path = _write(tmp_path / "bad.toml", 'base_case = "nowhere.toml"\nkind = "grid"\n')
+    with pytest.raises(CaseError, match=r"base_case: no case file 'nowhere.toml'"):
+        load_study(path)
+    path = _write(tmp_path / "bad.toml", f'base_case = "{BASE_CASE.as_posix()}"\nkind = "tornado"\n')
+    with pytest.raises(CaseError, match=r"kind: expected one of 'grid', 'sensitivity', 'list', got 'tornado'"):
+        load_study(path)
+    path = _write(tmp_path / "bad.toml", f'base_case = "{BASE_CASE.as_posix()}"\n')
+    with pytest.raises(CaseError, match=r"study\.kind: missing"):
+        load_study(path)
+
+
+def test_set_errors_name_the_key(tmp_path, monkeypatch, capsys):
+    path = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
+    code = _main(["study", path, "-o", tmp_path / "out", "--set", "fan_holes.ligamnt=4.0"], monkeypatch)
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    assert "fan_holes.ligamnt" in err and "did you mean 'fan_holes.ligament'" in err
+    assert not (tmp_path / "out").exists()  # validated before anything runs
+    code = _main(["study", path, "--set", "crank_bearing.model=ball", "--check"], monkeypatch)
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "crank_bearing.model" in err and len(err.splitlines()) == 1
+    code = _main(["study", path, "--set", "no equals sign"], monkeypatch)
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "expected KEY=VALUE" in err
+
+
+def test_sensitivity_study_variants_and_check(tmp_path, monkeypatch, capsys):
+    shipped = load_study(ROOT / "studies" / "rv40e_fanholes_tornado.toml")
+    assert shipped.kind == "sensitivity" and shipped.base.id == "base"
+    assert len(shipped.variants) == 1 + sum(v != p.base_value for p in shipped.parameters for v in p.values)
+    for p in shipped.parameters:  # low and high bracket the base value
+        assert p.values[0] <= p.base_value <= p.values[1] and p.values[0] < p.values[1], p
+    assert len({v.digest for v in shipped.variants}) == len(shipped.variants)
+    grid = load_study(ROOT / "studies" / "rv40e_ligament_torque_grid.toml")
+    sizes = [len(p.values) for p in grid.parameters]
+    assert len(grid.variants) == 1 + sizes[0] * sizes[1]
+    code = _main(["study", ROOT / "studies" / "rv40e_fanholes_tornado.toml", "--check"], monkeypatch)
+    assert code == 0 and "fan_holes.fillet_radius=" in capsys.readouterr().out
+
+
+def test_notebook_runs_from_its_own_folder(tmp_path, monkeypatch):
+    """Executed as Jupyter does (kernel started in notebooks/), on a local cluster."""
+    import nbformat
+    from nbclient import NotebookClient
+
+    monkeypatch.setenv("RVFEM_NOTEBOOK_RESULTS", str(tmp_path))
+    monkeypatch.setenv("PYTHONPATH", _env()["PYTHONPATH"])
+    path = ROOT / "notebooks" / "design_study.ipynb"
+    nb = nbformat.read(path, as_version=4)
+    NotebookClient(nb, timeout=300, kernel_name="python3",
+                   resources={"metadata": {"path": str(path.parent)}}).execute()
+    checks = json.loads((tmp_path / "design_study" / "run_info.json").read_text())
+    rows = read_study_csv(tmp_path / "design_study" / "study.csv")
+    assert all(r["status"] == "ok" for r in rows)
+    by = {(r["fan_holes.ligament"], r["loads.torque_Nm"]): r["max_load_N"] for r in rows if r["role"] == "grid"}
+    ligaments = sorted({k[0] for k in by})
+    torques = sorted({k[1] for k in by})
+    for t in torques:  # the largest load rises as the ligament shrinks
+        loads = [by[(lig, t)] for lig in ligaments]
+        assert loads == sorted(loads, reverse=True), loads
+    for lig in ligaments:  # and scales about linearly with the torque
+        ratio = by[(lig, torques[-1])] / by[(lig, torques[0])]
+        assert ratio == pytest.approx(torques[-1] / torques[0], rel=0.05)
+    assert checks["cwd"] == str(path.parent) and Path(checks["root"]) == ROOT
+
+
+def test_an_unreachable_scheduler_is_one_line(tmp_path):
+    from rvfem.study import ClusterError
+
+    study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
+    address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
+    with pytest.raises(ClusterError, match=f"cannot connect to the Dask scheduler at {address}") as info:
+        run_study(study_file, tmp_path / "out", scheduler=address, connect_timeout_s=1.0)
+    assert "\n" not in str(info.value)
+    assert not (tmp_path / "out" / LOCK_NAME).exists()
+    assert not [p for p in (tmp_path / "out" / "variants").iterdir()]
+
+
+def _fake_summary(max_n: float, fm_n: float, life_h: float) -> dict:
+    bearing = {"flexible": {"max_load_N": max_n, "min_load_N": 0.1 * max_n, "equivalent_load_N": fm_n,
+                            "L10h_h": life_h},
+               "rigid": {"max_load_N": 1000.0, "min_load_N": 100.0, "equivalent_load_N": 800.0, "L10h_h": 5e4},
+               "delta_max_percent": 100 * (max_n / 1000.0 - 1), "delta_equivalent_percent": 100 * (fm_n / 800.0 - 1),
+               "life_ratio": life_h / 5e4}
+    return {"bearings": [bearing, bearing], "max_bearing_load": {"bearing": 1}, "peak_von_mises_MPa": 50.0,
+            "stress": {"away_from_contacts": {"peak_von_mises_MPa": 40.0}}}
+
+
+def test_rows_and_plots_of_a_sensitivity_study(tmp_path):
+    """Deltas against the handbook and the base from known numbers; the tornado and bar charts."""
+    from rvfem.study import _plots, study_rows
+
+    path = _write(tmp_path / "s.toml", _study_text("sensitivity", """
+[[parameter]]
+key = "fan_holes.ligament"
+low = 3.5
+high = 5.5
+
+[[parameter]]
+key = "crank_bearing.model"
+low = "rollers"
+high = "rigid_bore"
+"""))
+    study = load_study(path)
+    assert [v.id for v in study.variants] == ["base", "fan_holes.ligament=3.5", "fan_holes.ligament=5.5",
+                                               "crank_bearing.model=rigid_bore"]  # 'rollers' is the base
+    loads = {"base": 1100.0, "fan_holes.ligament=3.5": 1210.0, "fan_holes.ligament=5.5": 1045.0,
+             "crank_bearing.model=rigid_bore": 990.0}
+    records = {vid: {"id": vid, "status": "ok", "error": "", "computed": True, "wall_time_s": 1.0,
+                     "summary": _fake_summary(f, 0.8 * f, 4e4 * (1100.0 / f) ** (10 / 3))} for vid, f in loads.items()}
+    records["fan_holes.ligament=5.5"] = {"id": "fan_holes.ligament=5.5", "status": "failed", "computed": True,
+                                         "error": "GeometryError: too thin", "summary": None, "wall_time_s": 0.1}
+    rows = {r["id"]: r for r in study_rows(study, records)}
+    thin = rows["fan_holes.ligament=3.5"]
+    assert thin["max_vs_base_percent"] == pytest.approx(10.0, rel=1e-12)
+    assert thin["max_vs_handbook_percent"] == pytest.approx(21.0, rel=1e-12)
+    assert thin["life_ratio_vs_base"] == pytest.approx(1.1 ** (-10 / 3), rel=1e-12)
+    assert thin["bearing2_Fm_vs_base_percent"] == pytest.approx(10.0, rel=1e-12)
+    assert thin["fan_holes.ligament"] == 3.5 and thin["crank_bearing.model"] == "rollers"
+    assert rows["fan_holes.ligament=5.5"]["max_load_N"] is None
+    assert rows["fan_holes.ligament=5.5"]["error"] == "GeometryError: too thin"
+    files = _plots(study, list(rows.values()), tmp_path / "plots")
+    assert set(files) == {"tornado", "variants"}
+    assert all(p.stat().st_size > 5000 for p in files.values())
