@@ -265,8 +265,11 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
 )
 
 
-def build_parser(subcommands: tuple[Subcommand, ...] = SUBCOMMANDS) -> argparse.ArgumentParser:
-    """The argument parser with one sub-parser per entry of ``subcommands``."""
+def build_parser(subcommands: tuple[Subcommand, ...] | None = None) -> argparse.ArgumentParser:
+    """The argument parser with one sub-parser per entry of ``subcommands`` (default
+    :data:`SUBCOMMANDS`)."""
+    if subcommands is None:
+        subcommands = SUBCOMMANDS
     parser = argparse.ArgumentParser(
         prog="rvfem",
         description="Crank-bearing loads of RV reducers with a flexible cycloid disc.",
@@ -333,3 +336,9 @@ def main(argv: list[str] | None = None) -> int:
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
+
+
+# the design-study subcommands live in their own module (they build on Subcommand above)
+from .cli_study import COMPARE, STUDY  # noqa: E402
+
+SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY)
