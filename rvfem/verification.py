@@ -11,8 +11,8 @@ bound (``< 1e-12``) rather than as the noise itself.
 
 The reference computations that need more than a formula (closed-form elasticity fields, the
 structured meshes they are compared on, a beam integrated numerically) are written here,
-independently of the code they check. The whole document takes about a minute and a half on one
-core (coarse meshes, 10° steps).
+independently of the code they check. The whole document takes under a minute of CPU time (coarse
+meshes, 10° steps; about two minutes of wall time on a busy two-core machine).
 """
 
 from __future__ import annotations
@@ -709,8 +709,8 @@ def render(sections: list[Section]) -> str:
         "rvfem functions the test suite calls: the quantity, the source of the reference value, the reference, "
         "rvfem's value, the error and the tolerance (the test suite's for the same check). Errors are relative "
         "unless the column says otherwise; relative errors below 1e-12 are round-off and printed as a bound. "
-        "Regenerate with `python -m rvfem.verification docs/verification.md` (about a minute and a half on one "
-        "core); `--check` compares instead and fails when this file is stale.",
+        "Regenerate with `python -m rvfem.verification docs/verification.md` (under a minute of CPU "
+        "time); `--check` compares instead and fails when this file is stale.",
         "",
         f"**{passed} of {total} checks within tolerance; {len(pending)} pending.**",
         "",
