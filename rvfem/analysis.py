@@ -60,6 +60,7 @@ __all__ = [
     "resolve_case",
     "cycle_angles",
     "kept_field_angles",
+    "default_cache_dir",
     "analyse_rigid",
     "analyse",
 ]
@@ -71,6 +72,7 @@ STAGES: dict[str, str] = {
     "rigid": "rigid handbook model",
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
+    "stress": "structural stress peak re-solved on P2 at its crank angles",
     "attribution": "attribution: the reducer-stage models step by step",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
@@ -420,15 +422,24 @@ class StressResult:
         Boundary name → width of the ignored band, mm.
     snapshots : tuple of rvfem.postprocess.FieldSnapshot
         The kept fields (saved angles, largest bearing load, the two peaks, ``field_step_deg``).
-    peak_element_von_mises_MPa : float
-        Largest element (not averaged) von Mises stress over the kept fields, MPa.
+    recovered : rvfem.postprocess.RecoveredPeak or None
+        The structural peak re-solved on P2 at its crank angles with the cycle's forces, with its
+        convergence check (None when ``analyse(..., recover_stress=False)`` or when no vertex lies
+        outside the contact bands). This is the structural peak the reports lead with.
     """
 
     peak: PeakStress
     away_from_contacts: PeakStress | None
     band_mm: dict[str, float]
     snapshots: tuple[FieldSnapshot, ...]
-    peak_element_von_mises_MPa: float
+    recovered: Any = None
+
+    @property
+    def structural(self) -> PeakStress | None:
+        """The structural peak away from contacts to report: P2-recovered if available, else P1."""
+        if self.recovered is not None:
+            return self.recovered.peak
+        return self.away_from_contacts
 
 
 @dataclass(frozen=True)
@@ -518,6 +529,39 @@ class Analysis:
         return np.stack([pin_centres(self.case, float(th)) for th in self.theta])
 
 
+def default_cache_dir() -> Path:
+    """The default mesh cache: ``meshes/`` of the repository when rvfem runs from a source checkout
+    (a folder holding ``pyproject.toml``, ``rvfem/`` and ``meshes/`` above the package), otherwise
+    the per-user cache folder of the platform (``platformdirs.user_cache_dir("rvfem")/meshes``,
+    e.g. ``~/.cache/rvfem/meshes`` on Linux). Never the current directory: running from elsewhere
+    must not start a new cache there."""
+    root = Path(__file__).resolve().parent.parent
+    if (root / "pyproject.toml").is_file() and (root / "meshes").is_dir():
+        return root / "meshes"
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("rvfem")) / "meshes"
+
+
+def _recover_structural_peak(system, cycle, mesh, band, away):
+    """The structural peak recovered on P2 (:func:`rvfem.postprocess.recover_peak`) at the P1
+    envelope's peak angles; the P2 model of the same mesh is built here (or is the cycle's own for
+    a P2 case)."""
+    from . import postprocess
+    from .cycle import build_system
+
+    t0 = time.perf_counter()
+    if system.model.order == 2:
+        system_p2, system_p1 = system, None
+    else:
+        system_p2, system_p1 = build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
+                                            pin_model=system.pin_model), system
+    setup = time.perf_counter() - t0
+    angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
+    return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
+                                    p1_peak=away, system_p1=system_p1, setup_seconds=setup)
+
+
 def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, ...]:
     """Crank angles (degrees) whose fields a load cycle keeps: the case's ``saved_angles_deg`` and
     every ``field_step_deg`` degrees if given (checked: in (0°, 360°], else CaseError)."""
@@ -531,8 +575,9 @@ def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, 
 
 def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             angle_step_deg: float | None = None, bearing_model: str | None = None, order: int | None = None,
-            field_step_deg: float | None = None, cache_dir: str | os.PathLike = "meshes",
-            progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None) -> Analysis:
+            field_step_deg: float | None = None, cache_dir: str | os.PathLike | None = None,
+            progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
+            recover_stress: bool = True) -> Analysis:
     """Analyse a case completely, in memory.
 
     Parameters
@@ -548,12 +593,15 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         Also keep the displacement/stress fields every ``field_step_deg`` degrees (by default only
         the case's ``analysis.saved_angles_deg``, the angle of the largest bearing load and the
         angles of the stress peaks).
-    cache_dir : path
-        Mesh cache folder.
+    cache_dir : path, optional
+        Mesh cache folder; default :func:`default_cache_dir`.
     progress : ProgressCallback, optional
     provenance : CaseProvenance, optional
         If given, ``case`` is taken as already resolved (by :func:`resolve_case`) and the ``check``
         stage is skipped.
+    recover_stress : bool
+        Re-solve the disc on P2 at the structural peak's crank angles with the cycle's forces
+        (:func:`rvfem.postprocess.recover_peak`; stage ``stress``, about 5 s on the default case).
 
     Returns
     -------
@@ -585,7 +633,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
 
     t = stages.start("mesh")
     geometry = disc_geometry(case)
-    mesh = mesh_case(case, cache_dir, geometry=geometry)
+    mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
     stages.end("mesh", t)
 
     t = stages.start("model")
@@ -617,9 +665,19 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
     snapshots = postprocess.field_snapshots(
         system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
-    stress = StressResult(
-        peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
-        peak_element_von_mises_MPa=max(float(s.stress.element.von_mises.max()) for s in snapshots))
+    stages.end("evaluation", t)
+
+    recovered = None
+    if recover_stress and away is not None:
+        t = stages.start("stress")
+        recovered = _recover_structural_peak(system, cycle, mesh, band, away)
+        stages.end("stress", t)
+        if not any(math.isclose(s.theta_deg, recovered.peak.theta_deg, abs_tol=1e-9) for s in snapshots):
+            snapshots = postprocess.field_snapshots(system, cycle, extra_angles=[
+                math.radians(x) for x in (peak.theta_deg, away.theta_deg, recovered.peak.theta_deg)])
+    t = time.perf_counter()
+    stress = StressResult(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
+                          recovered=recovered)
     # the first bearing among equals (the handbook curves are exact shifts of each other)
     rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
     roller_hertz = hertz.most_loaded_roller_hertz(case, cycle.theta, cycle.bearing_forces, cycle.roller_loads,
@@ -631,7 +689,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         duty = DutyCycleResult(
             rigid=iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings]),
             flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
-    stages.end("evaluation", t)
+    stages.seconds["evaluation"] += time.perf_counter() - t
 
     # what the flexibility effect is made of: the modelling steps the case's own model does not
     # already give, on the same angles and the same compliance

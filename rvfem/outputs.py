@@ -56,6 +56,7 @@ __all__ = [
     "image_count",
     "build_summary",
     "summary_text",
+    "stress_lines",
     "rigid_summary",
     "rigid_text",
     "write_case_json",
@@ -67,7 +68,7 @@ __all__ = [
     "write_report",
 ]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 """Version of the ``summary.json`` layout (docs/outputs.md); bumped when a key changes meaning or
 disappears (new keys do not bump it)."""
 
@@ -134,7 +135,7 @@ def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
             raise OutputError(f"{out_dir} exists and is not a folder; choose another output folder")
         if _is_nonempty_dir(out_dir) and not overwrite:
             raise OutputError(f"{out_dir} exists and is not empty; choose another output folder or pass "
-                              "--overwrite (overwrite=True) to replace it")
+                              "overwrite=True to replace it")
 
 
 def _make_parents(out_dir: Path) -> list[Path]:
@@ -246,9 +247,9 @@ class SummaryContext:
 def _stats_dict(s) -> dict:
     return {
         "max_load_N": s.max_N,
-        "max_at_deg": s.max_at_deg,
+        "max_at_deg": _angle(s.max_at_deg),
         "min_load_N": s.min_N,
-        "min_at_deg": s.min_at_deg,
+        "min_at_deg": _angle(s.min_at_deg),
         "equivalent_load_N": s.equivalent_N,
         "L10h_h": s.L10h,
     }
@@ -259,19 +260,31 @@ def _hertz_dict(h) -> dict:
         "roller_load_N": h.roller_load_N,
         "bearing": None if h.bearing is None else h.bearing + 1,
         "roller": None if h.roller is None else h.roller + 1,
-        "theta_deg": h.theta_deg,
+        "theta_deg": _angle(h.theta_deg),
         "inner": dataclasses.asdict(h.inner),
         "outer": dataclasses.asdict(h.outer),
     }
 
 
+ANGLE_DECIMALS = 6
+"""Crank angles in ``summary.json`` are rounded to this many decimals (no float noise such as
+255.00000000000003; every step rvfem accepts is a whole multiple of 1e-6°)."""
+
+
+def _angle(deg):
+    """A crank angle for the user, degrees, rounded to :data:`ANGLE_DECIMALS` (None stays None)."""
+    return None if deg is None else round(float(deg), ANGLE_DECIMALS) + 0.0
+
+
 def _peak_dict(peak) -> dict:
+    from .postprocess import user_feature_name
+
     return {
         "x_mm": peak.x_mm,
         "y_mm": peak.y_mm,
         "radius_mm": peak.radius_mm,
-        "theta_deg": peak.theta_deg,
-        "feature": peak.feature,
+        "theta_deg": _angle(peak.theta_deg),
+        "feature": user_feature_name(peak.feature),
         "feature_label": peak.feature_label,
         "distance_to_feature_mm": peak.distance_to_feature_mm,
     }
@@ -341,7 +354,7 @@ def _piece_bearings(a, ctx: SummaryContext) -> dict:
         "bearings": bearings,
         "max_bearing_load": {
             "bearing": i + 1,
-            "theta_deg": math.degrees(float(a.theta[k])),
+            "theta_deg": _angle(math.degrees(float(a.theta[k]))),
             "flexible_N": float(a.cycle.bearing_loads[k, i]),
         },
     }
@@ -367,19 +380,38 @@ def _piece_cycle(a, ctx: SummaryContext) -> dict:
 
 def _piece_stress(a, ctx: SummaryContext) -> dict:
     s = a.stress
-    away = s.away_from_contacts
+    away, rec = s.away_from_contacts, s.recovered
+    structural = s.structural
     return {
-        "peak_von_mises_MPa": s.peak.von_mises_MPa,
-        "peak_von_mises_at": _peak_dict(s.peak),
+        "peak_von_mises_MPa": None if structural is None else structural.von_mises_MPa,
+        "peak_von_mises_at": None if structural is None else _peak_dict(structural),
         "stress": {
-            "peak_element_von_mises_MPa": s.peak_element_von_mises_MPa,
+            "structural_peak": None if rec is None else {
+                "von_mises_MPa": rec.peak.von_mises_MPa,
+                "at": _peak_dict(rec.peak),
+                "method": rec.method,
+                "element_order": 2,
+                "estimated_error_MPa": rec.estimated_error_MPa,
+                "estimated_error_percent": rec.estimated_error_percent,
+                "p1_MPa": rec.p1_MPa,
+                "p1_at_peak_MPa": rec.p1_at_peak_MPa,
+                "p1_error_percent": rec.p1_error_percent,
+                "angles_deg": [_angle(x) for x in rec.angles_deg],
+                "seconds": rec.seconds,
+            },
             "away_from_contacts": None if away is None else {
                 "peak_von_mises_MPa": away.von_mises_MPa,
+                "element_order": a.system.model.order,
                 "at": _peak_dict(away),
                 "profile_band_mm": s.band_mm["profile"],
                 "bore_band_mm": s.band_mm.get("bore_0"),
             },
-            "field_angles_deg": [snap.theta_deg for snap in s.snapshots],
+            "contact_zone": {
+                "peak_von_mises_MPa": s.peak.von_mises_MPa,
+                "at": _peak_dict(s.peak),
+                "mesh_dependent": True,
+            },
+            "field_angles_deg": [_angle(snap.theta_deg) for snap in s.snapshots],
         },
     }
 
@@ -443,7 +475,7 @@ def _piece_files(a, ctx: SummaryContext) -> dict:
     files = set(ctx.files)
     fields = []
     for snap in a.stress.snapshots:
-        entry = {"theta_deg": snap.theta_deg, "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
+        entry = {"theta_deg": _angle(snap.theta_deg), "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
         image = f"images/{_stress_image_name(snap.theta_deg)}"
         if image in files:
             entry["image"] = image
@@ -740,19 +772,12 @@ def summary_text(summary: dict) -> str:
             lines.append(f"    {r['step']:<12} max {_num(r['delta_max_percent'], '+6.1f')}%  min "
                          f"{_num(r['delta_min_percent'], '+6.1f')}%  F_m {_num(r['delta_equivalent_percent'], '+6.1f')}%"
                          f"  life ratio {_num(r['life_ratio'], '.2f')}" + ("   <- this run" if r["final"] else ""))
-    at = summary["peak_von_mises_at"]
-    away = summary["stress"]["away_from_contacts"]
     h = summary["hertz"]
     fe = h.get("fe_rollers")
-    lines += [
-        "",
-        f"  peak von Mises {summary['peak_von_mises_MPa']:.0f} MPa at ({at['x_mm']:.1f}, {at['y_mm']:.1f}) mm, "
-        f"{at['feature_label']}, θ = {at['theta_deg']:.1f}°"
-        + (f"; away from contacts {away['peak_von_mises_MPa']:.0f} MPa near {away['at']['feature_label']}"
-           if away else ""),
+    lines += [""] + stress_lines(summary["stress"]) + [
         f"  pins in contact {summary['pins_in_contact']['min']}–{summary['pins_in_contact']['max']} of "
         f"{summary['pins_in_contact']['of']}; torsional stiffness {summary['torsional_stiffness_Nm_per_arcmin']:.1f} "
-        f"N·m/arcmin; equilibrium residual {summary['equilibrium_residual']:.1e}",
+        f"N·m/arcmin per disc; equilibrium residual {summary['equilibrium_residual']:.1e}",
     ]
     sr = h["stribeck_rigid"]
     hertz = (f"  Hertz, most loaded roller: rigid Stribeck Q = {sr['roller_load_N']:.0f} N, p_in "
@@ -760,6 +785,10 @@ def summary_text(summary: dict) -> str:
     if fe:
         hertz += (f"; FE Q = {fe['roller_load_N']:.0f} N, p_in {fe['inner']['peak_pressure_MPa']:.0f} / p_out "
                   f"{fe['outer']['peak_pressure_MPa']:.0f} MPa")
+    else:
+        sf = h["stribeck_flexible"]
+        hertz += (f"; FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N, p_in "
+                  f"{sf['inner']['peak_pressure_MPa']:.0f} / p_out {sf['outer']['peak_pressure_MPa']:.0f} MPa")
     lines.append(hertz)
     duty = summary.get("duty_cycle")
     if duty:
@@ -771,6 +800,34 @@ def summary_text(summary: dict) -> str:
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")
     return "\n".join(lines)
+
+
+def stress_lines(stress: dict) -> list[str]:
+    """The disc-stress lines of the screen summary (the ``stress`` object of ``summary.json``):
+    the structural peak away from contacts first, with its convergence check, then the
+    contact-zone peak, labelled as such."""
+    lines = []
+    sp, away, cz = stress.get("structural_peak"), stress.get("away_from_contacts"), stress["contact_zone"]
+    if sp:
+        at = sp["at"]
+        lines += [
+            f"  structural stress peak (away from contacts) {sp['von_mises_MPa']:.0f} MPa von Mises ± "
+            f"{sp['estimated_error_MPa']:.1f} MPa (estimated), {at['feature_label']} at ({at['x_mm']:.1f}, "
+            f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°",
+            f"    P2 re-solve at θ = {', '.join(f'{x:g}' for x in sp['angles_deg'])}° with the cycle's forces "
+            f"({sp['seconds']:.1f} s); the P{away['element_order']} cycle alone gives {sp['p1_MPa']:.0f} MPa "
+            f"({sp['p1_error_percent']:+.0f} %)",
+        ]
+    elif away:
+        at = away["at"]
+        lines.append(f"  structural stress peak (away from contacts) {away['peak_von_mises_MPa']:.0f} MPa von Mises "
+                     f"(P{away['element_order']}, not re-solved on P2), {at['feature_label']} at ({at['x_mm']:.1f}, "
+                     f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°")
+    at = cz["at"]
+    lines.append(f"  contact-zone peak {cz['peak_von_mises_MPa']:.0f} MPa (under a pin or roller footprint, "
+                 f"mesh-dependent; not a Hertz stress), {at['feature_label']}, {at['distance_to_feature_mm']:.2f} mm "
+                 f"from it, θ = {at['theta_deg']:g}°")
+    return lines
 
 
 def rigid_summary(result) -> dict:

@@ -163,7 +163,9 @@ def _case_rows(case: Case) -> list[list[str]]:
                   + (f", duty cycle of {len(ld.duty_cycle)} rows" if ld.duty_cycle else "")],
         ["analysis", f"angle step {an.angle_step_deg:g}°, P{an.element_order}, p = {an.equivalent_load_exponent:.4g}, "
                      f"saved angles {', '.join(f'{a:g}°' for a in an.saved_angles_deg)}"],
-        ["mesh sizes", f"flank {ms.size_flank:g} mm, bore {ms.size_bore:g} mm, interior {ms.size_interior:g} mm"],
+        ["mesh sizes", f"flank {ms.size_flank:g} mm, bore {ms.size_bore:g} mm, interior {ms.size_interior:g} mm, holes "
+                       + (f"{ms.size_hole:g} mm" if ms.size_hole is not None else
+                          f"{min(2 * ms.size_bore, ms.size_interior):g} mm (default: 2 × bore size)")],
     ]
     if case.fan_holes is not None:
         f = case.fan_holes
@@ -231,23 +233,36 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
     parts.append("<p class='meta'>Angles are crank angles θ (eccentric relative to the carrier). Deltas in % of "
                  "the rigid value. The equal-share reference (FE pin resultant shared equally) is in summary.json.</p>")
 
-    at = summary["peak_von_mises_at"]
-    away = summary["stress"].get("away_from_contacts")
+    st = summary["stress"]
+    sp, away, cz = st.get("structural_peak"), st.get("away_from_contacts"), st["contact_zone"]
     pins = summary["pins_in_contact"]
-    other = [
-        ["peak von Mises (vertex)", f"{summary['peak_von_mises_MPa']:.1f} MPa at ({at['x_mm']:.2f}, {at['y_mm']:.2f}) mm, "
-                                    f"{_where(at)}, θ = {at['theta_deg']:.1f}°"],
-        ["peak von Mises (element)", f"{summary['stress']['peak_element_von_mises_MPa']:.1f} MPa"],
-    ]
+    other = []
+    if sp:
+        a_ = sp["at"]
+        other += [
+            ["<b>structural stress peak</b> (away from contacts, P2 re-solve)",
+             f"<b>{sp['von_mises_MPa']:.1f} MPa</b> ± {sp['estimated_error_MPa']:.1f} MPa estimated "
+             f"({sp['estimated_error_percent']:.1f} %), at ({a_['x_mm']:.2f}, {a_['y_mm']:.2f}) mm, {_where(a_)}, "
+             f"θ = {a_['theta_deg']:g}°"],
+            ["convergence check of the structural peak",
+             f"P{away['element_order']} cycle {sp['p1_MPa']:.1f} MPa ({sp['p1_error_percent']:+.1f} % against P2); "
+             f"P2 re-solved at θ = {', '.join(f'{x:g}' for x in sp['angles_deg'])}° in {sp['seconds']:.1f} s. "
+             f"Method: {_e(sp['method'])}; the estimate is the spread of the P2 element stresses at the peak "
+             "vertex around their average."],
+        ]
     if away:
-        other.append(["peak von Mises away from contacts",
+        other.append([f"structural peak of the P{away['element_order']} cycle's envelope",
                       f"{away['peak_von_mises_MPa']:.1f} MPa at ({away['at']['x_mm']:.2f}, {away['at']['y_mm']:.2f}) mm, "
-                      f"{_where(away['at'])}, θ = {away['at']['theta_deg']:.1f}°"])
+                      f"{_where(away['at'])}, θ = {away['at']['theta_deg']:g}°"])
+    other.append(["contact-zone peak (under a footprint, mesh-dependent)",
+                  f"{cz['peak_von_mises_MPa']:.1f} MPa at ({cz['at']['x_mm']:.2f}, {cz['at']['y_mm']:.2f}) mm, "
+                  f"{_where(cz['at'])}, θ = {cz['at']['theta_deg']:g}°; depends on the footprint width and the mesh, "
+                  "not a Hertz stress"])
     mx = summary["max_bearing_load"]
     other += [
         ["largest bearing load", f"{mx['flexible_N']:.0f} N, bearing {mx['bearing']}, θ = {mx['theta_deg']:.1f}°"],
         ["pins in contact", f"{pins['min']}–{pins['max']} of {pins['of']} (mean {pins['mean']:.1f})"],
-        ["torsional stiffness (disc stage)", f"{summary['torsional_stiffness_Nm_per_arcmin']:.2f} N·m/arcmin"],
+        ["torsional stiffness (per disc)", f"{summary['torsional_stiffness_Nm_per_arcmin']:.2f} N·m/arcmin"],
         ["carrier rotation", f"{summary['carrier_rotation_arcmin']['mean']:.3f} arcmin (mean)"],
         ["equilibrium residual (max)", f"{summary['equilibrium_residual']:.2e}"],
         ["active-set iterations", f"max {summary['active_set_iterations']['max']}, mean "
@@ -310,9 +325,10 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
                 parts.append(_figure(root, f["image"], f"von Mises on the deformed disc at θ = {f['theta_deg']:.1f}° "
                                                        f"(ParaView: {f['vtu']})."))
         parts.append("<div class='grid'>")
-        parts.append(_figure(root, im.get("stress_peak_closeup"), "Close-up at the peak von Mises stress (ring)."))
         parts.append(_figure(root, im.get("stress_away_from_contacts_closeup"),
-                             "Close-up at the peak von Mises stress away from the pin and roller contacts (ring)."))
+                             "Close-up at the structural peak away from the pin and roller contacts (ring)."))
+        parts.append(_figure(root, im.get("stress_peak_closeup"),
+                             "Close-up at the contact-zone peak (ring): mesh-dependent, under a footprint."))
         parts.append("</div>")
         parts.append(_figure(root, im.get("mesh"), "The mesh (linear triangles) and a close-up of the rim under bore 1."))
 
