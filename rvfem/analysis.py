@@ -61,6 +61,7 @@ __all__ = [
     "cycle_angles",
     "kept_field_angles",
     "default_cache_dir",
+    "repository_path",
     "analyse_rigid",
     "analyse",
 ]
@@ -527,6 +528,42 @@ class Analysis:
         from .geometry import pin_centres
 
         return np.stack([pin_centres(self.case, float(th)) for th in self.theta])
+
+
+def repository_path(relative: str | os.PathLike, start: str | os.PathLike | None = None) -> Path:
+    """Find a repository file (e.g. ``cases/rv40e_fanholes.toml``) from wherever Python runs.
+
+    Jupyter, nbconvert and editors start a notebook's kernel in the notebook's folder, not in the
+    repository root. This looks for ``relative`` in ``start`` (default: the current directory)
+    and then in each of its parent folders, and returns the first that exists.
+
+    Parameters
+    ----------
+    relative : path
+        Path relative to the repository root.
+    start : path, optional
+        Where to start looking; default the current directory.
+
+    Returns
+    -------
+    Path
+        The path found (absolute).
+
+    Raises
+    ------
+    CaseError
+        If no folder from ``start`` up to the file-system root holds ``relative``.
+    """
+    relative = Path(relative)
+    if relative.is_absolute():
+        if relative.exists():
+            return relative
+        raise CaseError(f"{relative}: no such file")
+    here = Path(start if start is not None else os.getcwd()).resolve()
+    for folder in (here, *here.parents):
+        if (folder / relative).exists():
+            return folder / relative
+    raise CaseError(f"{relative}: not found in {here} or any folder above it")
 
 
 def default_cache_dir() -> Path:
