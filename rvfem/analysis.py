@@ -55,7 +55,9 @@ __all__ = [
     "RigidBearing",
     "RigidAnalysis",
     "StressResult",
+    "DutyCycleFE",
     "DutyCycleResult",
+    "duty_cycle_fe",
     "Analysis",
     "resolve_case",
     "cycle_angles",
@@ -74,6 +76,7 @@ STAGES: dict[str, str] = {
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
     "stress": "structural stress peak re-solved on P2 at its crank angles",
+    "duty_cycle": "flexible load cycle at the other duty-cycle torques",
     "attribution": "attribution: the reducer-stage models step by step",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
@@ -444,11 +447,110 @@ class StressResult:
 
 
 @dataclass(frozen=True)
+class DutyCycleFE:
+    """The duty cycle evaluated with the flexible model at every duty-cycle torque.
+
+    The service life of :class:`DutyCycleResult` ``flexible`` scales the rated flexible life with
+    (T_i/T0)^(10/3) (Gao et al. eq. 18): it assumes the bearing loads grow linearly with the
+    torque. The FE model is not linear (contact sets, Palmgren roller law, clearance), so here the
+    load cycle is solved at each distinct positive duty-cycle torque (same disc model and
+    compliance, no new factorisation) and Palmgren-Miner is applied to the bearing lives from
+    those equivalent loads: 1/L = Σ s_i/L_i per bearing, s_i the time shares, L_i the L10h at the
+    row's F_m and bearing speed; the service life is the shortest bearing's.
+
+    Attributes
+    ----------
+    torques_Nm : tuple of float
+        Distinct positive duty-cycle output torques, N·m.
+    equivalent_load_N : tuple of tuple of float
+        Flexible F_m per torque and bearing, N.
+    linear_scaling_error_percent : tuple of float
+        Per torque: largest over the bearings of F_m(T_i)/(F_m(T0)·T_i/T0) − 1, %.
+    service_life_h : float
+        Palmgren-Miner service life from the FE loads at every torque, hours.
+    linear_scaling_life_h : float
+        The same from the linear scaling (= ``DutyCycleResult.flexible.service_life_h``), hours.
+    seconds : float
+        Wall time of the extra load cycles, s.
+    """
+
+    torques_Nm: tuple[float, ...]
+    equivalent_load_N: tuple[tuple[float, ...], ...]
+    linear_scaling_error_percent: tuple[float, ...]
+    service_life_h: float
+    linear_scaling_life_h: float
+    seconds: float
+
+    @property
+    def life_difference_percent(self) -> float:
+        """(FE at every torque − linear scaling)/linear scaling of the service life, %."""
+        return 100.0 * (self.service_life_h / self.linear_scaling_life_h - 1.0)
+
+
+@dataclass(frozen=True)
 class DutyCycleResult:
-    """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives."""
+    """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives
+    (both scaled linearly with the torque, Gao et al. eq. 18), and the flexible one from the FE
+    at every duty-cycle torque (``flexible_fe``, None when not computed)."""
 
     rigid: iso281.DutyCycleLife
     flexible: iso281.DutyCycleLife
+    flexible_fe: DutyCycleFE | None = None
+
+
+def duty_cycle_fe(system, thetas: np.ndarray, cycle, comparison, linear_life_h: float) -> DutyCycleFE:
+    """Solve the flexible load cycle at every distinct positive duty-cycle torque of the case and
+    the service life from those loads (:class:`DutyCycleFE`; sources: ISO 281 life, Gao et al.
+    eqs. 16-18 with the FE loads in place of the linear scaling).
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+        The case's disc model (its compliance is reused).
+    thetas : ndarray
+        Crank angles, rad (those of ``cycle``).
+    cycle : rvfem.cycle.CycleResult
+        The cycle at the case's own torque (reused for a duty row at that torque).
+    comparison : rvfem.compare.Comparison
+        Its comparison (F_m at the case's torque).
+    linear_life_h : float
+        The linear-scaling service life, hours.
+    """
+    from . import compare
+    from . import cycle as cycle_module
+
+    t0 = time.perf_counter()
+    case = system.case
+    rows = case.loads.duty_cycle
+    rated_T = case.loads.torque_Nm
+    torques = sorted({float(r.torque_Nm) for r in rows if r.torque_Nm > 0})
+    rated_fm = [b.flexible.equivalent_N for b in comparison.bearings]
+    fm: dict[float, list[float]] = {}
+    for torque in torques:
+        if math.isclose(torque, rated_T, rel_tol=1e-12):
+            fm[torque] = rated_fm
+            continue
+        case_t = case.replace(loads=dataclasses.replace(case.loads, torque_Nm=torque))
+        system_t = dataclasses.replace(system, case=case_t)
+        cyc = cycle_module.load_cycle(system_t, thetas)
+        fm[torque] = [b.flexible.equivalent_N for b in compare.rigid_vs_flexible(case_t, cyc).bearings]
+    errors = tuple(100.0 * max((f / (f0 * t / rated_T) - 1.0 for f, f0 in zip(fm[t], rated_fm)), key=abs)
+                   for t in torques)
+    rating = iso281.crank_bearing_rating(case.crank_bearing)
+    total = sum(r.time_share for r in rows)
+    lives = []
+    for i in range(len(rated_fm)):
+        damage = 0.0  # Σ s_i / L_i, 1/h
+        for r in rows:
+            if r.torque_Nm <= 0:
+                continue
+            n_b = iso281.bearing_speed_rpm(r.speed_rpm, case.pins.count, case.cycloid.teeth)
+            life = iso281.rating_life_hours(rating, fm[float(r.torque_Nm)][i], n_b)
+            damage += (r.time_share / total) / life
+        lives.append(math.inf if damage == 0 else 1.0 / damage)
+    return DutyCycleFE(torques_Nm=tuple(torques), equivalent_load_N=tuple(tuple(fm[t]) for t in torques),
+                       linear_scaling_error_percent=errors, service_life_h=min(lives),
+                       linear_scaling_life_h=linear_life_h, seconds=time.perf_counter() - t0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -614,7 +716,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             angle_step_deg: float | None = None, bearing_model: str | None = None, order: int | None = None,
             field_step_deg: float | None = None, cache_dir: str | os.PathLike | None = None,
             progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
-            recover_stress: bool = True) -> Analysis:
+            recover_stress: bool = True, duty_fe: bool = True) -> Analysis:
     """Analyse a case completely, in memory.
 
     Parameters
@@ -639,6 +741,10 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     recover_stress : bool
         Re-solve the disc on P2 at the structural peak's crank angles with the cycle's forces
         (:func:`rvfem.postprocess.recover_peak`; stage ``stress``, about 5 s on the default case).
+    duty_fe : bool
+        With a duty cycle: also solve the flexible load cycle at every other duty-cycle torque and
+        give the service life from those loads (:func:`duty_cycle_fe`; stage ``duty_cycle``, one
+        load cycle per torque, no new factorisation).
 
     Returns
     -------
@@ -727,6 +833,11 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             rigid=iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings]),
             flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
     stages.seconds["evaluation"] += time.perf_counter() - t
+    if duty is not None and duty_fe:
+        t = stages.start("duty_cycle")
+        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
+                                                                   duty.flexible.service_life_h))
+        stages.end("duty_cycle", t)
 
     # what the flexibility effect is made of: the modelling steps the case's own model does not
     # already give, on the same angles and the same compliance

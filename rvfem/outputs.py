@@ -431,8 +431,19 @@ def _piece_hertz(a, ctx: SummaryContext) -> dict:
 def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
     if a.duty_cycle is None:
         return {}
-    return {"duty_cycle": {"rigid": dataclasses.asdict(a.duty_cycle.rigid),
-                           "flexible": dataclasses.asdict(a.duty_cycle.flexible)}}
+    fe = a.duty_cycle.flexible_fe
+    return {"duty_cycle": {
+        "rigid": dataclasses.asdict(a.duty_cycle.rigid),
+        "flexible": dataclasses.asdict(a.duty_cycle.flexible),
+        "flexible_fe": None if fe is None else {
+            "torques_Nm": list(fe.torques_Nm),
+            "equivalent_load_N": [list(row) for row in fe.equivalent_load_N],
+            "linear_scaling_error_percent": list(fe.linear_scaling_error_percent),
+            "service_life_h": fe.service_life_h,
+            "life_difference_percent": fe.life_difference_percent,
+            "seconds": fe.seconds,
+        },
+    }}
 
 
 def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
@@ -795,7 +806,14 @@ def summary_text(summary: dict) -> str:
         lines.append("  duty cycle: service life " + ", ".join(
             f"{key} {_num(duty[key]['service_life_h'], '.0f')} h" for key in ("rigid", "flexible"))
             + f" (equivalent torque {duty['rigid']['equivalent_torque_Nm']:.1f} N·m, "
-              f"speed {duty['rigid']['equivalent_speed_rpm']:.2f} rpm)")
+              f"speed {duty['rigid']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
+        fe = duty.get("flexible_fe")
+        if fe:
+            lines.append(
+                "    flexible FE at every duty torque (" + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): "
+                f"service life {_num(fe['service_life_h'], '.0f')} h ({_num(fe['life_difference_percent'], '+.1f')} % "
+                "against the linear scaling); F_m off linear scaling by "
+                + ", ".join(f"{e:+.1f} %" for e in fe["linear_scaling_error_percent"]))
     t = summary["timings_s"]
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")

@@ -306,6 +306,17 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
             [[k, _num(d[k]["rated_life_h"], ".0f"), _num(d[k]["equivalent_torque_Nm"]),
               _num(d[k]["equivalent_speed_rpm"], ".2f"), _num(d[k]["service_life_h"], ".0f")] for k in ("rigid", "flexible")],
             left=1))
+        parts.append("<p class='meta'>Both lives scale the rated life with (T_i/T0)^(10/3) (Gao et al. eq. 18): "
+                     "they assume the bearing loads grow linearly with the torque.</p>")
+        fe = d.get("flexible_fe")
+        if fe:
+            parts.append(
+                "<p>Checked with the flexible model solved at every duty-cycle torque ("
+                + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): F_m differs from the linear scaling by "
+                + ", ".join(f"{e:+.2f} %" for e in fe["linear_scaling_error_percent"])
+                + f"; Palmgren–Miner over the rows with those loads gives a service life of "
+                f"<b>{_num(fe['service_life_h'], '.0f')} h</b> ({_num(fe['life_difference_percent'], '+.1f')} % "
+                f"against the linear scaling; {fe['seconds']:.1f} s).</p>")
 
     # -- plots and images ----------------------------------------------------------------------
     pl = summary.get("plots", {})
