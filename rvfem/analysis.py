@@ -430,6 +430,9 @@ class StressResult:
         The structural peak re-solved on P2 at its crank angles with the cycle's forces, with its
         convergence check (None when ``analyse(..., recover_stress=False)`` or when no vertex lies
         outside the contact bands). This is the structural peak the reports lead with.
+    history : rvfem.postprocess.HotSpotHistory or None
+        Vertex stresses over every solved crank angle at the structural peak and the contact-zone
+        peak (for a fatigue check).
     """
 
     peak: PeakStress
@@ -437,6 +440,7 @@ class StressResult:
     band_mm: dict[str, float]
     snapshots: tuple[FieldSnapshot, ...]
     recovered: Any = None
+    history: Any = None
 
     @property
     def structural(self) -> PeakStress | None:
@@ -819,8 +823,14 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             snapshots = postprocess.field_snapshots(system, cycle, extra_angles=[
                 math.radians(x) for x in (peak.theta_deg, away.theta_deg, recovered.peak.theta_deg)])
     t = time.perf_counter()
+    spots = {"structural": recovered.peak if recovered is not None else away, "contact_zone": peak}
+    spots = {k: v for k, v in spots.items() if v is not None}
+    factors = {}
+    if recovered is not None and recovered.p1_at_peak_MPa > 0:
+        factors["structural"] = recovered.peak.von_mises_MPa / recovered.p1_at_peak_MPa
+    history = postprocess.hot_spot_history(system, cycle, spots, factors)
     stress = StressResult(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
-                          recovered=recovered)
+                          recovered=recovered, history=history)
     # the first bearing among equals (the handbook curves are exact shifts of each other)
     rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
     roller_hertz = hertz.most_loaded_roller_hertz(case, cycle.theta, cycle.bearing_forces, cycle.roller_loads,

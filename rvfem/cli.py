@@ -116,7 +116,8 @@ def _run_mesh(args: argparse.Namespace) -> int:
     import time
 
     from .geometry import disc_geometry
-    from .mesh import mesh_case, mesh_preview_png
+    from .mesh import mesh_case
+    from .plots import mesh_preview
 
     from .analysis import default_cache_dir
     from .postprocess import user_feature_name
@@ -127,7 +128,7 @@ def _run_mesh(args: argparse.Namespace) -> int:
     cache = default_cache_dir() if args.cache_dir is None else args.cache_dir
     mesh = mesh_case(case, cache, use_cache=not args.force, geometry=geom)
     elapsed = time.perf_counter() - start
-    png = mesh_preview_png(mesh, mesh.path.with_suffix(".png"), title=f"{case.name}: disc mesh")
+    png = mesh_preview(mesh, mesh.path.with_suffix(".png"), title=f"{case.name}: disc mesh")
     thinnest = geom.walls[0]
     print(f"mesh of case '{case.name}' ({args.case}): {mesh.path}"
           f" ({'cached' if mesh.from_cache else 'generated'} in {elapsed:.2f} s)")

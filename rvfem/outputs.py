@@ -46,6 +46,10 @@ log = logging.getLogger(__name__)
 
 __all__ = [
     "SCHEMA_VERSION",
+    "RIGID_SCHEMA_VERSION",
+    "VERSIONED_PACKAGES",
+    "command_line",
+    "environment",
     "IMAGE_SIZE",
     "DEFORMATION_DISPLAY_FRACTION",
     "SummaryContext",
@@ -71,6 +75,10 @@ __all__ = [
 SCHEMA_VERSION = 2
 """Version of the ``summary.json`` layout (docs/outputs.md); bumped when a key changes meaning or
 disappears (new keys do not bump it)."""
+
+RIGID_SCHEMA_VERSION = 1
+"""Version of the ``rvfem rigid --json`` layout (docs/outputs.md); bumped when a key changes meaning
+or disappears."""
 
 IMAGE_SIZE = (1500, 1100)
 """Size of the stress images, pixels (width, height)."""
@@ -290,11 +298,54 @@ def _peak_dict(peak) -> dict:
     }
 
 
+VERSIONED_PACKAGES = ("numpy", "scipy", "scikit-fem", "gmsh", "vtk", "pyvista", "matplotlib", "meshio")
+"""Packages whose installed versions ``summary.json`` records (``environment.versions``)."""
+
+
+def command_line() -> str | None:
+    """The command line of this process if it is the ``rvfem`` command (None from Python or a
+    notebook), shell-quoted."""
+    import shlex
+    import sys
+
+    argv = list(sys.argv)
+    if not argv:
+        return None
+    name = Path(argv[0]).name
+    if name == "rvfem" or (name in ("cli.py", "__main__.py") and "rvfem" in Path(argv[0]).parts):
+        return shlex.join(["rvfem", *argv[1:]])
+    return None
+
+
+def environment() -> dict:
+    """When, how and with what a result was computed: UTC date and time, the command line
+    (:func:`command_line`), Python, the platform and the versions of
+    :data:`VERSIONED_PACKAGES` (None if not installed)."""
+    import datetime
+    import platform
+    from importlib import metadata
+
+    versions = {}
+    for name in VERSIONED_PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return {
+        "date_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "command_line": command_line(),
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "versions": versions,
+    }
+
+
 def _piece_header(a, ctx: SummaryContext) -> dict:
     p, case = a.provenance, a.case
     return {
         "schema_version": SCHEMA_VERSION,
         "rvfem_version": __version__,
+        "environment": environment(),
         "case": {
             "name": case.name,
             "description": case.description,
@@ -412,7 +463,24 @@ def _piece_stress(a, ctx: SummaryContext) -> dict:
                 "mesh_dependent": True,
             },
             "field_angles_deg": [_angle(snap.theta_deg) for snap in s.snapshots],
+            "hot_spots": [] if s.history is None else [_hot_spot_dict(s.history, j)
+                                                       for j in range(len(s.history.names))],
         },
+    }
+
+
+def _hot_spot_dict(h, j: int) -> dict:
+    vm, sd = h.von_mises[:, j], h.dominant[:, j]
+    return {
+        "name": h.names[j],
+        "at": _peak_dict(h.peaks[j]),
+        "von_mises_max_MPa": float(vm.max()),
+        "von_mises_min_MPa": float(vm.min()),
+        "dominant_principal_max_MPa": float(sd.max()),
+        "dominant_principal_min_MPa": float(sd.min()),
+        "dominant_principal_range_MPa": float(sd.max() - sd.min()),
+        "dominant_principal_mean_MPa": float(0.5 * (sd.max() + sd.min())),
+        "p2_factor": h.p2_factor[j],
     }
 
 
@@ -576,6 +644,8 @@ def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
                                        a.classical.magnitude.T))
     out.append(tables.write_cycle_table(folder / "cycle.csv", th, cy.pins_in_contact, cy.carrier_rotation,
                                         cy.equilibrium_residual, cy.iterations))
+    if a.stress.history is not None:
+        out.append(tables.write_stress_history(folder / "stress_history.csv", a.stress.history))
     return out
 
 
@@ -601,6 +671,10 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
         if tick is not None and done < len(snapshots):
             tick(done, len(snapshots))
     out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
+    cy = analysis.cycle
+    if cy.von_mises_envelope is not None:
+        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, model.mesh.p.T, model.mesh.t.T,
+                                            cy.von_mises_envelope, cy.von_mises_envelope_theta))
     return out
 
 
@@ -676,14 +750,19 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
         done(render.stress_image(images / _stress_image_name(snap.theta_deg), scene(snap, label),
                                  window_size=IMAGE_SIZE))
     half = max(5.0, 12.0 * case.mesh.size_bore)
-    for key, pk in (("stress_peak_closeup", peak), ("stress_away_from_contacts_closeup", away)):
+    rec = a.stress.recovered
+    for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
+                          ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
         if pk is None:
             continue
         snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+        extra = ""
+        if rec is not None and key == "stress_away_from_contacts_closeup":
+            extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
         close = dataclasses.replace(
             scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
-            title=f"{case.name}   crank angle {snap.theta_deg:.1f}°   close-up (undeformed): von Mises "
-                  f"{pk.von_mises_MPa:.0f} MPa at the ring, {pk.feature_label}")
+            title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
+                  f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, {pk.feature_label}")
         done(render.stress_image(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
                                  marker=(pk.x_mm, pk.y_mm), show_edges=True, window_size=IMAGE_SIZE))
     b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
@@ -691,7 +770,7 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
                    closeup_centre=(float(b0[0]), float(b0[1])),
                    title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
                          f"(min quality {mesh.min_quality:.2f})",
-                   closeup_title="close-up: the rim under bore 1"))
+                   closeup_title="close-up: the rim under the bore of bearing 1"))
     return out
 
 
@@ -866,9 +945,17 @@ def rigid_summary(result) -> dict:
         "hertz_inner": dataclasses.asdict(b.hertz_inner),
         "hertz_outer": dataclasses.asdict(b.hertz_outer),
     } for b in result.bearings]
+    from .case import file_sha256
+
+    source = Path(case.source.removesuffix(" (with overrides)"))
     report = {
+        "schema_version": RIGID_SCHEMA_VERSION,
+        "rvfem_version": __version__,
+        "environment": environment(),
         "case": case.name,
         "source": case.source,
+        "case_sha256": file_sha256(source) if source.is_file() else None,
+        "case_digest": case.digest(),
         "overrides": list(case.overrides),
         "model": "rigid handbook (equal load sharing, zero clearance)",
         "output_torque_Nm": case.loads.torque_Nm,

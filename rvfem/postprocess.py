@@ -39,6 +39,9 @@ __all__ = [
     "RecoveredPeak",
     "peak_angles",
     "recover_peak",
+    "HotSpotHistory",
+    "vertex_of",
+    "hot_spot_history",
 ]
 
 
@@ -476,3 +479,84 @@ def user_feature_name(name: str) -> str:
     if stem in ("bore", "hole") and number.isdigit():
         return f"{stem}_{int(number) + 1}"
     return name
+
+
+# --------------------------------------------------------------------------------------------
+# Stress history at the hot spots (for a fatigue check)
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class HotSpotHistory:
+    """Stress over the crank angle at a few vertices (the hot spots), for a fatigue check.
+
+    Attributes
+    ----------
+    names : tuple of str
+        ``structural`` (the structural peak's vertex) and ``contact_zone`` (the overall peak's).
+    vertices : tuple of int
+        Mesh vertex of each hot spot.
+    peaks : tuple of PeakStress
+        Where each hot spot is (value and angle of the envelope there).
+    theta : ndarray (n,)
+        Crank angles, rad (the cycle's).
+    von_mises, s1, s2 : ndarray (n, hot spots)
+        Vertex von Mises and in-plane principal stresses of the cycle's model at every angle, MPa.
+    p2_factor : tuple of float
+        P2/P1 ratio of the von Mises stress at the hot spot at the recovery's angle (1 where not
+        re-solved): multiply the P1 history by it for an estimate of the P2 history.
+    """
+
+    names: tuple[str, ...]
+    vertices: tuple[int, ...]
+    peaks: tuple[PeakStress, ...]
+    theta: np.ndarray
+    von_mises: np.ndarray
+    s1: np.ndarray
+    s2: np.ndarray
+    p2_factor: tuple[float, ...]
+
+    @property
+    def dominant(self) -> np.ndarray:
+        """The in-plane principal stress of larger magnitude, signed, (n, hot spots), MPa: at a
+        free edge the one non-zero stress (the tangential one), whose range and mean a fatigue
+        check uses."""
+        return np.where(np.abs(self.s1) >= np.abs(self.s2), self.s1, self.s2)
+
+
+def vertex_of(points: np.ndarray, peak: PeakStress) -> int:
+    """Index of the mesh vertex at a peak's position."""
+    return int(np.argmin(np.hypot(points[:, 0] - peak.x_mm, points[:, 1] - peak.y_mm)))
+
+
+def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
+                     p2_factor: dict[str, float] | None = None) -> HotSpotHistory:
+    """Vertex stresses at the hot spots at every solved crank angle of a cycle: one
+    back-substitution and a few rows of :func:`rvfem.fem.nodal_stress_operator` per angle.
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+    cycle : rvfem.cycle.CycleResult
+    spots : dict
+        Name → PeakStress (its vertex is the hot spot).
+    p2_factor : dict, optional
+        Name → P2/P1 ratio at the hot spot (see :class:`HotSpotHistory`).
+    """
+    from .cycle import displacement
+    from .fem import StressState, nodal_stress_operator
+
+    points = np.asarray(system.mesh.points, dtype=float)
+    names = tuple(spots)
+    vertices = tuple(vertex_of(points, spots[n]) for n in names)
+    nv = system.model.n_vertices
+    op = nodal_stress_operator(system.model)
+    rows = np.concatenate([np.asarray(vertices) + c * nv for c in range(3)])
+    sub = op[rows]
+    comps = np.stack([sub @ displacement(system, r) for r in cycle.solutions])   # (n, 3·hot spots)
+    k = len(vertices)
+    state = StressState.from_components(comps[:, :k], comps[:, k:2 * k], comps[:, 2 * k:])
+    factors = tuple(float((p2_factor or {}).get(n, 1.0)) for n in names)
+    return HotSpotHistory(names=names, vertices=vertices, peaks=tuple(spots[n] for n in names),
+                          theta=np.asarray(cycle.theta), von_mises=np.asarray(state.von_mises),
+                          s1=np.asarray(state.s1), s2=np.asarray(state.s2), p2_factor=factors)
