@@ -268,11 +268,13 @@ def _bearing_arrows(pv, pl, scene: StressScene) -> None:
         if hb is not None:
             text += f"\nhandbook {np.hypot(*hb[i]):.0f} N"
         labels.append(text)
-        # on the side opposite the FE arrow, clear of both arrows (they point the same way within
-        # a few tens of degrees)
-        mag = float(np.hypot(*f))
-        away = -f / mag if mag > 0 else np.array([0.0, -1.0])
-        anchors.append(c + away * 0.35 * longest * scene.force_scale)
+        # above or below the centre, on the side the FE arrow does not point to (the text is
+        # horizontal: a vertical offset clears the arrows' start at the centre)
+        away = np.array([0.0, -1.0 if f[1] >= 0 else 1.0])
+        edges = scene.boundaries.get(f"bore_{i}")
+        radius = (float(np.mean(np.hypot(*(np.asarray(scene.points)[np.asarray(edges)[:, 0]] - c).T)))
+                  if edges is not None else longest * scene.force_scale)
+        anchors.append(c + away * 0.55 * radius)
     # no box: the labels sit inside the (empty, white) bores, and a box does not fit two centred lines
     pl.add_point_labels(np.column_stack([np.asarray(anchors), np.full(len(anchors), 2.0)]), labels, font_size=16,
                         point_size=1, text_color="black", shape=None, always_visible=True, show_points=False,
