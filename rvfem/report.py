@@ -17,7 +17,7 @@ from typing import Any
 
 from .case import Case
 
-__all__ = ["assumptions", "write_report"]
+__all__ = ["assumptions", "key_field_angles", "write_report"]
 
 _CSS = """
 body { font-family: system-ui, -apple-system, 'Segoe UI', Roboto, sans-serif; margin: 2em auto; max-width: 1200px;
@@ -178,6 +178,26 @@ def _case_rows(case: Case) -> list[list[str]]:
     return [[_e(a), _e(v)] for a, v in rows]
 
 
+def key_field_angles(summary: dict, case: Case) -> list[float]:
+    """Crank angles (degrees) whose stress images the report embeds: the case's saved angles (the
+    nearest kept field), the angle of the largest bearing load and the angles of the stress peaks.
+    The images of further angles (``--field-step``) are linked: a report with every image of a
+    10° step embedded weighs about 19 MB."""
+    fields = [f["theta_deg"] for f in summary.get("fields", [])]
+    wanted = [summary["max_bearing_load"]["theta_deg"]]
+    st = summary["stress"]
+    for entry in (st.get("structural_peak"), st.get("away_from_contacts"), st.get("contact_zone")):
+        if entry:
+            wanted.append(entry["at"]["theta_deg"])
+    key = set()
+    for a in wanted:
+        key.add(round(a, 6))
+    for a in case.analysis.saved_angles_deg:
+        if fields:
+            key.add(round(min(fields, key=lambda t: abs((t - a + 180.0) % 360.0 - 180.0)), 6))
+    return sorted(key)
+
+
 def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str | os.PathLike) -> Path:
     """Write ``report.html``.
 
@@ -331,10 +351,19 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
     im = summary.get("images", {})
     if im:
         parts.append("<h2>Stress images</h2>")
+        key = key_field_angles(summary, case)
+        linked = []
         for f in summary.get("fields", []):
-            if f.get("image"):
+            if not f.get("image"):
+                continue
+            if any(math.isclose(f["theta_deg"], a, abs_tol=1e-6) for a in key):
                 parts.append(_figure(root, f["image"], f"von Mises on the deformed disc at θ = {f['theta_deg']:.1f}° "
                                                        f"(ParaView: {f['vtu']})."))
+            else:
+                linked.append(f"<a href='{_e(f['image'])}'>{f['theta_deg']:g}°</a>")
+        if linked:
+            parts.append("<p class='meta'>Further stress images (<code>--field-step</code>), linked, not embedded, "
+                         "to keep this file light: " + ", ".join(linked) + ".</p>")
         parts.append("<div class='grid'>")
         parts.append(_figure(root, im.get("stress_away_from_contacts_closeup"),
                              "Close-up at the structural peak away from the pin and roller contacts (ring)."))

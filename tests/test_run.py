@@ -745,3 +745,24 @@ def test_repository_files_are_found_from_any_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert default_cache_dir() == root / "meshes"
     assert not (tmp_path / "meshes").exists()
+
+
+def test_report_links_further_field_images_instead_of_embedding_them(cli_run, summary, coarse_case_file, tmp_path):
+    """A --field-step run's extra images are linked, the key ones (saved angles, largest load,
+    stress peaks) embedded: the report stays light."""
+    import shutil
+
+    from rvfem.report import key_field_angles, write_report
+
+    folder = tmp_path / "copy"
+    shutil.copytree(cli_run, folder)
+    key = key_field_angles(summary, load_case(coarse_case_file))
+    extra = dict(summary["fields"][0], theta_deg=333.0)          # an angle that is none of the key ones
+    assert all(not math.isclose(333.0, a) for a in key)
+    s = dict(summary, fields=summary["fields"] + [extra])
+    html = write_report(folder / "report.html", s, load_case(coarse_case_file), folder).read_text(encoding="utf-8")
+    embedded = html.count('<img src="data:image/png;base64,')
+    assert embedded == len(summary["images"]) + len(summary["plots"])   # the extra one is not embedded
+    assert f"<a href='{extra['image']}'>333°</a>" in html
+    for f in summary["fields"]:                                          # the key angles are embedded
+        assert any(math.isclose(f["theta_deg"], a, abs_tol=1e-6) for a in key)
