@@ -308,7 +308,11 @@ def test_second_run_without_overwrite_fails_and_keeps_the_results(cli_run, coars
     err = capsys.readouterr().err
     assert code == 2
     assert "exists and is not empty" in err and "--overwrite" in err and "Traceback" not in err
+    assert "overwrite=True" not in err                     # the command line's wording, not the API's
     assert {p: p.read_bytes() for p in cli_run.rglob("*") if p.is_file()} == before
+    with pytest.raises(OutputError, match="overwrite=True") as info:   # and the API's from Python
+        outputs.check_output_folder(cli_run, overwrite=False)
+    assert "--overwrite" not in str(info.value)
 
 
 def test_overwrite_replaces_and_options_override_the_case(cli_run, coarse_case_file, cache_dir, workspace, capsys):
@@ -766,3 +770,12 @@ def test_report_links_further_field_images_instead_of_embedding_them(cli_run, su
     assert f"<a href='{extra['image']}'>333°</a>" in html
     for f in summary["fields"]:                                          # the key angles are embedded
         assert any(math.isclose(f["theta_deg"], a, abs_tol=1e-6) for a in key)
+
+
+def test_screen_gives_the_stribeck_pressure_without_roller_loads_and_stiffness_per_disc(summary):
+    rigid_bore = json.loads(json.dumps(summary))
+    rigid_bore["hertz"]["fe_rollers"] = None           # what the 'rigid_bore' bearing model gives
+    text = outputs.summary_text(rigid_bore)
+    sf = summary["hertz"]["stribeck_flexible"]
+    assert f"FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N" in text
+    assert "N·m/arcmin per disc" in text
