@@ -55,11 +55,15 @@ __all__ = [
     "RigidBearing",
     "RigidAnalysis",
     "StressResult",
+    "DutyCycleFE",
     "DutyCycleResult",
+    "duty_cycle_fe",
     "Analysis",
     "resolve_case",
     "cycle_angles",
     "kept_field_angles",
+    "default_cache_dir",
+    "repository_path",
     "analyse_rigid",
     "analyse",
 ]
@@ -71,6 +75,8 @@ STAGES: dict[str, str] = {
     "rigid": "rigid handbook model",
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
+    "stress": "structural stress peak re-solved on P2 at its crank angles",
+    "duty_cycle": "flexible load cycle at the other duty-cycle torques",
     "attribution": "attribution: the reducer-stage models step by step",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
@@ -420,23 +426,135 @@ class StressResult:
         Boundary name → width of the ignored band, mm.
     snapshots : tuple of rvfem.postprocess.FieldSnapshot
         The kept fields (saved angles, largest bearing load, the two peaks, ``field_step_deg``).
-    peak_element_von_mises_MPa : float
-        Largest element (not averaged) von Mises stress over the kept fields, MPa.
+    recovered : rvfem.postprocess.RecoveredPeak or None
+        The structural peak re-solved on P2 at its crank angles with the cycle's forces, with its
+        convergence check (None when ``analyse(..., recover_stress=False)`` or when no vertex lies
+        outside the contact bands). This is the structural peak the reports lead with.
+    history : rvfem.postprocess.HotSpotHistory or None
+        Vertex stresses over every solved crank angle at the structural peak and the contact-zone
+        peak (for a fatigue check).
     """
 
     peak: PeakStress
     away_from_contacts: PeakStress | None
     band_mm: dict[str, float]
     snapshots: tuple[FieldSnapshot, ...]
-    peak_element_von_mises_MPa: float
+    recovered: Any = None
+    history: Any = None
+
+    @property
+    def structural(self) -> PeakStress | None:
+        """The structural peak away from contacts to report: P2-recovered if available, else P1."""
+        if self.recovered is not None:
+            return self.recovered.peak
+        return self.away_from_contacts
+
+
+@dataclass(frozen=True)
+class DutyCycleFE:
+    """The duty cycle evaluated with the flexible model at every duty-cycle torque.
+
+    The service life of :class:`DutyCycleResult` ``flexible`` scales the rated flexible life with
+    (T_i/T0)^(10/3) (Gao et al. eq. 18): it assumes the bearing loads grow linearly with the
+    torque. The FE model is not linear (contact sets, Palmgren roller law, clearance), so here the
+    load cycle is solved at each distinct positive duty-cycle torque (same disc model and
+    compliance, no new factorisation) and Palmgren-Miner is applied to the bearing lives from
+    those equivalent loads: 1/L = Σ s_i/L_i per bearing, s_i the time shares, L_i the L10h at the
+    row's F_m and bearing speed; the service life is the shortest bearing's.
+
+    Attributes
+    ----------
+    torques_Nm : tuple of float
+        Distinct positive duty-cycle output torques, N·m.
+    equivalent_load_N : tuple of tuple of float
+        Flexible F_m per torque and bearing, N.
+    linear_scaling_error_percent : tuple of float
+        Per torque: largest over the bearings of F_m(T_i)/(F_m(T0)·T_i/T0) − 1, %.
+    service_life_h : float
+        Palmgren-Miner service life from the FE loads at every torque, hours.
+    linear_scaling_life_h : float
+        The same from the linear scaling (= ``DutyCycleResult.flexible.service_life_h``), hours.
+    seconds : float
+        Wall time of the extra load cycles, s.
+    """
+
+    torques_Nm: tuple[float, ...]
+    equivalent_load_N: tuple[tuple[float, ...], ...]
+    linear_scaling_error_percent: tuple[float, ...]
+    service_life_h: float
+    linear_scaling_life_h: float
+    seconds: float
+
+    @property
+    def life_difference_percent(self) -> float:
+        """(FE at every torque − linear scaling)/linear scaling of the service life, %."""
+        return 100.0 * (self.service_life_h / self.linear_scaling_life_h - 1.0)
 
 
 @dataclass(frozen=True)
 class DutyCycleResult:
-    """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives."""
+    """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives
+    (both scaled linearly with the torque, Gao et al. eq. 18), and the flexible one from the FE
+    at every duty-cycle torque (``flexible_fe``, None when not computed)."""
 
     rigid: iso281.DutyCycleLife
     flexible: iso281.DutyCycleLife
+    flexible_fe: DutyCycleFE | None = None
+
+
+def duty_cycle_fe(system, thetas: np.ndarray, cycle, comparison, linear_life_h: float) -> DutyCycleFE:
+    """Solve the flexible load cycle at every distinct positive duty-cycle torque of the case and
+    the service life from those loads (:class:`DutyCycleFE`; sources: ISO 281 life, Gao et al.
+    eqs. 16-18 with the FE loads in place of the linear scaling).
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+        The case's disc model (its compliance is reused).
+    thetas : ndarray
+        Crank angles, rad (those of ``cycle``).
+    cycle : rvfem.cycle.CycleResult
+        The cycle at the case's own torque (reused for a duty row at that torque).
+    comparison : rvfem.compare.Comparison
+        Its comparison (F_m at the case's torque).
+    linear_life_h : float
+        The linear-scaling service life, hours.
+    """
+    from . import compare
+    from . import cycle as cycle_module
+
+    t0 = time.perf_counter()
+    case = system.case
+    rows = case.loads.duty_cycle
+    rated_T = case.loads.torque_Nm
+    torques = sorted({float(r.torque_Nm) for r in rows if r.torque_Nm > 0})
+    rated_fm = [b.flexible.equivalent_N for b in comparison.bearings]
+    fm: dict[float, list[float]] = {}
+    for torque in torques:
+        if math.isclose(torque, rated_T, rel_tol=1e-12):
+            fm[torque] = rated_fm
+            continue
+        case_t = case.replace(loads=dataclasses.replace(case.loads, torque_Nm=torque))
+        system_t = dataclasses.replace(system, case=case_t)
+        cyc = cycle_module.load_cycle(system_t, thetas)
+        fm[torque] = [b.flexible.equivalent_N for b in compare.rigid_vs_flexible(case_t, cyc).bearings]
+    errors = tuple(100.0 * max((f / (f0 * t / rated_T) - 1.0 for f, f0 in zip(fm[t], rated_fm)), key=abs)
+                   for t in torques)
+    rating = iso281.crank_bearing_rating(case.crank_bearing)
+    total = sum(r.time_share for r in rows)
+    lives = []
+    for i in range(len(rated_fm)):
+        damage = 0.0  # Σ s_i / L_i, 1/h
+        for r in rows:
+            if r.torque_Nm <= 0:
+                continue
+            n_b = iso281.bearing_speed_rpm(r.speed_rpm, case.pins.count, case.cycloid.teeth)
+            life = iso281.rating_life_hours(rating, fm[float(r.torque_Nm)][i], n_b)
+            damage += (r.time_share / total) / life
+        lives.append(math.inf if damage == 0 else 1.0 / damage)
+    return DutyCycleFE(torques_Nm=tuple(torques), equivalent_load_N=tuple(tuple(fm[t]) for t in torques),
+                       linear_scaling_error_percent=errors, service_life_h=min(lives),
+                       linear_scaling_life_h=linear_life_h, seconds=time.perf_counter() - t0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -518,6 +636,75 @@ class Analysis:
         return np.stack([pin_centres(self.case, float(th)) for th in self.theta])
 
 
+def repository_path(relative: str | os.PathLike, start: str | os.PathLike | None = None) -> Path:
+    """Find a repository file (e.g. ``cases/rv40e_fanholes.toml``) from wherever Python runs.
+
+    Jupyter, nbconvert and editors start a notebook's kernel in the notebook's folder, not in the
+    repository root. This looks for ``relative`` in ``start`` (default: the current directory)
+    and then in each of its parent folders, and returns the first that exists.
+
+    Parameters
+    ----------
+    relative : path
+        Path relative to the repository root.
+    start : path, optional
+        Where to start looking; default the current directory.
+
+    Returns
+    -------
+    Path
+        The path found (absolute).
+
+    Raises
+    ------
+    CaseError
+        If no folder from ``start`` up to the file-system root holds ``relative``.
+    """
+    relative = Path(relative)
+    if relative.is_absolute():
+        if relative.exists():
+            return relative
+        raise CaseError(f"{relative}: no such file")
+    here = Path(start if start is not None else os.getcwd()).resolve()
+    for folder in (here, *here.parents):
+        if (folder / relative).exists():
+            return folder / relative
+    raise CaseError(f"{relative}: not found in {here} or any folder above it")
+
+
+def default_cache_dir() -> Path:
+    """The default mesh cache: ``meshes/`` of the repository when rvfem runs from a source checkout
+    (a folder holding ``pyproject.toml``, ``rvfem/`` and ``meshes/`` above the package), otherwise
+    the per-user cache folder of the platform (``platformdirs.user_cache_dir("rvfem")/meshes``,
+    e.g. ``~/.cache/rvfem/meshes`` on Linux). Never the current directory: running from elsewhere
+    must not start a new cache there."""
+    root = Path(__file__).resolve().parent.parent
+    if (root / "pyproject.toml").is_file() and (root / "meshes").is_dir():
+        return root / "meshes"
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("rvfem")) / "meshes"
+
+
+def _recover_structural_peak(system, cycle, mesh, band, away):
+    """The structural peak recovered on P2 (:func:`rvfem.postprocess.recover_peak`) at the P1
+    envelope's peak angles; the P2 model of the same mesh is built here (or is the cycle's own for
+    a P2 case)."""
+    from . import postprocess
+    from .cycle import build_system
+
+    t0 = time.perf_counter()
+    if system.model.order == 2:
+        system_p2, system_p1 = system, None
+    else:
+        system_p2, system_p1 = build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
+                                            pin_model=system.pin_model), system
+    setup = time.perf_counter() - t0
+    angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
+    return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
+                                    p1_peak=away, system_p1=system_p1, setup_seconds=setup)
+
+
 def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, ...]:
     """Crank angles (degrees) whose fields a load cycle keeps: the case's ``saved_angles_deg`` and
     every ``field_step_deg`` degrees if given (checked: in (0°, 360°], else CaseError)."""
@@ -531,8 +718,9 @@ def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, 
 
 def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             angle_step_deg: float | None = None, bearing_model: str | None = None, order: int | None = None,
-            field_step_deg: float | None = None, cache_dir: str | os.PathLike = "meshes",
-            progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None) -> Analysis:
+            field_step_deg: float | None = None, cache_dir: str | os.PathLike | None = None,
+            progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
+            recover_stress: bool = True, duty_fe: bool = True) -> Analysis:
     """Analyse a case completely, in memory.
 
     Parameters
@@ -548,12 +736,19 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         Also keep the displacement/stress fields every ``field_step_deg`` degrees (by default only
         the case's ``analysis.saved_angles_deg``, the angle of the largest bearing load and the
         angles of the stress peaks).
-    cache_dir : path
-        Mesh cache folder.
+    cache_dir : path, optional
+        Mesh cache folder; default :func:`default_cache_dir`.
     progress : ProgressCallback, optional
     provenance : CaseProvenance, optional
         If given, ``case`` is taken as already resolved (by :func:`resolve_case`) and the ``check``
         stage is skipped.
+    recover_stress : bool
+        Re-solve the disc on P2 at the structural peak's crank angles with the cycle's forces
+        (:func:`rvfem.postprocess.recover_peak`; stage ``stress``, about 5 s on the default case).
+    duty_fe : bool
+        With a duty cycle: also solve the flexible load cycle at every other duty-cycle torque and
+        give the service life from those loads (:func:`duty_cycle_fe`; stage ``duty_cycle``, one
+        load cycle per torque, no new factorisation).
 
     Returns
     -------
@@ -585,7 +780,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
 
     t = stages.start("mesh")
     geometry = disc_geometry(case)
-    mesh = mesh_case(case, cache_dir, geometry=geometry)
+    mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
     stages.end("mesh", t)
 
     t = stages.start("model")
@@ -617,9 +812,25 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
     snapshots = postprocess.field_snapshots(
         system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
-    stress = StressResult(
-        peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
-        peak_element_von_mises_MPa=max(float(s.stress.element.von_mises.max()) for s in snapshots))
+    stages.end("evaluation", t)
+
+    recovered = None
+    if recover_stress and away is not None:
+        t = stages.start("stress")
+        recovered = _recover_structural_peak(system, cycle, mesh, band, away)
+        stages.end("stress", t)
+        if not any(math.isclose(s.theta_deg, recovered.peak.theta_deg, abs_tol=1e-9) for s in snapshots):
+            snapshots = postprocess.field_snapshots(system, cycle, extra_angles=[
+                math.radians(x) for x in (peak.theta_deg, away.theta_deg, recovered.peak.theta_deg)])
+    t = time.perf_counter()
+    spots = {"structural": recovered.peak if recovered is not None else away, "contact_zone": peak}
+    spots = {k: v for k, v in spots.items() if v is not None}
+    factors = {}
+    if recovered is not None and recovered.p1_at_peak_MPa > 0:
+        factors["structural"] = recovered.peak.von_mises_MPa / recovered.p1_at_peak_MPa
+    history = postprocess.hot_spot_history(system, cycle, spots, factors)
+    stress = StressResult(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
+                          recovered=recovered, history=history)
     # the first bearing among equals (the handbook curves are exact shifts of each other)
     rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
     roller_hertz = hertz.most_loaded_roller_hertz(case, cycle.theta, cycle.bearing_forces, cycle.roller_loads,
@@ -631,7 +842,12 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         duty = DutyCycleResult(
             rigid=iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings]),
             flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
-    stages.end("evaluation", t)
+    stages.seconds["evaluation"] += time.perf_counter() - t
+    if duty is not None and duty_fe:
+        t = stages.start("duty_cycle")
+        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
+                                                                   duty.flexible.service_life_h))
+        stages.end("duty_cycle", t)
 
     # what the flexibility effect is made of: the modelling steps the case's own model does not
     # already give, on the same angles and the same compliance

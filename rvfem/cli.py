@@ -20,6 +20,7 @@ import sys
 import tempfile
 import traceback
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable, TextIO
 
 from . import __version__
@@ -105,8 +106,9 @@ def _run_rigid(args: argparse.Namespace) -> int:
 
 def _add_mesh_arguments(parser: argparse.ArgumentParser) -> None:
     _add_case_argument(parser)
-    parser.add_argument("--cache-dir", default="meshes",
-                        help="directory of cached meshes and previews (default: meshes)")
+    parser.add_argument("--cache-dir", default=None,
+                        help="directory of cached meshes and previews (default: the repository's meshes/ in a "
+                             "source checkout, else the per-user cache, e.g. ~/.cache/rvfem/meshes)")
     parser.add_argument("--force", action="store_true", help="re-mesh even if a cached mesh exists")
 
 
@@ -114,21 +116,28 @@ def _run_mesh(args: argparse.Namespace) -> int:
     import time
 
     from .geometry import disc_geometry
-    from .mesh import mesh_case, mesh_preview_png
+    from .mesh import mesh_case
+    from .plots import mesh_preview
+
+    from .analysis import default_cache_dir
+    from .postprocess import user_feature_name
 
     case = _load(args)
     start = time.perf_counter()
     geom = disc_geometry(case)
-    mesh = mesh_case(case, args.cache_dir, use_cache=not args.force, geometry=geom)
+    cache = default_cache_dir() if args.cache_dir is None else args.cache_dir
+    mesh = mesh_case(case, cache, use_cache=not args.force, geometry=geom)
     elapsed = time.perf_counter() - start
-    png = mesh_preview_png(mesh, mesh.path.with_suffix(".png"), title=f"{case.name}: disc mesh")
+    png = mesh_preview(mesh, mesh.path.with_suffix(".png"), title=f"{case.name}: disc mesh")
     thinnest = geom.walls[0]
     print(f"mesh of case '{case.name}' ({args.case}): {mesh.path}"
           f" ({'cached' if mesh.from_cache else 'generated'} in {elapsed:.2f} s)")
     print(f"  {mesh.n_nodes} nodes, {mesh.n_elements} linear triangles, "
           f"min element quality ({mesh.quality_measure}) {mesh.min_quality:.3f}")
-    print(f"  boundaries: {', '.join(f'{n} ({len(e)} edges)' for n, e in mesh.boundaries.items())}")
-    print(f"  thinnest wall {thinnest.thickness:.2f} mm between {thinnest.first} and {thinnest.second}")
+    print(f"  mesh cache: {Path(cache).resolve()}" + (" (default)" if args.cache_dir is None else ""))
+    print(f"  boundaries: {', '.join(f'{user_feature_name(n)} ({len(e)} edges)' for n, e in mesh.boundaries.items())}")
+    print(f"  thinnest wall {thinnest.thickness:.2f} mm between {user_feature_name(thinnest.first)} and "
+          f"{user_feature_name(thinnest.second)}")
     print(f"  preview: {png}")
     return EXIT_OK
 
@@ -153,10 +162,13 @@ def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--overwrite", action="store_true",
                         help="replace an existing result folder (only once the new results are complete)")
     parser.add_argument("--field-step", type=float, metavar="DEG",
-                        help="also keep stress fields (VTU frames) every DEG degrees; default: the case's "
-                             "saved angles and the angle of the largest bearing load")
+                        help="also keep stress fields (VTU frames, images) every DEG degrees; always kept: the "
+                             "case's saved angles, the angle of the largest bearing load and the angles of the "
+                             "structural and the contact-zone stress peaks")
     parser.add_argument("--no-images", action="store_true", help="skip the PyVista stress images")
-    parser.add_argument("--cache-dir", default="meshes", help="directory of cached meshes (default: meshes)")
+    parser.add_argument("--cache-dir", default=None,
+                        help="directory of cached meshes (default: the repository's meshes/ in a source checkout, "
+                             "else the per-user cache, e.g. ~/.cache/rvfem/meshes)")
 
 
 class _RunProgress:
@@ -236,8 +248,15 @@ def _run_run(args: argparse.Namespace) -> int:
 
     from .run import run_case, summary_text
 
+    from .errors import OutputError
+    from .outputs import check_output_folder
+
     case = _load(args)
     out_dir = Path(args.output) if args.output else Path("results") / case.name
+    try:
+        check_output_folder(out_dir, args.overwrite)
+    except OutputError as exc:  # the command line's wording: the option, not the keyword argument
+        raise OutputError(str(exc).replace("overwrite=True", "--overwrite")) from None
     progress = _RunProgress(sys.stderr, sys.stderr.isatty())
     try:
         result = run_case(case, out_dir, angle_step_deg=args.step, bearing_model=args.bearing_model,

@@ -46,6 +46,10 @@ log = logging.getLogger(__name__)
 
 __all__ = [
     "SCHEMA_VERSION",
+    "RIGID_SCHEMA_VERSION",
+    "VERSIONED_PACKAGES",
+    "command_line",
+    "environment",
     "IMAGE_SIZE",
     "DEFORMATION_DISPLAY_FRACTION",
     "SummaryContext",
@@ -56,6 +60,7 @@ __all__ = [
     "image_count",
     "build_summary",
     "summary_text",
+    "stress_lines",
     "rigid_summary",
     "rigid_text",
     "write_case_json",
@@ -67,9 +72,13 @@ __all__ = [
     "write_report",
 ]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 """Version of the ``summary.json`` layout (docs/outputs.md); bumped when a key changes meaning or
 disappears (new keys do not bump it)."""
+
+RIGID_SCHEMA_VERSION = 1
+"""Version of the ``rvfem rigid --json`` layout (docs/outputs.md); bumped when a key changes meaning
+or disappears."""
 
 IMAGE_SIZE = (1500, 1100)
 """Size of the stress images, pixels (width, height)."""
@@ -134,7 +143,7 @@ def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
             raise OutputError(f"{out_dir} exists and is not a folder; choose another output folder")
         if _is_nonempty_dir(out_dir) and not overwrite:
             raise OutputError(f"{out_dir} exists and is not empty; choose another output folder or pass "
-                              "--overwrite (overwrite=True) to replace it")
+                              "overwrite=True to replace it")
 
 
 def _make_parents(out_dir: Path) -> list[Path]:
@@ -246,9 +255,9 @@ class SummaryContext:
 def _stats_dict(s) -> dict:
     return {
         "max_load_N": s.max_N,
-        "max_at_deg": s.max_at_deg,
+        "max_at_deg": _angle(s.max_at_deg),
         "min_load_N": s.min_N,
-        "min_at_deg": s.min_at_deg,
+        "min_at_deg": _angle(s.min_at_deg),
         "equivalent_load_N": s.equivalent_N,
         "L10h_h": s.L10h,
     }
@@ -259,21 +268,75 @@ def _hertz_dict(h) -> dict:
         "roller_load_N": h.roller_load_N,
         "bearing": None if h.bearing is None else h.bearing + 1,
         "roller": None if h.roller is None else h.roller + 1,
-        "theta_deg": h.theta_deg,
+        "theta_deg": _angle(h.theta_deg),
         "inner": dataclasses.asdict(h.inner),
         "outer": dataclasses.asdict(h.outer),
     }
 
 
+ANGLE_DECIMALS = 6
+"""Crank angles in ``summary.json`` are rounded to this many decimals (no float noise such as
+255.00000000000003; every step rvfem accepts is a whole multiple of 1e-6°)."""
+
+
+def _angle(deg):
+    """A crank angle for the user, degrees, rounded to :data:`ANGLE_DECIMALS` (None stays None)."""
+    return None if deg is None else round(float(deg), ANGLE_DECIMALS) + 0.0
+
+
 def _peak_dict(peak) -> dict:
+    from .postprocess import user_feature_name
+
     return {
         "x_mm": peak.x_mm,
         "y_mm": peak.y_mm,
         "radius_mm": peak.radius_mm,
-        "theta_deg": peak.theta_deg,
-        "feature": peak.feature,
+        "theta_deg": _angle(peak.theta_deg),
+        "feature": user_feature_name(peak.feature),
         "feature_label": peak.feature_label,
         "distance_to_feature_mm": peak.distance_to_feature_mm,
+    }
+
+
+VERSIONED_PACKAGES = ("numpy", "scipy", "scikit-fem", "gmsh", "vtk", "pyvista", "matplotlib", "meshio")
+"""Packages whose installed versions ``summary.json`` records (``environment.versions``)."""
+
+
+def command_line() -> str | None:
+    """The command line of this process if it is the ``rvfem`` command (None from Python or a
+    notebook), shell-quoted."""
+    import shlex
+    import sys
+
+    argv = list(sys.argv)
+    if not argv:
+        return None
+    name = Path(argv[0]).name
+    if name == "rvfem" or (name in ("cli.py", "__main__.py") and "rvfem" in Path(argv[0]).parts):
+        return shlex.join(["rvfem", *argv[1:]])
+    return None
+
+
+def environment() -> dict:
+    """When, how and with what a result was computed: UTC date and time, the command line
+    (:func:`command_line`), Python, the platform and the versions of
+    :data:`VERSIONED_PACKAGES` (None if not installed)."""
+    import datetime
+    import platform
+    from importlib import metadata
+
+    versions = {}
+    for name in VERSIONED_PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return {
+        "date_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "command_line": command_line(),
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "versions": versions,
     }
 
 
@@ -282,6 +345,7 @@ def _piece_header(a, ctx: SummaryContext) -> dict:
     return {
         "schema_version": SCHEMA_VERSION,
         "rvfem_version": __version__,
+        "environment": environment(),
         "case": {
             "name": case.name,
             "description": case.description,
@@ -341,7 +405,7 @@ def _piece_bearings(a, ctx: SummaryContext) -> dict:
         "bearings": bearings,
         "max_bearing_load": {
             "bearing": i + 1,
-            "theta_deg": math.degrees(float(a.theta[k])),
+            "theta_deg": _angle(math.degrees(float(a.theta[k]))),
             "flexible_N": float(a.cycle.bearing_loads[k, i]),
         },
     }
@@ -367,20 +431,56 @@ def _piece_cycle(a, ctx: SummaryContext) -> dict:
 
 def _piece_stress(a, ctx: SummaryContext) -> dict:
     s = a.stress
-    away = s.away_from_contacts
+    away, rec = s.away_from_contacts, s.recovered
+    structural = s.structural
     return {
-        "peak_von_mises_MPa": s.peak.von_mises_MPa,
-        "peak_von_mises_at": _peak_dict(s.peak),
+        "peak_von_mises_MPa": None if structural is None else structural.von_mises_MPa,
+        "peak_von_mises_at": None if structural is None else _peak_dict(structural),
         "stress": {
-            "peak_element_von_mises_MPa": s.peak_element_von_mises_MPa,
+            "structural_peak": None if rec is None else {
+                "von_mises_MPa": rec.peak.von_mises_MPa,
+                "at": _peak_dict(rec.peak),
+                "method": rec.method,
+                "element_order": 2,
+                "estimated_error_MPa": rec.estimated_error_MPa,
+                "estimated_error_percent": rec.estimated_error_percent,
+                "p1_MPa": rec.p1_MPa,
+                "p1_at_peak_MPa": rec.p1_at_peak_MPa,
+                "p1_error_percent": rec.p1_error_percent,
+                "angles_deg": [_angle(x) for x in rec.angles_deg],
+                "seconds": rec.seconds,
+            },
             "away_from_contacts": None if away is None else {
                 "peak_von_mises_MPa": away.von_mises_MPa,
+                "element_order": a.system.model.order,
                 "at": _peak_dict(away),
                 "profile_band_mm": s.band_mm["profile"],
                 "bore_band_mm": s.band_mm.get("bore_0"),
             },
-            "field_angles_deg": [snap.theta_deg for snap in s.snapshots],
+            "contact_zone": {
+                "peak_von_mises_MPa": s.peak.von_mises_MPa,
+                "at": _peak_dict(s.peak),
+                "mesh_dependent": True,
+            },
+            "field_angles_deg": [_angle(snap.theta_deg) for snap in s.snapshots],
+            "hot_spots": [] if s.history is None else [_hot_spot_dict(s.history, j)
+                                                       for j in range(len(s.history.names))],
         },
+    }
+
+
+def _hot_spot_dict(h, j: int) -> dict:
+    vm, sd = h.von_mises[:, j], h.dominant[:, j]
+    return {
+        "name": h.names[j],
+        "at": _peak_dict(h.peaks[j]),
+        "von_mises_max_MPa": float(vm.max()),
+        "von_mises_min_MPa": float(vm.min()),
+        "dominant_principal_max_MPa": float(sd.max()),
+        "dominant_principal_min_MPa": float(sd.min()),
+        "dominant_principal_range_MPa": float(sd.max() - sd.min()),
+        "dominant_principal_mean_MPa": float(0.5 * (sd.max() + sd.min())),
+        "p2_factor": h.p2_factor[j],
     }
 
 
@@ -399,8 +499,19 @@ def _piece_hertz(a, ctx: SummaryContext) -> dict:
 def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
     if a.duty_cycle is None:
         return {}
-    return {"duty_cycle": {"rigid": dataclasses.asdict(a.duty_cycle.rigid),
-                           "flexible": dataclasses.asdict(a.duty_cycle.flexible)}}
+    fe = a.duty_cycle.flexible_fe
+    return {"duty_cycle": {
+        "rigid": dataclasses.asdict(a.duty_cycle.rigid),
+        "flexible": dataclasses.asdict(a.duty_cycle.flexible),
+        "flexible_fe": None if fe is None else {
+            "torques_Nm": list(fe.torques_Nm),
+            "equivalent_load_N": [list(row) for row in fe.equivalent_load_N],
+            "linear_scaling_error_percent": list(fe.linear_scaling_error_percent),
+            "service_life_h": fe.service_life_h,
+            "life_difference_percent": fe.life_difference_percent,
+            "seconds": fe.seconds,
+        },
+    }}
 
 
 def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
@@ -443,7 +554,7 @@ def _piece_files(a, ctx: SummaryContext) -> dict:
     files = set(ctx.files)
     fields = []
     for snap in a.stress.snapshots:
-        entry = {"theta_deg": snap.theta_deg, "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
+        entry = {"theta_deg": _angle(snap.theta_deg), "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
         image = f"images/{_stress_image_name(snap.theta_deg)}"
         if image in files:
             entry["image"] = image
@@ -533,6 +644,8 @@ def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
                                        a.classical.magnitude.T))
     out.append(tables.write_cycle_table(folder / "cycle.csv", th, cy.pins_in_contact, cy.carrier_rotation,
                                         cy.equilibrium_residual, cy.iterations))
+    if a.stress.history is not None:
+        out.append(tables.write_stress_history(folder / "stress_history.csv", a.stress.history))
     return out
 
 
@@ -558,6 +671,10 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
         if tick is not None and done < len(snapshots):
             tick(done, len(snapshots))
     out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
+    cy = analysis.cycle
+    if cy.von_mises_envelope is not None:
+        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, model.mesh.p.T, model.mesh.t.T,
+                                            cy.von_mises_envelope, cy.von_mises_envelope_theta))
     return out
 
 
@@ -633,14 +750,19 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
         done(render.stress_image(images / _stress_image_name(snap.theta_deg), scene(snap, label),
                                  window_size=IMAGE_SIZE))
     half = max(5.0, 12.0 * case.mesh.size_bore)
-    for key, pk in (("stress_peak_closeup", peak), ("stress_away_from_contacts_closeup", away)):
+    rec = a.stress.recovered
+    for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
+                          ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
         if pk is None:
             continue
         snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+        extra = ""
+        if rec is not None and key == "stress_away_from_contacts_closeup":
+            extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
         close = dataclasses.replace(
             scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
-            title=f"{case.name}   crank angle {snap.theta_deg:.1f}°   close-up (undeformed): von Mises "
-                  f"{pk.von_mises_MPa:.0f} MPa at the ring, {pk.feature_label}")
+            title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
+                  f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, {pk.feature_label}")
         done(render.stress_image(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
                                  marker=(pk.x_mm, pk.y_mm), show_edges=True, window_size=IMAGE_SIZE))
     b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
@@ -648,7 +770,7 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
                    closeup_centre=(float(b0[0]), float(b0[1])),
                    title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
                          f"(min quality {mesh.min_quality:.2f})",
-                   closeup_title="close-up: the rim under bore 1"))
+                   closeup_title="close-up: the rim under the bore of bearing 1"))
     return out
 
 
@@ -740,19 +862,12 @@ def summary_text(summary: dict) -> str:
             lines.append(f"    {r['step']:<12} max {_num(r['delta_max_percent'], '+6.1f')}%  min "
                          f"{_num(r['delta_min_percent'], '+6.1f')}%  F_m {_num(r['delta_equivalent_percent'], '+6.1f')}%"
                          f"  life ratio {_num(r['life_ratio'], '.2f')}" + ("   <- this run" if r["final"] else ""))
-    at = summary["peak_von_mises_at"]
-    away = summary["stress"]["away_from_contacts"]
     h = summary["hertz"]
     fe = h.get("fe_rollers")
-    lines += [
-        "",
-        f"  peak von Mises {summary['peak_von_mises_MPa']:.0f} MPa at ({at['x_mm']:.1f}, {at['y_mm']:.1f}) mm, "
-        f"{at['feature_label']}, θ = {at['theta_deg']:.1f}°"
-        + (f"; away from contacts {away['peak_von_mises_MPa']:.0f} MPa near {away['at']['feature_label']}"
-           if away else ""),
+    lines += [""] + stress_lines(summary["stress"]) + [
         f"  pins in contact {summary['pins_in_contact']['min']}–{summary['pins_in_contact']['max']} of "
         f"{summary['pins_in_contact']['of']}; torsional stiffness {summary['torsional_stiffness_Nm_per_arcmin']:.1f} "
-        f"N·m/arcmin; equilibrium residual {summary['equilibrium_residual']:.1e}",
+        f"N·m/arcmin per disc; equilibrium residual {summary['equilibrium_residual']:.1e}",
     ]
     sr = h["stribeck_rigid"]
     hertz = (f"  Hertz, most loaded roller: rigid Stribeck Q = {sr['roller_load_N']:.0f} N, p_in "
@@ -760,17 +875,56 @@ def summary_text(summary: dict) -> str:
     if fe:
         hertz += (f"; FE Q = {fe['roller_load_N']:.0f} N, p_in {fe['inner']['peak_pressure_MPa']:.0f} / p_out "
                   f"{fe['outer']['peak_pressure_MPa']:.0f} MPa")
+    else:
+        sf = h["stribeck_flexible"]
+        hertz += (f"; FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N, p_in "
+                  f"{sf['inner']['peak_pressure_MPa']:.0f} / p_out {sf['outer']['peak_pressure_MPa']:.0f} MPa")
     lines.append(hertz)
     duty = summary.get("duty_cycle")
     if duty:
         lines.append("  duty cycle: service life " + ", ".join(
             f"{key} {_num(duty[key]['service_life_h'], '.0f')} h" for key in ("rigid", "flexible"))
             + f" (equivalent torque {duty['rigid']['equivalent_torque_Nm']:.1f} N·m, "
-              f"speed {duty['rigid']['equivalent_speed_rpm']:.2f} rpm)")
+              f"speed {duty['rigid']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
+        fe = duty.get("flexible_fe")
+        if fe:
+            lines.append(
+                "    flexible FE at every duty torque (" + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): "
+                f"service life {_num(fe['service_life_h'], '.0f')} h ({_num(fe['life_difference_percent'], '+.1f')} % "
+                "against the linear scaling); F_m off linear scaling by "
+                + ", ".join(f"{e:+.1f} %" for e in fe["linear_scaling_error_percent"]))
     t = summary["timings_s"]
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")
     return "\n".join(lines)
+
+
+def stress_lines(stress: dict) -> list[str]:
+    """The disc-stress lines of the screen summary (the ``stress`` object of ``summary.json``):
+    the structural peak away from contacts first, with its convergence check, then the
+    contact-zone peak, labelled as such."""
+    lines = []
+    sp, away, cz = stress.get("structural_peak"), stress.get("away_from_contacts"), stress["contact_zone"]
+    if sp:
+        at = sp["at"]
+        lines += [
+            f"  structural stress peak (away from contacts) {sp['von_mises_MPa']:.0f} MPa von Mises ± "
+            f"{sp['estimated_error_MPa']:.1f} MPa (estimated), {at['feature_label']} at ({at['x_mm']:.1f}, "
+            f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°",
+            f"    P2 re-solve at θ = {', '.join(f'{x:g}' for x in sp['angles_deg'])}° with the cycle's forces "
+            f"({sp['seconds']:.1f} s); the P{away['element_order']} cycle alone gives {sp['p1_MPa']:.0f} MPa "
+            f"({sp['p1_error_percent']:+.0f} %)",
+        ]
+    elif away:
+        at = away["at"]
+        lines.append(f"  structural stress peak (away from contacts) {away['peak_von_mises_MPa']:.0f} MPa von Mises "
+                     f"(P{away['element_order']}, not re-solved on P2), {at['feature_label']} at ({at['x_mm']:.1f}, "
+                     f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°")
+    at = cz["at"]
+    lines.append(f"  contact-zone peak {cz['peak_von_mises_MPa']:.0f} MPa (under a pin or roller footprint, "
+                 f"mesh-dependent; not a Hertz stress), {at['feature_label']}, {at['distance_to_feature_mm']:.2f} mm "
+                 f"from it, θ = {at['theta_deg']:g}°")
+    return lines
 
 
 def rigid_summary(result) -> dict:
@@ -791,9 +945,17 @@ def rigid_summary(result) -> dict:
         "hertz_inner": dataclasses.asdict(b.hertz_inner),
         "hertz_outer": dataclasses.asdict(b.hertz_outer),
     } for b in result.bearings]
+    from .case import file_sha256
+
+    source = Path(case.source.removesuffix(" (with overrides)"))
     report = {
+        "schema_version": RIGID_SCHEMA_VERSION,
+        "rvfem_version": __version__,
+        "environment": environment(),
         "case": case.name,
         "source": case.source,
+        "case_sha256": file_sha256(source) if source.is_file() else None,
+        "case_digest": case.digest(),
         "overrides": list(case.overrides),
         "model": "rigid handbook (equal load sharing, zero clearance)",
         "output_torque_Nm": case.loads.torque_Nm,

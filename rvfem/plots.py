@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["mesh_plot", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
+__all__ = ["mesh_plot", "mesh_preview", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
 
 DPI = 120
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
@@ -67,7 +67,9 @@ def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.
     ax.set_ylabel("bearing load |F| [N]")
     ax.set_ylim(bottom=0.0)
     ax.set_title(title or "Crank-bearing loads over one crank revolution")
-    ax.legend(ncol=flexible.shape[1], fontsize=8, loc="lower center")
+    # below the axes: inside it would hide the minima (small loads at every angle)
+    ax.legend(ncol=flexible.shape[1], fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13),
+              frameon=False)
     fig.tight_layout()
     return _save(fig, path)
 
@@ -216,21 +218,63 @@ def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
     x, y = pts[:, 0], pts[:, 1]
     colours = {"profile": "tab:red", "central_hole": "tab:green"}
     cycle = ["tab:blue", "tab:orange", "tab:purple", "tab:brown", "tab:olive", "tab:cyan"]
+    from .postprocess import feature_label
+
+    handles = {}
     for ax in axes:
         ax.triplot(x, y, np.asarray(triangles), lw=0.15, color="0.35")
         for i, (name, edges) in enumerate(boundaries.items()):
             loop = np.append(np.asarray(edges)[:, 0], np.asarray(edges)[0, 0])
-            ax.plot(x[loop], y[loop], lw=1.0, color=colours.get(name, cycle[i % len(cycle)]))
+            line, = ax.plot(x[loop], y[loop], lw=1.0, color=colours.get(name, cycle[i % len(cycle)]))
+            handles[feature_label(name)] = line
         ax.set_aspect("equal")
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
     cx, cy = closeup_centre
-    axes[1].set_xlim(cx - closeup_half_height, cx + closeup_half_height)
-    axes[1].set_ylim(cy - closeup_half_height, cy + closeup_half_height)
+    h = closeup_half_height
+    axes[1].set_xlim(cx - h, cx + h)
+    axes[1].set_ylim(cy - h, cy + h)
     axes[1].set_title(closeup_title)
     axes[0].set_title(title)
+    # where the close-up is: a frame on the whole disc
+    from matplotlib.patches import Rectangle
+
+    axes[0].add_patch(Rectangle((cx - h, cy - h), 2 * h, 2 * h, fill=False, lw=1.4, color="black", zorder=5))
+    axes[0].annotate("close-up", (cx + h, cy + h), xytext=(4, 4), textcoords="offset points", fontsize=9)
+    # the key of the boundary colours (names as users read them, numbered from 1)
+    fig.legend(list(handles.values()), list(handles), loc="lower center", ncol=min(len(handles), 6),
+               fontsize=8, frameon=False)
     if subtitle:
         fig.suptitle(subtitle)
-    fig.tight_layout(rect=(0, 0, 1, 0.95 if subtitle else 1.0))
+    fig.tight_layout(rect=(0, 0.07, 1, 0.94 if subtitle else 0.97))
     fig.savefig(path, dpi=dpi)
     return path
+
+
+def mesh_preview(mesh, path: str | os.PathLike, *, title: str = "", dpi: int = 150) -> Path:
+    """The preview ``rvfem mesh`` writes next to a cached mesh: :func:`mesh_plot` of the whole disc
+    and of the rim under the bore of bearing 1 with the teeth next to it.
+
+    Parameters
+    ----------
+    mesh : rvfem.mesh.DiscMesh
+    path : path-like
+        PNG to write.
+    title : str
+        Title of the left panel (default: the mesh file's name).
+    dpi : int
+    """
+    pts = np.asarray(mesh.points, dtype=float)
+    if "bore_0" in mesh.boundaries:
+        b = np.unique(np.asarray(mesh.boundaries["bore_0"]).ravel())
+        c = pts[b[np.argmax(np.hypot(pts[b, 0], pts[b, 1]))]]
+        c = c * (1 + 3.0 / np.hypot(*c))
+        where = "close-up: rim under the bore of bearing 1 and teeth"
+    else:
+        c = pts[np.asarray(mesh.boundaries["profile"])[0, 0]]
+        where = "close-up: tooth profile"
+    return mesh_plot(path, pts, mesh.triangles, mesh.boundaries, closeup_centre=(float(c[0]), float(c[1])),
+                     title=title or mesh.path.stem,
+                     subtitle=f"{mesh.n_nodes} nodes, {mesh.n_elements} triangles (P1), "
+                              f"min {mesh.quality_measure} = {mesh.min_quality:.3f}",
+                     closeup_title=where, dpi=dpi)

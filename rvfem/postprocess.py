@@ -29,11 +29,19 @@ __all__ = [
     "PeakStress",
     "FEATURE_LABELS",
     "feature_label",
+    "user_feature_name",
     "max_load_index",
     "nearest_index",
     "field_snapshots",
     "stress_envelope",
     "peak_von_mises",
+    "RECOVERY_ANGLES",
+    "RecoveredPeak",
+    "peak_angles",
+    "recover_peak",
+    "HotSpotHistory",
+    "vertex_of",
+    "hot_spot_history",
 ]
 
 
@@ -276,3 +284,279 @@ def peak_von_mises(source, points: np.ndarray,
         feature_label=feature_label(feature),
         distance_to_feature_mm=dist,
     )
+
+
+# --------------------------------------------------------------------------------------------
+# The structural peak recovered on P2
+# --------------------------------------------------------------------------------------------
+
+
+RECOVERY_ANGLES = 3
+"""Crank angles at which :func:`recover_peak` re-solves the disc on P2: the angles of the largest
+P1 envelope values away from the contacts, at least one per feature (hole, bore…) that comes within
+10 % of the P1 peak."""
+
+
+@dataclass(frozen=True)
+class RecoveredPeak:
+    """The structural stress peak recovered on a P2 model of the same mesh, with its convergence check.
+
+    Method: the disc is re-solved on P2 (scikit-fem ``ElementTriP2`` on the same triangles, same
+    footprint interface) loaded with the converged contact and roller forces of the P1 cycle at a
+    few crank angles where the P1 peak lies; the stresses are recovered on P2 and the largest vertex
+    von Mises stress away from the contacts is taken. The bearing loads are not changed (P1 and P2
+    give them within 0.1 %, see docs/theory.md); only the stress is re-evaluated.
+
+    Attributes
+    ----------
+    peak : PeakStress
+        The P2 peak: value (MPa), location, crank angle, nearest feature.
+    p1_MPa : float
+        The P1 envelope's structural peak (what the P1 cycle alone gives), MPa.
+    p1_at_peak_MPa : float
+        The P1 vertex value at the P2 peak's vertex and angle, MPa.
+    estimated_error_MPa : float
+        Estimated error of the P2 peak: the largest difference between the (discontinuous) P2
+        element stresses at the peak vertex and their area-weighted average, von Mises, MPa (a
+        Zienkiewicz-Zhu type indicator: recovered minus raw stress).
+    angles_deg : tuple of float
+        Crank angles re-solved on P2, degrees.
+    seconds : float
+        Wall time of the recovery (P2 assembly, factorisation and the solves), s.
+    method : str
+        One line describing the method.
+    """
+
+    peak: PeakStress
+    p1_MPa: float
+    p1_at_peak_MPa: float
+    estimated_error_MPa: float
+    angles_deg: tuple[float, ...]
+    seconds: float
+    method: str = ("P2 re-solve of the same mesh at the P1 peak angles, loaded with the P1 cycle's "
+                   "contact and roller forces")
+
+    @property
+    def p1_error_percent(self) -> float:
+        """(P1 − P2)/P2 of the structural peak, %: the error of the P1 envelope's peak."""
+        return 100.0 * (self.p1_MPa - self.peak.von_mises_MPa) / self.peak.von_mises_MPa
+
+    @property
+    def estimated_error_percent(self) -> float:
+        """``estimated_error_MPa`` relative to the P2 peak, %."""
+        return 100.0 * self.estimated_error_MPa / self.peak.von_mises_MPa
+
+
+def _mask(points: np.ndarray, boundaries: dict[str, np.ndarray], exclude: dict[str, float] | None) -> np.ndarray:
+    mask = np.ones(len(points), dtype=bool)
+    for name, band in (exclude or {}).items():
+        if name in boundaries and band > 0:
+            mask &= _distances(points, points[np.asarray(boundaries[name])[:, 0]]) >= band
+    return mask
+
+
+def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
+                exclude: dict[str, float] | None = None, count: int = RECOVERY_ANGLES,
+                within: float = 0.1) -> tuple[float, ...]:
+    """Crank angles (rad) where the structural peak may lie: for every mesh boundary, the angle at
+    which its nearest vertices reach their largest envelope value, if that comes within ``within``
+    of the overall peak; the ``count`` highest, the overall peak's angle first."""
+    env = stress_envelope(source)
+    points = np.asarray(points, dtype=float)
+    mask = _mask(points, boundaries, exclude)
+    candidates = np.flatnonzero(mask)
+    if candidates.size == 0:
+        return ()
+    names = list(boundaries)
+    dist = np.stack([_distances(points[candidates], points[np.asarray(boundaries[n])[:, 0]]) for n in names])
+    nearest = np.argmin(dist, axis=0)
+    top = float(env.von_mises[candidates].max())
+    best: list[tuple[float, float]] = []
+    for j in range(len(names)):
+        sel = candidates[nearest == j]
+        if sel.size == 0:
+            continue
+        v = sel[np.argmax(env.von_mises[sel])]
+        if env.von_mises[v] >= (1.0 - within) * top:
+            best.append((float(env.von_mises[v]), float(env.theta[v])))
+    angles: list[float] = []
+    for _, th in sorted(best, reverse=True):
+        if not any(math.isclose(th, a, abs_tol=1e-12) for a in angles):
+            angles.append(th)
+    return tuple(angles[:count])
+
+
+def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
+                 exclude: dict[str, float] | None = None, p1_peak: PeakStress | None = None,
+                 system_p1=None, setup_seconds: float = 0.0) -> RecoveredPeak:
+    """Re-solve the disc on P2 at ``angles`` with the P1 cycle's forces; the structural peak.
+
+    Parameters
+    ----------
+    system_p2 : rvfem.cycle.DiscSystem
+        The P2 model of the same mesh (``build_system(case, mesh, order=2)``): its footprint
+        interface has the same columns as the P1 cycle's.
+    cycle : rvfem.cycle.CycleResult
+        The P1 cycle (its ``solutions`` hold the converged contact and roller forces).
+    angles : iterable of float
+        Crank angles to re-solve, rad (nearest of ``cycle.theta``).
+    points, boundaries, exclude
+        As for :func:`peak_von_mises` (mesh vertices, boundary edges, contact bands).
+    p1_peak : PeakStress, optional
+        The P1 structural peak (reported beside the P2 value).
+    system_p1 : rvfem.cycle.DiscSystem, optional
+        The P1 model of the cycle: gives ``p1_at_peak_MPa`` (NaN without it).
+    setup_seconds : float
+        Time already spent building ``system_p2``, added to ``seconds``.
+
+    Returns
+    -------
+    RecoveredPeak
+
+    Notes
+    -----
+    The load of the P2 model is ``B₂ W λ``: the same footprint forces λ of the converged P1
+    contact problem spread by the P2 consistent footprint weights, so each body is in equilibrium
+    exactly as in the P1 solve. The P2 response is the stress under these forces; the contact
+    forces themselves would change by less than 0.1 % on P2 (the bearing loads do, docs/theory.md).
+    """
+    import time
+
+    from .cycle import displacement
+
+    t0 = time.perf_counter()
+    model = system_p2.model
+    if system_p2.interface.B.shape[1] != cycle.solutions[0].contacts.W.shape[0]:
+        raise ValueError("the P2 model's interface does not match the P1 cycle's")
+    points = np.asarray(points, dtype=float)
+    mask = _mask(points, boundaries, exclude)
+    candidates = np.flatnonzero(mask)
+    best = None
+    for theta in angles:
+        k = nearest_index(cycle.theta, float(theta))
+        u = displacement(system_p2, cycle.solutions[k])
+        fields = fem.stress_fields(model, u)
+        vm = fields.nodal.von_mises
+        v = int(candidates[np.argmax(vm[candidates])])
+        if best is None or vm[v] > best[0]:
+            best = (float(vm[v]), v, k, u)
+    value, vertex, k, u = best
+    # the spread of the P2 element stresses at the peak vertex around their average
+    g = model._stress_basis.interpolate(u).grad[:, :, :, :3]      # (2, 2, n_elements, 3 vertices)
+    lam, mu = fem.plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
+    t = model.mesh.t
+    local, elems = np.nonzero(t == vertex)
+    gv = g[:, :, elems, local]
+    tr = gv[0, 0] + gv[1, 1]
+    sxx, syy = lam * tr + 2 * mu * gv[0, 0], lam * tr + 2 * mu * gv[1, 1]
+    sxy = mu * (gv[0, 1] + gv[1, 0])
+    vm_raw = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+    spread = float(np.max(np.abs(vm_raw - value)))
+    envelope = np.full(len(points), -np.inf)
+    envelope[vertex] = value
+    peak = peak_von_mises(StressEnvelope(envelope, np.full(len(points), float(cycle.theta[k]))), points,
+                          boundaries)
+    p1_here = math.nan
+    if system_p1 is not None:
+        u1 = displacement(system_p1, cycle.solutions[k])
+        p1_here = float(fem.stress_fields(system_p1.model, u1).nodal.von_mises[vertex])
+    return RecoveredPeak(
+        peak=peak,
+        p1_MPa=float(p1_peak.von_mises_MPa) if p1_peak is not None else math.nan,
+        p1_at_peak_MPa=p1_here,
+        estimated_error_MPa=spread,
+        angles_deg=tuple(round(math.degrees(float(cycle.theta[nearest_index(cycle.theta, float(a))])), 9)
+                         for a in angles),
+        seconds=setup_seconds + time.perf_counter() - t0,
+    )
+
+
+def user_feature_name(name: str) -> str:
+    """A mesh boundary's name as users read it, numbered from 1 like bearings, pins and rollers:
+    ``bore_0`` → ``bore_1``, ``hole_2`` → ``hole_3``; other names unchanged. (The mesh's boundary
+    names are numbered from 0 internally; every output maps them with this function.)"""
+    stem, _, number = name.rpartition("_")
+    if stem in ("bore", "hole") and number.isdigit():
+        return f"{stem}_{int(number) + 1}"
+    return name
+
+
+# --------------------------------------------------------------------------------------------
+# Stress history at the hot spots (for a fatigue check)
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class HotSpotHistory:
+    """Stress over the crank angle at a few vertices (the hot spots), for a fatigue check.
+
+    Attributes
+    ----------
+    names : tuple of str
+        ``structural`` (the structural peak's vertex) and ``contact_zone`` (the overall peak's).
+    vertices : tuple of int
+        Mesh vertex of each hot spot.
+    peaks : tuple of PeakStress
+        Where each hot spot is (value and angle of the envelope there).
+    theta : ndarray (n,)
+        Crank angles, rad (the cycle's).
+    von_mises, s1, s2 : ndarray (n, hot spots)
+        Vertex von Mises and in-plane principal stresses of the cycle's model at every angle, MPa.
+    p2_factor : tuple of float
+        P2/P1 ratio of the von Mises stress at the hot spot at the recovery's angle (1 where not
+        re-solved): multiply the P1 history by it for an estimate of the P2 history.
+    """
+
+    names: tuple[str, ...]
+    vertices: tuple[int, ...]
+    peaks: tuple[PeakStress, ...]
+    theta: np.ndarray
+    von_mises: np.ndarray
+    s1: np.ndarray
+    s2: np.ndarray
+    p2_factor: tuple[float, ...]
+
+    @property
+    def dominant(self) -> np.ndarray:
+        """The in-plane principal stress of larger magnitude, signed, (n, hot spots), MPa: at a
+        free edge the one non-zero stress (the tangential one), whose range and mean a fatigue
+        check uses."""
+        return np.where(np.abs(self.s1) >= np.abs(self.s2), self.s1, self.s2)
+
+
+def vertex_of(points: np.ndarray, peak: PeakStress) -> int:
+    """Index of the mesh vertex at a peak's position."""
+    return int(np.argmin(np.hypot(points[:, 0] - peak.x_mm, points[:, 1] - peak.y_mm)))
+
+
+def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
+                     p2_factor: dict[str, float] | None = None) -> HotSpotHistory:
+    """Vertex stresses at the hot spots at every solved crank angle of a cycle: one
+    back-substitution and a few rows of :func:`rvfem.fem.nodal_stress_operator` per angle.
+
+    Parameters
+    ----------
+    system : rvfem.cycle.DiscSystem
+    cycle : rvfem.cycle.CycleResult
+    spots : dict
+        Name → PeakStress (its vertex is the hot spot).
+    p2_factor : dict, optional
+        Name → P2/P1 ratio at the hot spot (see :class:`HotSpotHistory`).
+    """
+    from .cycle import displacement
+    from .fem import StressState, nodal_stress_operator
+
+    points = np.asarray(system.mesh.points, dtype=float)
+    names = tuple(spots)
+    vertices = tuple(vertex_of(points, spots[n]) for n in names)
+    nv = system.model.n_vertices
+    op = nodal_stress_operator(system.model)
+    rows = np.concatenate([np.asarray(vertices) + c * nv for c in range(3)])
+    sub = op[rows]
+    comps = np.stack([sub @ displacement(system, r) for r in cycle.solutions])   # (n, 3·hot spots)
+    k = len(vertices)
+    state = StressState.from_components(comps[:, :k], comps[:, k:2 * k], comps[:, 2 * k:])
+    factors = tuple(float((p2_factor or {}).get(n, 1.0)) for n in names)
+    return HotSpotHistory(names=names, vertices=vertices, peaks=tuple(spots[n] for n in names),
+                          theta=np.asarray(cycle.theta), von_mises=np.asarray(state.von_mises),
+                          s1=np.asarray(state.s1), s2=np.asarray(state.s2), p2_factor=factors)

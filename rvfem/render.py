@@ -259,10 +259,26 @@ def _bearing_arrows(pv, pl, scene: StressScene) -> None:
             arrow = pv.Arrow(start=(c[0], c[1], 1.0), direction=(f[0], f[1], 0.0), scale=mag * scene.force_scale,
                              tip_length=0.22, tip_radius=0.09, shaft_radius=shaft)
             pl.add_mesh(arrow, color=colour, lighting=False)
-    labels = [f"B{i + 1}: {np.hypot(*f):.0f} N" for i, f in enumerate(np.asarray(scene.bearing_forces, dtype=float))]
-    pl.add_point_labels(np.column_stack([centres, np.full(len(centres), 2.0)]), labels, font_size=18, point_size=1,
-                        text_color="black", shape_color="white", shape_opacity=0.7, always_visible=True,
-                        show_points=False)
+    fe = np.asarray(scene.bearing_forces, dtype=float)
+    hb = None if scene.rigid_forces is None else np.asarray(scene.rigid_forces, dtype=float)
+    labels, anchors = [], []
+    longest = max(float(np.max(np.hypot(*fe.T))), 0.0 if hb is None else float(np.max(np.hypot(*hb.T))))
+    for i, (c, f) in enumerate(zip(centres, fe)):
+        text = f"B{i + 1}: FE {np.hypot(*f):.0f} N"
+        if hb is not None:
+            text += f"\nhandbook {np.hypot(*hb[i]):.0f} N"
+        labels.append(text)
+        # above or below the centre, on the side the FE arrow does not point to (the text is
+        # horizontal: a vertical offset clears the arrows' start at the centre)
+        away = np.array([0.0, -1.0 if f[1] >= 0 else 1.0])
+        edges = scene.boundaries.get(f"bore_{i}")
+        radius = (float(np.mean(np.hypot(*(np.asarray(scene.points)[np.asarray(edges)[:, 0]] - c).T)))
+                  if edges is not None else longest * scene.force_scale)
+        anchors.append(c + away * 0.55 * radius)
+    # no box: the labels sit inside the (empty, white) bores, and a box does not fit two centred lines
+    pl.add_point_labels(np.column_stack([np.asarray(anchors), np.full(len(anchors), 2.0)]), labels, font_size=16,
+                        point_size=1, text_color="black", shape=None, always_visible=True, show_points=False,
+                        justification_horizontal="center")
     key = ["black arrows: FE bearing forces on the disc"]
     if scene.rigid_forces is not None:
         key.append("grey arrows: handbook (rigid) forces")
@@ -330,12 +346,14 @@ def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[fl
             pl.add_mesh(chosen[0].merge(chosen[1:]) if len(chosen) > 1 else chosen[0], color=colour,
                         lighting=False)
 
-    if focus is None:
+    closeup = focus is not None
+    if not closeup:
         _bearing_arrows(pv, pl, scene)
     if marker is not None:
         ring = pv.Disc(center=(marker[0], marker[1], 3.0), inner=0.35, outer=0.5, c_res=32)
         pl.add_mesh(ring, color="black", lighting=False)
-    pl.add_text(scene.title, position="upper_left", font_size=12, color="black")
+    title = pl.add_text(scene.title, position="upper_left", font_size=12 if not closeup else 11, color="black")
+    _text_background(title)
 
     if focus is None:
         # the whole disc on the left, the colour bar and the legend in the free band on the right
@@ -345,5 +363,70 @@ def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[fl
         half_height = r_view if half_height is None else half_height
     elif half_height is None:
         half_height = 5.0
+    if closeup:
+        _scale_bar(pv, pl, focus, half_height, window_size[0] / window_size[1])
+        _locator_inset(pv, pl, pts, scene.boundaries, focus, half_height, window_size[0] / window_size[1])
     _top_view(pl, focus, half_height)
     return _save(pl, path)
+
+
+def _text_background(actor) -> None:
+    """A white, nearly opaque box behind a text (the close-ups' titles lie over the mesh)."""
+    try:
+        prop = actor.GetTextProperty()
+        prop.SetBackgroundColor(1.0, 1.0, 1.0)
+        prop.SetBackgroundOpacity(0.85)
+    except AttributeError:  # pragma: no cover - a VTK without text backgrounds
+        pass
+
+
+def _scale_bar(pv, pl, focus: tuple[float, float], half_height: float, aspect: float) -> None:
+    """A scale bar in the lower-left corner of a close-up: a round length (1, 2 or 5·10^k mm) of
+    about a fifth of the view's height, labelled."""
+    length = nice_factor(0.4 * half_height)
+    x0 = focus[0] - aspect * half_height * 0.25      # right of the locator inset (lower left)
+    y0 = focus[1] - half_height * 0.86
+    bar = pv.Box(bounds=(x0, x0 + length, y0, y0 + 0.015 * half_height * 2, 3.0, 3.2))
+    pl.add_mesh(bar, color="black", lighting=False)
+    pl.add_point_labels([(x0, y0 + 0.06 * half_height, 3.5)], [f"{length:g} mm"], font_size=16,
+                        point_size=1, text_color="black", shape_color="white", shape_opacity=0.85,
+                        always_visible=True, show_points=False)
+
+
+def _locator_inset(pv, pl, points: np.ndarray, boundaries: dict, focus: tuple[float, float], half_height: float,
+                   aspect: float) -> None:
+    """A small view of the whole disc in the lower-left corner with a red frame where the close-up is."""
+    import vtk
+
+    ren = vtk.vtkRenderer()
+    ren.SetViewport(0.005, 0.005, 0.255, 0.345)
+    ren.SetBackground(1.0, 1.0, 1.0)
+    ren.SetLayer(1)
+    ren.SetPreserveColorBuffer(False)   # its own white background over the close-up
+    win = pl.render_window
+    win.SetNumberOfLayers(max(2, win.GetNumberOfLayers()))
+    outline = _outline(pv, points, boundaries, 0.0)
+    w, h = aspect * half_height, half_height
+    cx, cy = focus
+    frame = pv.lines_from_points(np.array([[cx - w, cy - h, 1.0], [cx + w, cy - h, 1.0], [cx + w, cy + h, 1.0],
+                                           [cx - w, cy + h, 1.0], [cx - w, cy - h, 1.0]]))
+    r = 1.05 * float(np.max(np.hypot(points[:, 0], points[:, 1])))
+    backdrop = pv.Plane(center=(0.0, 0.0, -1.0), direction=(0.0, 0.0, 1.0), i_size=4 * r, j_size=4 * r)
+    for mesh, colour, width in ((backdrop, (1.0, 1.0, 1.0), 1.0), (outline, (0.3, 0.3, 0.3), 1.0),
+                                (frame, (0.85, 0.0, 0.0), 3.0)):
+        mapper = vtk.vtkPolyDataMapper()
+        mapper.SetInputData(mesh)
+        actor = vtk.vtkActor()
+        actor.SetMapper(mapper)
+        actor.GetProperty().SetColor(*colour)
+        actor.GetProperty().SetLineWidth(width)
+        actor.GetProperty().LightingOff()
+        ren.AddActor(actor)
+    cam = ren.GetActiveCamera()
+    cam.ParallelProjectionOn()
+    cam.SetPosition(0.0, 0.0, 1000.0)
+    cam.SetFocalPoint(0.0, 0.0, 0.0)
+    cam.SetViewUp(0.0, 1.0, 0.0)
+    cam.SetParallelScale(r)
+    ren.SetInteractive(False)
+    win.AddRenderer(ren)

@@ -113,7 +113,7 @@ class RunSummary:
 
 def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angle_step_deg: float | None = None,
              bearing_model: str | None = None, order: int | None = None, overwrite: bool = False,
-             progress: ProgressCallback | None = None, cache_dir: str | os.PathLike = "meshes",
+             progress: ProgressCallback | None = None, cache_dir: str | os.PathLike | None = None,
              images: bool = True, field_step_deg: float | None = None,
              overrides: tuple[str, ...] = ()) -> RunSummary:
     """Run a case completely and write its result folder.
@@ -134,8 +134,9 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
         Replace an existing non-empty ``out_dir`` (only once the new results are complete).
     progress : callable, optional
         See :data:`ProgressCallback`; the stages are :data:`STAGES`.
-    cache_dir : path
-        Mesh cache folder.
+    cache_dir : path, optional
+        Mesh cache folder; default :func:`rvfem.analysis.default_cache_dir` (the repository's
+        ``meshes/`` in a source checkout, else the per-user cache).
     images : bool
         Render the PyVista images (needs off-screen OpenGL; checked before anything is computed).
     field_step_deg : float, optional

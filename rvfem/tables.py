@@ -27,7 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table"]
+__all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
+           "write_stress_history"]
 
 
 def _fmt(v) -> str:
@@ -137,3 +138,21 @@ def write_cycle_table(path: str | os.PathLike, theta: np.ndarray, pins_in_contac
             for t, p, a, r, i in zip(theta, pins_in_contact, arcmin, residual, iterations))
     return _write(path, ["theta_deg", "pins_in_contact", "carrier_rotation_arcmin", "equilibrium_residual",
                          "active_set_iterations"], rows)
+
+
+def write_stress_history(path: str | os.PathLike, history) -> Path:
+    """Write ``stress_history.csv``: per crank angle, the von Mises and principal stresses at each
+    hot spot of a :class:`rvfem.postprocess.HotSpotHistory` (columns ``<name>_von_mises_MPa``,
+    ``<name>_s1_MPa``, ``<name>_s2_MPa``, ``<name>_dominant_MPa``: the principal stress of larger
+    magnitude, signed), MPa."""
+    header = ["theta_deg"]
+    for name in history.names:
+        header += [f"{name}_von_mises_MPa", f"{name}_s1_MPa", f"{name}_s2_MPa", f"{name}_dominant_MPa"]
+    rows = []
+    dominant = history.dominant
+    for k, theta in enumerate(history.theta):
+        row = [math.degrees(float(theta))]
+        for j in range(len(history.names)):
+            row += [history.von_mises[k, j], history.s1[k, j], history.s2[k, j], dominant[k, j]]
+        rows.append(row)
+    return _write(path, header, rows)

@@ -29,7 +29,7 @@ import numpy as np
 
 from .postprocess import FieldSnapshot
 
-__all__ = ["POINT_FIELDS", "CELL_FIELDS", "vtu_name", "write_vtu", "write_pvd"]
+__all__ = ["POINT_FIELDS", "CELL_FIELDS", "ENVELOPE_FILE", "vtu_name", "write_vtu", "write_pvd", "write_envelope_vtu"]
 
 #: Point-data arrays of every ``.vtu`` (name → number of components).
 POINT_FIELDS = {
@@ -125,4 +125,34 @@ def write_pvd(path: str | os.PathLike, entries: list[tuple[float, str]]) -> Path
         lines.append(f'    <DataSet timestep="{time:.6g}" group="" part="0" file={quoteattr(name)}/>')
     lines += ["  </Collection>", "</VTKFile>", ""]
     path.write_text("\n".join(lines), encoding="utf-8")
+    return path
+
+
+ENVELOPE_FILE = "disc_envelope.vtu"
+"""File name of the stress envelope in ``vtk/`` (not part of the ``.pvd`` time series)."""
+
+
+def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray,
+                       von_mises: np.ndarray, theta: np.ndarray) -> Path:
+    """Write the cycle's stress envelope as a ``.vtu``: point data ``von_mises_envelope_MPa``
+    (the largest vertex von Mises stress of every vertex over every solved crank angle) and
+    ``envelope_theta_deg`` (the crank angle at which it occurs).
+
+    Parameters
+    ----------
+    path : path-like
+    points : ndarray (n_vertices, 2)
+    triangles : ndarray (n_elements, 3)
+    von_mises : ndarray (n_vertices,)
+        MPa.
+    theta : ndarray (n_vertices,)
+        rad.
+    """
+    import meshio
+
+    path = Path(path)
+    mesh = meshio.Mesh(_xyz(np.asarray(points, dtype=float)), [("triangle", np.asarray(triangles, dtype=np.int64))],
+                       point_data={"von_mises_envelope_MPa": np.asarray(von_mises, dtype=float),
+                                   "envelope_theta_deg": np.degrees(np.asarray(theta, dtype=float))})
+    meshio.write(path, mesh, file_format="vtu", binary=True, compression="zlib")
     return path

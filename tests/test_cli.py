@@ -5,9 +5,11 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
+import rvfem
 from rvfem import __version__, cli
 
 from conftest import CASES_DIR
@@ -238,3 +240,61 @@ def test_run_progress_draws_stages_and_the_cycle(tty):
         assert "flexible load cycle:   0%" in text and "/36" in text          # the tqdm bar of the cycle
     else:
         assert "rvfem run: cycle 36/36" not in text and "cycle 18/36 angles (50 %)" in text
+
+
+def _rigid_documented_keys() -> set[str]:
+    """Key paths of the `rvfem rigid --json` table in docs/outputs.md (same rules as summary.json's)."""
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "outputs.md").read_text(encoding="utf-8")
+    table = text[text.index("## `rvfem rigid --json`"):]
+    table = table[table.index("| key | type | meaning |"):]
+    table = table[: table.index("\n\n")]
+    keys: set[str] = set()
+    parents: list[str] = []
+    for row in table.splitlines()[2:]:
+        first = row.split("|")[1].strip()
+        names = re.findall(r"`([^`]+)`", first)
+        if first.startswith("&nbsp;"):
+            keys.update(p + n for p in parents for n in names)
+        else:
+            keys.update(names)
+            parents = names
+    return keys
+
+
+def _keys(obj, prefix=""):
+    out = {prefix} if prefix else set()
+    if prefix in ("environment",):
+        return out
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            name = f"{prefix}.{k}" if prefix else k
+            if isinstance(v, list) and v and isinstance(v[0], dict):
+                out.add(name + "[]")
+                for entry in v:
+                    out |= _keys(entry, name + "[]")
+            else:
+                out |= _keys(v, name)
+    return out
+
+
+def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
+    from rvfem.case import file_sha256, load_case
+    from rvfem.outputs import RIGID_SCHEMA_VERSION
+
+    duty = str(Path(__file__).resolve().parents[1] / "cases" / "crv80e_duty.toml")
+    written = set()
+    for path in (CRV80E, duty):
+        assert cli.main(["rigid", path, "--json"]) == 0
+        report = json.loads(capsys.readouterr().out)
+        assert report["schema_version"] == RIGID_SCHEMA_VERSION
+        assert report["rvfem_version"] == rvfem.__version__
+        assert report["case_sha256"] == file_sha256(path)
+        assert report["case_digest"] == load_case(path).digest()
+        assert report["environment"]["versions"]["numpy"]
+        written |= _keys(report)
+    documented = _rigid_documented_keys()
+    assert written - documented == set(), "keys written but not documented"
+    assert documented - written == set(), "keys documented but not written"

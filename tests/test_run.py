@@ -33,7 +33,7 @@ STEP_DEG = 20.0
 
 #: Documented keys of summary.json (docs/outputs.md).
 TOP_KEYS = {
-    "schema_version", "rvfem_version", "case", "model", "bearings", "max_bearing_load", "pins_in_contact",
+    "schema_version", "rvfem_version", "environment", "case", "model", "bearings", "max_bearing_load", "pins_in_contact",
     "peak_von_mises_MPa", "peak_von_mises_at", "stress", "torsional_stiffness_Nm_per_arcmin",
     "carrier_rotation_arcmin", "equilibrium_residual", "active_set_iterations", "hertz", "fields", "images",
     "plots", "timings_s", "files",
@@ -103,7 +103,7 @@ def test_summary_has_the_documented_keys(summary, coarse_case_file):
     assert TOP_KEYS <= set(summary)
     assert CASE_KEYS <= set(summary["case"])
     assert MODEL_KEYS <= set(summary["model"])
-    assert summary["schema_version"] == 1
+    assert summary["schema_version"] == 2
     assert summary["case"]["sha256"] == file_sha256(coarse_case_file)
     assert summary["case"]["matches_file"] is True and summary["case"]["overrides"] == {}
     assert summary["model"]["angle_step_deg"] == pytest.approx(STEP_DEG)
@@ -168,6 +168,7 @@ def _von_mises(sxx, syy, sxy):
 
 def test_vtu_files_read_back_with_the_named_fields(cli_run, summary):
     entries = _pvd_files(cli_run)
+    cz = summary["stress"]["contact_zone"]
     angles = [f["theta_deg"] for f in summary["fields"]]
     assert [t for t, _ in entries] == pytest.approx(sorted(angles))
     assert 0.0 in angles and summary["max_bearing_load"]["theta_deg"] in angles
@@ -187,13 +188,13 @@ def test_vtu_files_read_back_with_the_named_fields(cli_run, summary):
             np.testing.assert_allclose(data["von_mises_MPa"], vm, rtol=1e-10, atol=1e-9)
             np.testing.assert_allclose(data["s1_MPa"] + data["s2_MPa"], data["sxx_MPa"] + data["syy_MPa"],
                                        rtol=1e-10, atol=1e-9)
-        assert float(pd["von_mises_MPa"].max()) <= summary["peak_von_mises_MPa"] * (1 + 1e-12)
-    peak_file = next(p for t, p in entries if t == pytest.approx(summary["peak_von_mises_at"]["theta_deg"]))
+        assert float(pd["von_mises_MPa"].max()) <= cz["peak_von_mises_MPa"] * (1 + 1e-12)
+    # the contact-zone peak is the envelope's overall maximum: its field holds it at its place
+    peak_file = next(p for t, p in entries if t == pytest.approx(cz["at"]["theta_deg"]))
     mesh = meshio.read(peak_file)
     i = int(np.argmax(mesh.point_data["von_mises_MPa"]))
-    assert mesh.point_data["von_mises_MPa"][i] == pytest.approx(summary["peak_von_mises_MPa"], rel=1e-12)
-    assert mesh.points[i, :2] == pytest.approx([summary["peak_von_mises_at"]["x_mm"],
-                                                summary["peak_von_mises_at"]["y_mm"]])
+    assert mesh.point_data["von_mises_MPa"][i] == pytest.approx(cz["peak_von_mises_MPa"], rel=1e-12)
+    assert mesh.points[i, :2] == pytest.approx([cz["at"]["x_mm"], cz["at"]["y_mm"]])
 
 
 # --------------------------------------------------------------------------------------------
@@ -307,7 +308,11 @@ def test_second_run_without_overwrite_fails_and_keeps_the_results(cli_run, coars
     err = capsys.readouterr().err
     assert code == 2
     assert "exists and is not empty" in err and "--overwrite" in err and "Traceback" not in err
+    assert "overwrite=True" not in err                     # the command line's wording, not the API's
     assert {p: p.read_bytes() for p in cli_run.rglob("*") if p.is_file()} == before
+    with pytest.raises(OutputError, match="overwrite=True") as info:   # and the API's from Python
+        outputs.check_output_folder(cli_run, overwrite=False)
+    assert "--overwrite" not in str(info.value)
 
 
 def test_overwrite_replaces_and_options_override_the_case(cli_run, coarse_case_file, cache_dir, workspace, capsys):
@@ -506,7 +511,8 @@ def test_field_step_keeps_a_field_every_step(duty_run):
     # besides: the largest bearing load and the stress peaks, nothing else
     extra = {round(a, 6) for a in angles} - {round(t, 6) for t in every}
     assert extra <= {round(s["max_bearing_load"]["theta_deg"], 6), round(s["peak_von_mises_at"]["theta_deg"], 6),
-                     round(s["stress"]["away_from_contacts"]["at"]["theta_deg"], 6)}
+                     round(s["stress"]["away_from_contacts"]["at"]["theta_deg"], 6),
+                     round(s["stress"]["contact_zone"]["at"]["theta_deg"], 6)}
     assert s["stress"]["field_angles_deg"] == pytest.approx(angles)
     assert [t for t, _ in _pvd_files(out)] == pytest.approx(sorted(angles))
     for f in s["fields"]:
@@ -525,9 +531,15 @@ def test_analyse_writes_nothing_and_gives_the_summary_numbers(coarse_case_file, 
     analysis = analyse(coarse_case_file, cache_dir=cache_dir)
     assert list(tmp_path.iterdir()) == [] and sorted(p.name for p in cache_dir.iterdir()) == cached
     built = outputs.build_summary(analysis)
-    skipped = {"timings_s", "files", "fields", "images", "plots"}
-    assert {k: v for k, v in built.items() if k not in skipped} == {k: v for k, v in summary.items()
-                                                                     if k not in skipped}
+    skipped = {"timings_s", "files", "fields", "images", "plots", "environment"}   # wall times, dates
+
+    def numbers(s):
+        out = {k: v for k, v in s.items() if k not in skipped}
+        out["stress"] = dict(out["stress"], structural_peak={k: v for k, v in out["stress"]["structural_peak"].items()
+                                                             if k != "seconds"})
+        return out
+
+    assert numbers(built) == numbers(summary)
     assert built["files"] == [] and built["images"] == {}
     assert [f["theta_deg"] for f in built["fields"]] == [f["theta_deg"] for f in summary["fields"]]
     assert json.loads(json.dumps(built, allow_nan=False)) == built
@@ -553,7 +565,7 @@ def _documented_keys() -> set[str]:
     return keys
 
 
-OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timings_s"}
+OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timings_s", "environment.versions"}
 """Objects whose keys are names (case keys, files, stages), documented as a whole."""
 
 
@@ -608,3 +620,162 @@ def test_result_folder_moves_into_place_only_when_complete(tmp_path):
         (folder / "y.txt").write_text("complete")
     assert [p.name for p in out.iterdir()] == ["y.txt"]
     assert [p.name for p in out.parent.iterdir()] == ["out"]
+
+
+# --------------------------------------------------------------------------------------------
+# The structural stress peak, numbering, angles, provenance
+# --------------------------------------------------------------------------------------------
+
+
+def test_structural_peak_leads_and_is_recovered_on_p2(summary, cli_run):
+    st = summary["stress"]
+    sp, away, cz = st["structural_peak"], st["away_from_contacts"], st["contact_zone"]
+    # the headline number is the P2-recovered structural peak, at a lightening hole, away from contacts
+    assert summary["peak_von_mises_MPa"] == sp["von_mises_MPa"]
+    assert summary["peak_von_mises_at"] == sp["at"]
+    assert sp["at"]["feature"].startswith("hole_")
+    # P1 vertex stresses (averages of constant element stresses) lie low at a free edge
+    assert sp["p1_MPa"] == away["peak_von_mises_MPa"] and sp["von_mises_MPa"] > sp["p1_MPa"]
+    assert sp["p1_error_percent"] == pytest.approx(100 * (sp["p1_MPa"] / sp["von_mises_MPa"] - 1))
+    assert 0 < sp["estimated_error_MPa"] < 0.2 * sp["von_mises_MPa"]
+    assert sp["at"]["theta_deg"] in sp["angles_deg"] and sp["seconds"] > 0
+    assert cz["mesh_dependent"] is True and cz["peak_von_mises_MPa"] >= away["peak_von_mises_MPa"]
+    screen_lines = outputs.stress_lines(st)
+    assert screen_lines[0].lstrip().startswith("structural stress peak (away from contacts)")
+    assert "contact-zone" in screen_lines[-1] and "mesh-dependent" in screen_lines[-1]
+    html = (cli_run / "report.html").read_text(encoding="utf-8")
+    assert html.index("structural stress peak") < html.index("contact-zone peak")
+
+
+@pytest.mark.slow
+def test_p2_recovery_matches_a_full_p2_cycle(coarse_case_file, cache_dir):
+    """The P2 re-solve with the P1 cycle's forces against a P2 load cycle solved throughout
+    (its own contact and roller forces): the same structural peak within 1 %."""
+    p1 = analyse(coarse_case_file, cache_dir=cache_dir)
+    p2 = analyse(coarse_case_file, cache_dir=cache_dir, order=2, recover_stress=False)
+    rec, full = p1.stress.recovered, p2.stress.away_from_contacts
+    assert rec.peak.von_mises_MPa == pytest.approx(full.von_mises_MPa, rel=0.01)
+    assert (rec.peak.x_mm, rec.peak.y_mm) == pytest.approx((full.x_mm, full.y_mm), abs=1.0)
+    assert p2.stress.recovered is None and p1.stress.recovered.p1_MPa == p1.stress.away_from_contacts.von_mises_MPa
+
+
+def test_features_are_numbered_from_one(summary):
+    for at in (summary["stress"]["structural_peak"]["at"], summary["stress"]["contact_zone"]["at"]):
+        stem, _, number = at["feature"].rpartition("_")
+        if stem == "bore":
+            assert at["feature_label"] == f"bore of bearing {number}"
+        elif stem == "hole":
+            assert at["feature_label"] == f"lightening hole {number}"
+        assert at["feature"] not in ("bore_0", "hole_0")
+    from rvfem.postprocess import feature_label, user_feature_name
+
+    for name in ("bore_0", "bore_2", "hole_0", "hole_5"):
+        number = user_feature_name(name).rpartition("_")[2]
+        assert feature_label(name).endswith(f" {number}")
+    assert user_feature_name("profile") == "profile" and user_feature_name("central_hole") == "central_hole"
+
+
+def _angles(obj, key=""):
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            yield from _angles(v, k)
+    elif isinstance(obj, list):
+        for v in obj:
+            yield from _angles(v, key)
+    elif isinstance(obj, float) and (key.endswith("_deg") or key == "angles_deg"):
+        yield obj
+
+
+def test_angles_carry_no_float_noise(summary, duty_run):
+    angles = list(_angles(summary)) + list(_angles(duty_run[1]))
+    assert angles
+    for a in angles:
+        assert a == round(a, outputs.ANGLE_DECIMALS)
+
+
+def test_summary_records_date_versions_and_command(summary, monkeypatch):
+    import datetime
+
+    env = summary["environment"]
+    when = datetime.datetime.strptime(env["date_utc"], "%Y-%m-%dT%H:%M:%SZ")
+    assert abs((datetime.datetime.now(datetime.timezone.utc).replace(tzinfo=None) - when).total_seconds()) < 3600
+    for name in ("numpy", "scipy", "scikit-fem", "gmsh", "vtk"):
+        assert env["versions"][name]
+    import numpy
+
+    assert env["versions"]["numpy"] == numpy.__version__
+    assert env["command_line"] is None                 # run from Python (pytest), not the command
+    monkeypatch.setattr("sys.argv", ["/somewhere/bin/rvfem", "run", "a b.toml", "-o", "x"])
+    assert outputs.command_line() == "rvfem run 'a b.toml' -o x"
+
+
+def test_duty_cycle_at_every_torque_is_palmgren_miner_of_the_fe_loads(duty_run):
+    from rvfem.iso281 import rating_life_hours
+
+    out, s, screen = duty_run
+    fe = s["duty_cycle"]["flexible_fe"]
+    assert fe["torques_Nm"] == sorted({t for _, _, t in DUTY_ROWS})
+    # at the case's own torque the FE loads are the run's own
+    i0 = fe["torques_Nm"].index(412.0)
+    assert fe["equivalent_load_N"][i0] == pytest.approx([b["flexible"]["equivalent_load_N"] for b in s["bearings"]],
+                                                         rel=1e-12)
+    assert fe["linear_scaling_error_percent"][i0] == pytest.approx(0.0, abs=1e-9)
+    # Palmgren-Miner written out: 1/L = sum s_i/L_i per bearing, L_i the L10h at the row's F_m and speed
+    c, total = s["model"]["dynamic_load_rating_N"], sum(t for t, _, _ in DUTY_ROWS)
+    lives = []
+    for i in range(len(s["bearings"])):
+        damage = sum((t / total) / rating_life_hours(c, fe["equivalent_load_N"][fe["torques_Nm"].index(torque)][i],
+                                                     n * 40 / (40 - 39))
+                     for t, n, torque in DUTY_ROWS)
+        lives.append(1 / damage)
+    assert fe["service_life_h"] == pytest.approx(min(lives), rel=1e-12)
+    assert fe["life_difference_percent"] == pytest.approx(
+        100 * (fe["service_life_h"] / s["duty_cycle"]["flexible"]["service_life_h"] - 1), rel=1e-9)
+    assert "flexible FE at every duty torque" in screen
+
+
+def test_repository_files_are_found_from_any_folder(tmp_path, monkeypatch):
+    from rvfem.analysis import default_cache_dir, repository_path
+    from rvfem.errors import CaseError
+
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.chdir(root / "notebooks")
+    assert repository_path("cases/rv40e_fanholes.toml") == root / "cases" / "rv40e_fanholes.toml"
+    assert repository_path("cases/rv40e_fanholes.toml", start=root / "rvfem" / "fem") == \
+        root / "cases" / "rv40e_fanholes.toml"
+    with pytest.raises(CaseError, match="not found"):
+        repository_path("cases/no_such_case.toml", start=tmp_path)
+    # the default mesh cache does not follow the current folder
+    monkeypatch.chdir(tmp_path)
+    assert default_cache_dir() == root / "meshes"
+    assert not (tmp_path / "meshes").exists()
+
+
+def test_report_links_further_field_images_instead_of_embedding_them(cli_run, summary, coarse_case_file, tmp_path):
+    """A --field-step run's extra images are linked, the key ones (saved angles, largest load,
+    stress peaks) embedded: the report stays light."""
+    import shutil
+
+    from rvfem.report import key_field_angles, write_report
+
+    folder = tmp_path / "copy"
+    shutil.copytree(cli_run, folder)
+    key = key_field_angles(summary, load_case(coarse_case_file))
+    extra = dict(summary["fields"][0], theta_deg=333.0)          # an angle that is none of the key ones
+    assert all(not math.isclose(333.0, a) for a in key)
+    s = dict(summary, fields=summary["fields"] + [extra])
+    html = write_report(folder / "report.html", s, load_case(coarse_case_file), folder).read_text(encoding="utf-8")
+    embedded = html.count('<img src="data:image/png;base64,')
+    assert embedded == len(summary["images"]) + len(summary["plots"])   # the extra one is not embedded
+    assert f"<a href='{extra['image']}'>333°</a>" in html
+    for f in summary["fields"]:                                          # the key angles are embedded
+        assert any(math.isclose(f["theta_deg"], a, abs_tol=1e-6) for a in key)
+
+
+def test_screen_gives_the_stribeck_pressure_without_roller_loads_and_stiffness_per_disc(summary):
+    rigid_bore = json.loads(json.dumps(summary))
+    rigid_bore["hertz"]["fe_rollers"] = None           # what the 'rigid_bore' bearing model gives
+    text = outputs.summary_text(rigid_bore)
+    sf = summary["hertz"]["stribeck_flexible"]
+    assert f"FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N" in text
+    assert "N·m/arcmin per disc" in text
