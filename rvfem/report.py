@@ -149,6 +149,26 @@ def assumptions(summary: dict, case: Case) -> list[str]:
     ]
 
 
+def _depends_on(summary: dict, case: Case) -> str:
+    """The section "What this delta depends on": this run's modelling choices next to the measured
+    sensitivity of the shipped fan-hole case (notebooks/what_drives_the_flexibility_effect.ipynb)."""
+    m, rs = summary["model"], summary["reducer_stage"]
+    b, mod = case.crank_bearing, case.cycloid.modification
+    law = b.stiffness_law if b.model == "rollers" else "isotropic spring"
+    choices = (f"{rs['model']}; bearing model {m['bearing_model']} ({law}), radial clearance "
+               f"{b.radial_clearance:g} mm; pin model {m['pin_model']}, friction μ = {case.analysis.friction:g}; "
+               f"profile modification ΔRrp = {mod.equidistant:g} mm, ΔRp = {mod.shift:g} mm")
+    return (
+        "<h2>What this delta depends on</h2>"
+        f"<p>This delta is for: {_e(choices)}.</p>"
+        "<p>Each of these choices moves the delta by several points, some (the reducer-stage model, the "
+        "crank-support stiffness, a profile modification, clearance, pin friction) more than the hole "
+        "geometry does; rigid crank support is the upper bound. The table above separates the reducer-stage "
+        "steps for this case; the tornado chart of all the drivers on the shipped RV-40E fan-hole case, and "
+        "the curves behind it, are in <code>notebooks/what_drives_the_flexibility_effect.ipynb</code> and "
+        "<code>docs/figures/tornado_rv40e_fanholes.png</code> of the rvfem repository.</p>")
+
+
 def _case_rows(case: Case) -> list[list[str]]:
     c, p, k, b, mat, ld, an, ms = (case.cycloid, case.pins, case.cranks, case.crank_bearing, case.material,
                                    case.loads, case.analysis, case.mesh)
@@ -304,6 +324,7 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
         "crank angles and the same disc model; deltas are against the handbook. "
         + "; ".join(f"<b>{_e(k)}</b>: {_e(v)}" for k, v in labels) + ".</p>"
         + _table(["step", "bearing", "max N", "Δmax %", "min N", "Δmin %", "F_m N", "ΔF_m %", "life ratio"], rows))
+    parts.append(_depends_on(summary, case))
 
     h = summary["hertz"]
     hrows = []

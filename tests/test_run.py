@@ -247,6 +247,21 @@ def test_report_embeds_the_images(cli_run, summary):
     assert f"{summary['bearings'][0]['flexible']['max_load_N']:.0f}" in html
 
 
+def test_report_states_the_reducer_stage_and_what_the_delta_depends_on(cli_run, summary):
+    import html as html_module
+
+    text = html_module.unescape((cli_run / "report.html").read_text(encoding="utf-8"))
+    assert "What the flexibility delta is made of" in text and "What this delta depends on" in text
+    assert summary["reducer_stage"]["model"] in text
+    steps = {r["step"] for r in summary["attribution"]}
+    assert {"handbook", "equal_share", "one_disc", "two_discs"} <= steps
+    # the run's own model is the last step of the chain and equals the run's bearing loads
+    final = [r for r in summary["attribution"] if r["final"]]
+    assert {r["step"] for r in final} == {summary["reducer_stage"]["step"]}
+    for r, b in zip(final, summary["bearings"]):
+        assert r["max_N"] == pytest.approx(b["flexible"]["max_load_N"], rel=1e-12)
+
+
 def test_files_listed_exist(cli_run, summary):
     listed = set(summary["files"])
     on_disk = {p.relative_to(cli_run).as_posix() for p in cli_run.rglob("*") if p.is_file()}
