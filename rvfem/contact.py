@@ -378,7 +378,9 @@ def hertz_pin_approach(Q, *, length: float, pin_radius: float, flank_curvature, 
     """
     Q = np.maximum(np.asarray(Q, dtype=float), 1e-300)
     kappa = np.asarray(flank_curvature, dtype=float)
-    inv_r = 1.0 / pin_radius + kappa
+    # a concave flank tighter than the pin (a negative equidistant modification at the root) is
+    # not a Hertz contact: the relative radius is capped at 1000 r_rp (conforming)
+    inv_r = np.maximum(1.0 / pin_radius + kappa, 1e-3 / pin_radius)
     cp = (1.0 - pin_poisson**2) / (np.pi * pin_modulus)
     cd = (1.0 - disc_poisson**2) / (np.pi * disc_modulus)
     e_star = 1.0 / (np.pi * (cp + cd))
