@@ -414,8 +414,8 @@ class Analysis:
         1 (P1) or 2 (P2) triangles.
     friction : float
         Coulomb friction coefficient at the pins (force μ·λ along the known sliding direction,
-        the pin centre's velocity relative to the disc); default 0.05 (lubricated steel, the value
-        of the published 3D model).
+        the pin centre's velocity relative to the disc); 0.05 in the published 3D model, 0 by
+        default (see docs/theory.md, "Pin contact").
     max_active_set_iterations : int
         Bound of the contact active-set loop.
     saved_angles_deg : tuple of float
@@ -428,9 +428,9 @@ class Analysis:
     angle_step_deg: float = param(1.0, unit="deg", low=0.05, high=30.0,
                                   doc="crank-angle step of the load cycle; the cycle has round(360/step) equal steps")
     element_order: int = param(1, choices=(1, 2), labels={1: "P1", 2: "P2"}, doc="P1 or P2 triangles")
-    friction: float = param(0.05, low=0.0, high=1.0,
+    friction: float = param(0.0, low=0.0, high=1.0,
                             doc="Coulomb friction coefficient at the pins (along the pins' known sliding "
-                                "direction); default 0.05, the published 3D model's value (Zhang et al.)")
+                                "direction; 0.05 in Zhang et al.)")
     max_active_set_iterations: int = param(50, low=1, high=1000, doc="bound of the contact active-set loop")
     saved_angles_deg: tuple[float, ...] = param((0.0, 90.0, 180.0, 270.0), **_ANGLE, max_length=360,
                                                 doc="crank angles at which fields are written")

@@ -358,3 +358,16 @@ def test_handbook_applicable_says_why_not(rv40e):
     assert handbook_applicable(rv40e) == (True, "")
     ok, reason = handbook_applicable(rv40e.replace(cycloid=dataclasses.replace(rv40e.cycloid, teeth=38)))
     assert not ok and reason.startswith("not defined for Zp − Zc ≠ 1") and "pins.count" in reason
+
+
+def test_duty_cycle_rows_with_reversed_torque_count_with_their_magnitude(rv40e):
+    from rvfem.case import DutyRow
+    from rvfem.iso281 import case_duty_cycle_life
+
+    rows = (DutyRow(0.5, 15.0, 412.0), DutyRow(0.5, 15.0, 300.0))
+    fwd = rv40e.replace(loads=dataclasses.replace(rv40e.loads, duty_cycle=rows))
+    mixed = rv40e.replace(loads=dataclasses.replace(
+        rv40e.loads, torque_Nm=-412.0, duty_cycle=(DutyRow(0.5, 15.0, -412.0), DutyRow(0.5, 15.0, 300.0))))
+    a, b = case_duty_cycle_life(fwd, [1000.0]), case_duty_cycle_life(mixed, [1000.0])
+    assert b.service_life_h == pytest.approx(a.service_life_h, rel=1e-15)
+    assert b.equivalent_torque_Nm == pytest.approx(a.equivalent_torque_Nm, rel=1e-15)
