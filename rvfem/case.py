@@ -163,16 +163,34 @@ class Pins:
     radius : float
         Pin radius r_rp, mm.
     model : str
-        ``"rigid"`` (Signorini contact with a rigid pin) or ``"hertz"`` (the pin–tooth line
-        contact adds its Hertz approach); any model registered in :mod:`rvfem.registry`.
+        How a pin acts on the flank (:mod:`rvfem.models`, registered in :mod:`rvfem.registry`):
+        ``"hertz"`` (default: the Hertz line contact of pin and flank at the flank's local
+        curvature), ``"rigid"`` (Signorini contact with a rigid pin), ``"palmgren"`` (Palmgren's
+        steel roller formula; ``"hertz"`` before rvfem had the Hertz pin law) or ``"linear"``
+        (the classical pin-force distribution's linear springs).
+    youngs_modulus, poissons_ratio : float
+        Elastic constants of the pins (the Hertz law), MPa and –.
+    linear_stiffness_N_per_mm : float or None
+        Stiffness of the ``"linear"`` model, N/mm.
     """
 
     count: int = param(low=4, high=200, doc="number of pins Zp, must exceed `cycloid.teeth`")
     circle_radius: float = param(unit="mm", low=1.0, high=2000.0, doc="pin-circle radius Rp")
     radius: float = param(unit="mm", low=0.1, high=200.0,
                           doc="pin radius r_rp; neighbouring pins must not overlap (r_rp < Rp·sin(π/Zp))")
-    model: str = param("rigid", choices=pin_model_names,
-                       doc="rigid pins, or pins with Hertz line-contact compliance (registered pin models)")
+    model: str = param("hertz", choices=pin_model_names,
+                       doc="`\"hertz\"`: Hertz line contact of pin and flank at the flank's local curvature "
+                           "(the reducer's physics; default); `\"rigid\"`: rigid pins (Signorini contact; "
+                           "the contact compliance is then the mesh's); `\"palmgren\"`: Palmgren's steel roller "
+                           "formula, independent of pin radius, curvature and materials (rvfem's former "
+                           "`\"hertz\"`); `\"linear\"`: linear springs of `linear_stiffness_N_per_mm`, the "
+                           "classical pin-force distribution (with a rigid disc)")
+    youngs_modulus: float = param(206000.0, unit="MPa", low=1.0e3, high=1.2e6,
+                                  doc="E of the pins (Hertz law); default bearing steel")
+    poissons_ratio: float = param(0.3, low=0.0, high=0.5, high_open=True,
+                                  doc="ν of the pins (Hertz law); default bearing steel")
+    linear_stiffness_N_per_mm: float | None = param(None, unit="N/mm", low=1.0, high=1.0e10,
+                                                    doc="pin stiffness; required when `model = \"linear\"`")
 
 
 def _equal_crank_angles(values: Mapping[str, Any]) -> tuple[float, ...]:
@@ -321,7 +339,8 @@ class RoundHoles:
 
 @dataclass(frozen=True)
 class Material:
-    """Linear elastic material of the disc (and, for Hertz, of pins and rollers)."""
+    """Linear elastic material of the disc (and of the rollers in the roller Hertz pressures; the
+    pins have their own constants, ``pins.youngs_modulus`` and ``pins.poissons_ratio``)."""
 
     name: str = param("bearing steel", max_length=200, doc="label")
     youngs_modulus: float = param(206000.0, unit="MPa", low=1.0e3, high=1.2e6, doc="E")
@@ -334,7 +353,8 @@ class DutyRow:
 
     time_share: float = param(unit="any", low=1.0e-9, high=1.0e9, doc="share of time (only ratios matter)")
     speed_rpm: float = param(unit="rpm", low=1.0e-3, high=1.0e4, doc="output speed")
-    torque_Nm: float = param(unit="N·m", low=0.0, high=1.0e6, doc="output torque (0 or at least 0.001 N·m)")
+    torque_Nm: float = param(unit="N·m", low=-1.0e6, high=1.0e6,
+                             doc="output torque, negative when reversed (0 or at least 0.001 N·m in magnitude)")
 
 
 TORQUE_SPLITS = ("stiffness", "equal")
@@ -348,7 +368,8 @@ class Loads:
     Attributes
     ----------
     torque_Nm : float
-        Output torque T, N·m (the whole reducer).
+        Output torque T, N·m (the whole reducer). Negative for a reversed torque (the carrier
+        driven the other way round); the loads are then those of the reverse direction.
     speed_rpm : float
         Output speed, rpm.
     discs : int
@@ -361,7 +382,9 @@ class Loads:
         carries T/discs: the handbook's assumption).
     """
 
-    torque_Nm: float = param(unit="N·m", low=1.0e-3, high=1.0e6, doc="output torque T of the whole reducer")
+    torque_Nm: float = param(unit="N·m", low=-1.0e6, high=1.0e6,
+                             doc="output torque T of the whole reducer; negative reverses it (at least 0.001 N·m in "
+                                 "magnitude)")
     speed_rpm: float = param(unit="rpm", low=1.0e-3, high=1.0e4, doc="output speed")
     discs: int = param(2, low=1, high=4, doc="number of cycloid discs sharing the torque")
     duty_cycle: tuple[DutyRow, ...] = param((), max_length=1000)
@@ -391,7 +414,8 @@ class Analysis:
         1 (P1) or 2 (P2) triangles.
     friction : float
         Coulomb friction coefficient at the pins (force μ·λ along the known sliding direction,
-        the pin centre's velocity relative to the disc).
+        the pin centre's velocity relative to the disc); 0.05 in the published 3D model, 0 by
+        default (see docs/theory.md, "Pin contact").
     max_active_set_iterations : int
         Bound of the contact active-set loop.
     saved_angles_deg : tuple of float
@@ -599,6 +623,8 @@ def _check_cranks(case: Case) -> None:
 def _check_crank_bearing(case: Case) -> None:
     b = case.crank_bearing
     key = "crank_bearing."
+    if case.pins.model == "linear" and case.pins.linear_stiffness_N_per_mm is None:
+        raise _error(case, "pins.linear_stiffness_N_per_mm", "is missing (required when pins.model = 'linear')")
     if b.stiffness_law == "linear" and b.linear_stiffness_N_per_mm is None:
         raise _error(case, key + "linear_stiffness_N_per_mm", "is missing (required when stiffness_law = 'linear')")
     if b.roller_diameter >= b.pitch_diameter:   # γ = D_we/D_m in (0, 1): ISO 281 f_c, inner raceway > 0
@@ -638,12 +664,16 @@ def _check_loads(case: Case) -> None:
     if loads.torque_split == "stiffness" and loads.discs > 2:
         raise _error(case, "loads.torque_split",
                      f"= 'stiffness' needs 1 or 2 discs (loads.discs = {loads.discs}); use 'equal'")
+    if abs(loads.torque_Nm) < MIN_DUTY_TORQUE_NM:
+        raise _error(case, "loads.torque_Nm",
+                     f"must be at least {MIN_DUTY_TORQUE_NM:g} N·m in magnitude (negative reverses it), "
+                     f"got {loads.torque_Nm!r}")
     for i, row in enumerate(loads.duty_cycle):
-        if 0.0 < row.torque_Nm < MIN_DUTY_TORQUE_NM:
+        if 0.0 < abs(row.torque_Nm) < MIN_DUTY_TORQUE_NM:
             raise _error(case, f"loads.duty_cycle[{i}].torque_Nm",
-                         f"must be 0 or at least {MIN_DUTY_TORQUE_NM:g} N·m, got {row.torque_Nm!r}")
-    if loads.duty_cycle and not any(row.torque_Nm > 0 for row in loads.duty_cycle):
-        raise _error(case, "loads.duty_cycle", "needs at least one row with a positive torque_Nm")
+                         f"must be 0 or at least {MIN_DUTY_TORQUE_NM:g} N·m in magnitude, got {row.torque_Nm!r}")
+    if loads.duty_cycle and not any(row.torque_Nm != 0 for row in loads.duty_cycle):
+        raise _error(case, "loads.duty_cycle", "needs at least one row with a non-zero torque_Nm")
 
 
 MAX_MESH_NODES = 2_000_000

@@ -16,7 +16,8 @@ The model (docs/theory.md) in the disc's body frame:
   self-equilibrated loads the contact problem produces, it differs from the floating disc only by
   a rigid-body motion ``a`` (2 translations, 1 rotation), which is an unknown of the small system.
 * Pins are rigid (Signorini: gap ≥ 0, force ≥ 0, force·gap = 0, primal–dual active set) or
-  compliant (Palmgren line contact, one contact). Rollers are compression-only springs along their
+  compliant: the Hertz pin–flank line contact (:func:`hertz_pin_law`), Palmgren's roller formula
+  or a linear spring (:mod:`rvfem.models`). Rollers are compression-only springs along their
   radial line with the Palmgren law for both raceways, δ = 2·3.84e-5·Q^0.9 / L^0.8 (mm, N), or a
   linear stiffness; the approach is the radial relative displacement of eccentric and bore minus
   half the radial clearance.
@@ -58,6 +59,8 @@ __all__ = [
     "build_interface",
     "palmgren_law",
     "linear_law",
+    "hertz_pin_approach",
+    "hertz_pin_law",
     "solve_contact",
     "solve_bodies",
     "Body",
@@ -321,6 +324,132 @@ def linear_law(stiffness: float, bilateral: bool = False):
         if bilateral:
             return stiffness * delta, np.full_like(delta, stiffness)
         return stiffness * np.maximum(delta, 0.0), np.where(delta > 0, stiffness, 0.0)
+
+    return law
+
+
+def hertz_pin_approach(Q, *, length: float, pin_radius: float, flank_curvature, pin_modulus: float,
+                       pin_poisson: float, disc_modulus: float, disc_poisson: float,
+                       footprint_half_width: float):
+    """Approach δ (mm) of a pin–flank Hertz line contact at the force Q (N), and dδ/dQ (mm/N).
+
+    Parameters
+    ----------
+    Q : array_like
+        Contact force, N (> 0).
+    length : float
+        Contact length L (the disc width), mm; P = Q/L is the load per unit length.
+    pin_radius : float
+        R_p, mm.
+    flank_curvature : array_like
+        Signed curvature κ of the flank at the contact point, 1/mm: positive where the flank is
+        convex (near the tips), negative where it is concave (near the roots).
+    pin_modulus, pin_poisson, disc_modulus, disc_poisson : float
+        E (MPa) and ν of the pin and of the disc.
+    footprint_half_width : float
+        Half-width w of the elliptical footprint over which the FE model spreads the pin force, mm.
+
+    Returns
+    -------
+    delta, ddelta_dQ : ndarray
+
+    Notes
+    -----
+    Hertz line contact (Johnson, *Contact Mechanics*, §4.2 and §5.6, plane strain): relative
+    curvature 1/R = 1/R_p + κ, contact modulus 1/E* = (1 − ν_p²)/E_p + (1 − ν_d²)/E_d, half-width
+    a = √(4PR/(πE*)). The approach is the sum of two parts:
+
+    * the pin: approach of its centre to the contact, Johnson's line-contact result for a
+      cylinder, δ_p = P(1 − ν_p²)/(πE_p)·(2 ln(4R_p/a) − 1);
+    * the disc: the FE model already deforms the disc under the force spread elliptically over
+      ±w; what it lacks is the difference between the Hertz pressure of half-width a and that
+      footprint. On a half-plane (plane strain) the approach of the surface point above depth z
+      under an elliptical pressure of half-width c is, integrating the strain of the Hertz
+      subsurface stresses along the axis,
+      2P/(πE)·[(1 − ν²)·asinh(z/c) − ν(1 + ν)·(z√(c² + z²) − z²)/c²]
+      → 2P(1 − ν²)/(πE)·[ln(2z/c) − ν/(2(1 − ν))] for z ≫ c; in the difference of c = a and c = w
+      the depth and the Poisson term cancel: δ_d = 2P(1 − ν_d²)/(πE_d)·ln(w/a).
+
+    The "depth" convention is therefore: the pin's centre, and for the disc the far field the FE
+    model resolves (the sum pin law + FE does not depend on w as long as a and w are small
+    against the flank radius). δ(Q) increases up to a half-width a0 where dδ/dP would vanish
+    (≈1.2 mm for steel, r_rp = 3 mm, w = 0.5 mm: far beyond any pin load, but a trial approach
+    of the solver may get there); beyond a0/√e it is continued linearly with its tangent.
+    """
+    Q = np.maximum(np.asarray(Q, dtype=float), 1e-300)
+    kappa = np.asarray(flank_curvature, dtype=float)
+    # a concave flank tighter than the pin (a negative equidistant modification at the root) is
+    # not a Hertz contact: the relative radius is capped at 1000 r_rp (conforming)
+    inv_r = np.maximum(1.0 / pin_radius + kappa, 1e-3 / pin_radius)
+    cp = (1.0 - pin_poisson**2) / (np.pi * pin_modulus)
+    cd = (1.0 - disc_poisson**2) / (np.pi * disc_modulus)
+    e_star = 1.0 / (np.pi * (cp + cd))
+    # dδ/dP = cp·(2 ln(4R_p/a) − 2) + 2cd·(ln(w/a) − ½) vanishes at a0; beyond a_lim = a0/√e
+    # (where it is still cp + cd) the law is continued with its tangent, so that it stays monotone
+    # for any trial approach of the solver (a_lim ≈ 0.7 mm for steel, r_rp = 3, w = 0.5 mm:
+    # thousands of newtons per pin even at the conforming roots)
+    ln_a0 = (cp * (2.0 * np.log(4.0 * pin_radius) - 2.0) + cd * (2.0 * np.log(footprint_half_width) - 1.0)) / (2.0 * (cp + cd))
+    a_lim = np.exp(ln_a0 - 0.5)
+    P_lim = a_lim**2 * np.pi * e_star * inv_r / 4.0
+
+    def parts(P):
+        a = np.sqrt(4.0 * P / (inv_r * np.pi * e_star))
+        d = P * (cp * (2.0 * np.log(4.0 * pin_radius / a) - 1.0) + 2.0 * cd * np.log(footprint_half_width / a))
+        # d ln a / dP = 1/(2P)
+        dd = cp * (2.0 * np.log(4.0 * pin_radius / a) - 2.0) + 2.0 * cd * (np.log(footprint_half_width / a) - 0.5)
+        return d, dd
+
+    P = Q / length
+    beyond = P > P_lim
+    d, dd = parts(np.where(beyond, P_lim, P))
+    delta = np.where(beyond, d + dd * (P - P_lim), d)
+    return delta, dd / length
+
+
+def hertz_pin_law(**params):
+    """Force–approach law of the pin–flank Hertz line contact (:func:`hertz_pin_approach`),
+    inverted: ``law(delta) -> (Q, dQ/dδ)`` per pin (arrays broadcast against the pins' curvatures).
+
+    The inversion is Newton's method on ln Q (δ(Q) ∝ Q up to logarithms, so that ln δ is nearly
+    linear in ln Q), safeguarded by bisection, to a relative 1e-13. δ ≤ 0 gives Q = 0 and
+    dQ/dδ = 0 (compression only, as Palmgren's law).
+    """
+    curvature = np.asarray(params["flank_curvature"], dtype=float)
+    params = dict(params)
+
+    def law(delta):
+        delta = np.asarray(delta, dtype=float)
+        kappa = np.broadcast_to(curvature, np.broadcast(delta, curvature).shape)
+        d = np.broadcast_to(delta, kappa.shape)
+        pos = d > 0
+        q = np.zeros(kappa.shape)
+        dq = np.zeros(kappa.shape)
+        params["flank_curvature"] = kappa
+        if np.any(pos):
+            dpos = np.where(pos, d, 1.0)
+            # start: the secant at 1 kN
+            d_ref, _ = hertz_pin_approach(np.full(kappa.shape, 1000.0), **params)
+            x = np.log(1000.0 * dpos / d_ref)
+            lo = np.full(kappa.shape, -60.0)
+            hi = np.full(kappa.shape, 40.0)
+            for _ in range(100):
+                dd, dp = hertz_pin_approach(np.exp(x), **params)
+                f = np.log(dd) - np.log(dpos)
+                lo = np.where(f < 0, x, lo)
+                hi = np.where(f >= 0, x, hi)
+                step = -f / (np.exp(x) * dp / dd)
+                x_new = x + step
+                bad = ~np.isfinite(x_new) | (x_new <= lo) | (x_new >= hi) | (dp <= 0)
+                x_new = np.where(bad, 0.5 * (lo + hi), x_new)
+                done = np.abs(x_new - x) < 1e-13
+                x = x_new
+                if np.all(done | ~pos):
+                    break
+            Q = np.exp(x)
+            _, dp = hertz_pin_approach(Q, **params)
+            q = np.where(pos, Q, 0.0)
+            dq = np.where(pos, 1.0 / dp, 0.0)
+        return q, dq
 
     return law
 

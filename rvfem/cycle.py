@@ -115,14 +115,14 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     stiffness_scale : float
         Multiplies the disc's Young's modulus (1000 gives the "rigid disc" limit of the design
         notes' validation ladder).
-    pin_model : {"rigid", "hertz", "linear"}, optional
-        Default ``case.pins.model``. ``"linear"`` (a validation device: the classical pin-force
-        distribution assumes pin deflections proportional to the forces) needs
-        ``pin_stiffness_N_per_mm``.
+    pin_model : {"rigid", "hertz", "palmgren", "linear"}, optional
+        Default ``case.pins.model`` (:mod:`rvfem.models`). ``"linear"`` (the classical pin-force
+        distribution assumes pin deflections proportional to the forces) takes its stiffness from
+        ``pin_stiffness_N_per_mm`` or else ``pins.linear_stiffness_N_per_mm``.
     bearing_stiffness_scale : float
         Multiplies the ``rigid_bore`` bearing stiffness (for the rigid-limit checks).
     pin_stiffness_N_per_mm : float, optional
-        Stiffness of the ``"linear"`` pin model, N/mm.
+        Stiffness of the ``"linear"`` pin model, N/mm (overrides the case's).
     column_stride : int
         Interface columns at every stride-th boundary vertex. 1 (default) is the accurate
         choice; 2 halves the back-substitutions (default fan-hole case: cycle 8.5 → 6.0 s) at the
@@ -175,9 +175,10 @@ def pin_contacts(system: DiscSystem, theta: float):
     Each pin pushes along the inward normal of the profile at its closest point; the gap is the
     exact one of the (modified, pitch-error) profile. With friction (``analysis.friction`` = μ)
     the load on the disc is λ·(d + μ·s·t) along the known sliding direction, while the gap is
-    still measured along the normal d.
+    still measured along the normal d. The pin model's law gets the angle's contacts and the
+    flank curvature at each pin's closest point (the Hertz law depends on it).
     """
-    from .geometry import pin_centres, pin_profile_contacts
+    from .geometry import pin_centres, pin_profile_contacts, profile_curvature
     from .models import ContactGroup
 
     case = system.case
@@ -202,7 +203,7 @@ def pin_contacts(system: DiscSystem, theta: float):
         slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
         _, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
         W_load = sp.csc_matrix((pin_load.ravel(), index), shape=shape)
-    law = system.pins.law()
+    law = system.pins.law(pc, profile_curvature(system.geometry.profile, pc.segment, pc.param))
     rigid = law is None
     return ContactGroup(
         W=W, signorini=np.full(zp, rigid), gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),

@@ -337,6 +337,7 @@ def case_duty_cycle_life(case: Case, rated_lives_h: Sequence[float]) -> DutyCycl
 
     The rated point is the case's output speed and torque (``loads.speed_rpm``, ``loads.torque_Nm``)
     at which ``rated_lives_h`` were computed; the shortest of them is L0 of :func:`duty_cycle_life`.
+    Rows with a reversed (negative) torque count with |T|.
 
     Parameters
     ----------
@@ -351,4 +352,9 @@ def case_duty_cycle_life(case: Case, rated_lives_h: Sequence[float]) -> DutyCycl
     """
     if not case.loads.duty_cycle:
         return None
-    return duty_cycle_life(case.loads.duty_cycle, min(rated_lives_h), case.loads.speed_rpm, case.loads.torque_Nm)
+    # a reversed torque loads the bearings with the mirror image of the forward loads (exactly in
+    # the handbook model): the bearing load scales with |T|
+    import dataclasses
+
+    rows = [dataclasses.replace(r, torque_Nm=abs(r.torque_Nm)) for r in case.loads.duty_cycle]
+    return duty_cycle_life(rows, min(rated_lives_h), case.loads.speed_rpm, abs(case.loads.torque_Nm))

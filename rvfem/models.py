@@ -33,6 +33,7 @@ __all__ = [
     "RollerBearing",
     "RigidBoreBearing",
     "RigidPins",
+    "HertzPins",
     "PalmgrenPins",
     "LinearPins",
     "roller_angles",
@@ -116,8 +117,14 @@ class PinModel(Protocol):
     def describe(self) -> str:
         """One sentence for the report's assumptions."""
 
-    def law(self):
-        """The pins' force–approach law (None for rigid pins)."""
+    def law(self, contacts=None, curvature=None):
+        """The pins' force–approach law at one crank angle (None for rigid pins).
+
+        ``contacts`` is the angle's :class:`rvfem.geometry.PinContacts` and ``curvature`` (Zp,)
+        the flank curvature at each pin's contact point, 1/mm; a law may use them (the Hertz law
+        does: its compliance depends on the local curvature) or not. The law is vectorised over
+        the pins: ``law(delta) -> (Q, dQ/dδ)``.
+        """
 
 
 def roller_angles(case, theta: float) -> np.ndarray:
@@ -236,7 +243,12 @@ class RigidBoreBearing:
 
 @register_pin_model
 class RigidPins:
-    """Rigid pins: Signorini contact (gap ≥ 0, force ≥ 0, no force across a gap) with the flank."""
+    """Rigid pins: Signorini contact (gap ≥ 0, force ≥ 0, no force across a gap) with the flank.
+
+    For: the limit of infinitely stiff pin contacts. On an elastic disc the local contact
+    compliance is then whatever the FE footprint makes it (a mesh parameter, not physics), and the
+    load concentrates on few pins; use it for comparisons, not as the model of a reducer.
+    """
 
     name = "rigid"
     rigid = True
@@ -247,14 +259,27 @@ class RigidPins:
     def describe(self) -> str:
         return "rigid pins (Signorini contact: gap ≥ 0, force ≥ 0)"
 
-    def law(self):
+    def law(self, contacts=None, curvature=None):
         return None
 
 
+def _footprint_half_width(case) -> float:
+    """Half-width of the FE pin-load footprint, mm (``cycle.FOOTPRINT_ELEMENTS`` element sizes)."""
+    from .cycle import FOOTPRINT_ELEMENTS
+
+    return FOOTPRINT_ELEMENTS * case.mesh.size_flank
+
+
 @register_pin_model
-class PalmgrenPins:
-    """Compliant pins: Palmgren's line-contact approach of one pin–flank contact over the disc
-    width, δ = 3.84e-5·Q^0.9/b^0.8 (Harris & Kotzalas, *Rolling Bearing Analysis*)."""
+class HertzPins:
+    """Compliant pins: the Hertz line contact of the pin (radius r_rp) with the flank, at the flank's
+    own radius of curvature at each contact point, with the elastic constants of pin and disc.
+
+    The approach is the pin centre's (Johnson, *Contact Mechanics*) plus the local disc
+    compression that the FE footprint does not resolve (:func:`rvfem.contact.hertz_pin_approach`).
+    For: the default model of a reducer — the compliance the physics of the contact gives, which
+    makes the load sharing among the pins independent of the mesh.
+    """
 
     name = "hertz"
     rigid = False
@@ -263,28 +288,74 @@ class PalmgrenPins:
         self.case = case
 
     def describe(self) -> str:
-        return "compliant pins: Palmgren line-contact approach of each pin–flank contact"
+        p, m = self.case.pins, self.case.material
+        return (f"compliant pins: Hertz line contact of each pin (r_rp = {p.radius:g} mm, E = "
+                f"{p.youngs_modulus:g} MPa, ν = {p.poissons_ratio:g}) with the flank at its local "
+                f"curvature (disc E = {m.youngs_modulus:g} MPa, ν = {m.poissons_ratio:g}), over the "
+                f"disc width {self.case.cycloid.thickness:g} mm")
 
-    def law(self):
+    def law(self, contacts=None, curvature=None):
+        """The law of the pins of one crank angle; ``curvature`` (Zp,) is the flank curvature at
+        each pin's contact point, 1/mm (:func:`rvfem.geometry.profile_curvature`)."""
+        if curvature is None:
+            raise ValueError("the Hertz pin law needs the flank curvature at each contact point")
+        case = self.case
+        return contact.hertz_pin_law(
+            length=case.cycloid.thickness, pin_radius=case.pins.radius,
+            flank_curvature=np.asarray(curvature, dtype=float),
+            pin_modulus=case.pins.youngs_modulus, pin_poisson=case.pins.poissons_ratio,
+            disc_modulus=case.material.youngs_modulus, disc_poisson=case.material.poissons_ratio,
+            footprint_half_width=_footprint_half_width(case))
+
+
+@register_pin_model
+class PalmgrenPins:
+    """Compliant pins: Palmgren's line-contact approach of one steel roller–raceway contact over the
+    disc width, δ = 3.84e-5·Q^0.9/b^0.8 (Harris & Kotzalas, *Rolling Bearing Analysis*).
+
+    For: comparison with rvfem before the Hertz pin law (this was ``"hertz"`` then) and with tools
+    that use Palmgren's formula. It ignores the pin radius, the flank curvature and the materials.
+    """
+
+    name = "palmgren"
+    rigid = False
+
+    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+        self.case = case
+
+    def describe(self) -> str:
+        return ("compliant pins: Palmgren's steel line-contact approach of each pin–flank contact "
+                "(independent of pin radius, flank curvature and materials)")
+
+    def law(self, contacts=None, curvature=None):
         return contact.palmgren_law(self.case.cycloid.thickness, contacts=1)
 
 
 @register_pin_model
 class LinearPins:
     """Linear pin springs Q = k·δ (compression only): the classical textbook assumption that the
-    pin deflections are proportional to the forces (a validation device of the rigid limit)."""
+    pin deflections are proportional to the forces.
+
+    For: the classical pin-force distribution. On a (nearly) rigid disc held at its centre with a
+    stiffness k far below the disc's, the pins' forces are the textbook
+    F_i = F_max·sin φ_i/√(1 + K1² − 2K1·cos φ_i). The stiffness is ``pins.linear_stiffness_N_per_mm``
+    (or passed explicitly for the validation checks).
+    """
 
     name = "linear"
     rigid = False
 
     def __init__(self, case, stiffness_N_per_mm: float | None = None):
+        if stiffness_N_per_mm is None:
+            stiffness_N_per_mm = getattr(case.pins, "linear_stiffness_N_per_mm", None)
         if not (stiffness_N_per_mm and stiffness_N_per_mm > 0):
-            raise CaseError("pin model 'linear' needs a positive pin stiffness (N/mm)")
+            raise CaseError("pin model 'linear' needs a positive pin stiffness "
+                            "(pins.linear_stiffness_N_per_mm, N/mm)")
         self.case = case
         self.stiffness = float(stiffness_N_per_mm)
 
     def describe(self) -> str:
         return f"linear pin springs of {self.stiffness:g} N/mm (the classical pin-force assumption)"
 
-    def law(self):
+    def law(self, contacts=None, curvature=None):
         return contact.linear_law(self.stiffness)

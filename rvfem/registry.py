@@ -23,7 +23,7 @@ __all__ = [
 ]
 
 _BUILTIN_BEARINGS = {"rollers": "RollerBearing", "rigid_bore": "RigidBoreBearing"}
-_BUILTIN_PINS = {"rigid": "RigidPins", "hertz": "PalmgrenPins", "linear": "LinearPins"}
+_BUILTIN_PINS = {"rigid": "RigidPins", "hertz": "HertzPins", "palmgren": "PalmgrenPins", "linear": "LinearPins"}
 _BEARINGS: dict[str, type] = {}
 _PINS: dict[str, type] = {}
 
@@ -46,9 +46,9 @@ def bearing_model_names() -> tuple[str, ...]:
 
 
 def pin_model_names(*, case_file: bool = True) -> tuple[str, ...]:
-    """Valid values of ``pins.model`` (``case_file=False`` adds the validation-only models)."""
-    names = [n for n in (*_BUILTIN_PINS, *_PINS) if case_file is False or n != "linear"]
-    return tuple(dict.fromkeys(names))
+    """Valid values of ``pins.model`` (every registered pin model; ``case_file`` is kept for
+    callers of earlier versions, where it hid the linear model from case files)."""
+    return tuple(dict.fromkeys([*_BUILTIN_PINS, *_PINS]))
 
 
 def _resolve(name: str, registered: dict, builtin: dict, kind: str) -> type:

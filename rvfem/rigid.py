@@ -37,7 +37,8 @@ Torque
     convention behind the handbook's ΣP_x = T / (2 e Zc) (= T_disc / (e Zc) for two discs). About
     the reducer axis the same forces have the moment T_disc·Zp/Zc. For positive torque the pins
     with 0 < φ < π are loaded and act on the disc with the clockwise moment −T_disc; the crank
-    bearings act on the disc with +T_disc.
+    bearings act on the disc with +T_disc. A negative torque (reversed) loads the pins with
+    −π < φ < 0, the mirror image about the eccentricity axis.
 Bearing loads
     The force of bearing i on the disc is F_i = F2·u⊥ − F3·u + F1·t_i with u = (cos θ, sin θ),
     u⊥ = (−sin θ, cos θ) and t_i = (−sin α_i, cos α_i). In the bearing's own radial/tangential
@@ -65,6 +66,7 @@ __all__ = [
     "BearingLoadSummary",
     "PinForces",
     "load_cycle_angles",
+    "handbook_applicable",
     "handbook_components",
     "handbook_bearing_loads",
     "handbook_load_extremes",
@@ -269,22 +271,38 @@ def _as_theta(theta) -> np.ndarray:
     return th
 
 
-def _check_handbook_applicable(case: Case) -> None:
-    """The handbook formulas assume a one-tooth difference and equally spaced cranks."""
+def handbook_applicable(case: Case) -> tuple[bool, str]:
+    """Whether the handbook crank-bearing model and the classical pin-force distribution apply.
+
+    Returns
+    -------
+    (bool, str)
+        True and "" if they do; False and the reason (one line, naming the case keys) if not.
+        They assume a one-tooth difference (Zp = Zc + 1: the pitch point at e·Zc from the disc
+        centre, k_y and ΣP_x = T/(e·Zc) of Gao et al.) and equally spaced cranks (equal sharing).
+        For Zp − Zc ≠ 1 the FE model runs and is compared with the references that exist (the
+        equal share of its own pin resultant); the handbook column is "not defined for
+        Zp − Zc ≠ 1".
+    """
     zp, zc = case.pins.count, case.cycloid.teeth
     if zp - zc != 1:
-        raise CaseError(
-            f"{case.source}: 'pins.count' - 'cycloid.teeth' = {zp - zc}: the handbook crank-bearing "
-            "model assumes a one-tooth difference (Zp = Zc + 1)"
-        )
+        return False, (f"not defined for Zp − Zc ≠ 1: 'pins.count' − 'cycloid.teeth' = {zp - zc}, the handbook "
+                       "crank-bearing model and the classical pin-force distribution assume a one-tooth "
+                       "difference (Zp = Zc + 1)")
     n = case.cranks.count
     angles = np.sort(np.mod(case.cranks.angles_deg, 360.0))
     gaps = np.diff(np.append(angles, angles[0] + 360.0))
     if not np.allclose(gaps, 360.0 / n, rtol=0.0, atol=1e-6):
-        raise CaseError(
-            f"{case.source}: 'cranks.angles_deg' {list(case.cranks.angles_deg)} are not equally "
-            f"spaced by {360.0 / n:g}°: the handbook equal-share model needs equally spaced cranks"
-        )
+        return False, (f"'cranks.angles_deg' {list(case.cranks.angles_deg)} are not equally spaced by "
+                       f"{360.0 / n:g}°: the handbook equal-share model needs equally spaced cranks")
+    return True, ""
+
+
+def _check_handbook_applicable(case: Case) -> None:
+    """Raise :class:`CaseError` where :func:`handbook_applicable` says no."""
+    ok, reason = handbook_applicable(case)
+    if not ok:
+        raise CaseError(f"{case.source}: {reason}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -313,7 +331,9 @@ def handbook_components(case: Case) -> HandbookComponents:
     Notes
     -----
     ΣP_x = T_disc/(e·Zc) with T_disc = T_out/discs is Gao et al.'s T/(2eZc) for two discs; T_disc
-    is the moment about the disc centre (see the module docstring).
+    is the moment about the disc centre (see the module docstring). A negative (reversed) torque
+    loads the other half of the pins, the mirror image about the eccentricity axis: ΣP_x, F1 and F2
+    change sign, ΣP_y = k_y·|ΣP_x| and F3 do not.
     """
     _check_handbook_applicable(case)
     e = case.cycloid.eccentricity
@@ -323,7 +343,9 @@ def handbook_components(case: Case) -> HandbookComponents:
     t_disc = case.loads.disc_torque_Nmm
     n = case.cranks.count
     sum_px = t_disc / (e * zc)
-    sum_py = k_y * sum_px
+    # a reversed torque loads the mirror-image half of the pins (mirror about the eccentricity
+    # axis): the torque-carrying ΣP_x changes sign, the component along the eccentricity does not
+    sum_py = k_y * abs(sum_px)
     comp = HandbookComponents(
         k=k,
         k_y=k_y,
@@ -386,7 +408,8 @@ def handbook_load_extremes(components: HandbookComponents) -> tuple[float, float
     """Exact maximum and minimum of the handbook bearing load over a turn.
 
     Since F² = F1² + F2² + F3² + 2·F1·√(F2² + F3²)·cos(β + δ) with δ = atan2(F3, F2),
-    F_max = F1 + √(F2² + F3²) at β = −δ and F_min = |F1 − √(F2² + F3²)| at β = π − δ.
+    F_max = |F1| + √(F2² + F3²) at β = −δ and F_min = |F1 − √(F2² + F3²)| at β = π − δ (for a
+    reversed torque, F1 < 0, the two angles swap).
 
     Parameters
     ----------
@@ -400,11 +423,14 @@ def handbook_load_extremes(components: HandbookComponents) -> tuple[float, float
     amp = math.hypot(components.f2, components.f3)
     delta = math.atan2(components.f3, components.f2)
     two_pi = 2.0 * math.pi
+    f1 = components.f1
+    # F² = F1² + amp² + 2·F1·amp·cos(β + δ): the maximum where cos(β + δ) has the sign of F1
+    at_max, at_min = ((-delta, math.pi - delta) if f1 >= 0 else (math.pi - delta, -delta))
     return (
-        components.f1 + amp,
-        (-delta) % two_pi,
-        abs(components.f1 - amp),
-        (math.pi - delta) % two_pi,
+        abs(f1) + amp,
+        at_max % two_pi,
+        abs(abs(f1) - amp),
+        at_min % two_pi,
     )
 
 
@@ -498,7 +524,8 @@ def classical_pin_forces(case: Case, theta=None, *, exact_moment: bool = False) 
     """Classical rigid pin-force distribution (zero clearance, unmodified profile).
 
     F_j = F_max·sin φ_j / √(1 + K1² − 2·K1·cos φ_j) for the pins with sin φ_j > 0, zero for the
-    others, with K1 = e·Zp/Rp and F_max = 4·T_disc/(K1·Zc·Rp). Each force acts on the disc along
+    others, with K1 = e·Zp/Rp and F_max = 4·T_disc/(K1·Zc·Rp); for a reversed torque (T_disc < 0)
+    the pins with sin φ_j < 0 carry |F_max|·|sin φ_j|/√(…), the mirror image. Each force acts on the disc along
     the line from the pin centre through the pitch point P, which lies on the line of centres at
     e·Zc from the disc centre, on the side of the eccentric: P = e·Zc·(cos θ, sin θ) in the disc
     frame. Pin positions and φ_j follow the module docstring.
@@ -530,14 +557,14 @@ def classical_pin_forces(case: Case, theta=None, *, exact_moment: bool = False) 
     psi = 2.0 * np.pi * np.arange(zp)[:, None] / zp + th[None, :] * (zp - zc) / zp
     phi = np.angle(np.exp(1j * (psi - th[None, :])))  # wrapped to (−π, π]
     s2 = 1.0 + k1 * k1 - 2.0 * k1 * np.cos(phi)
-    sin_phi = np.sin(phi)
+    sin_phi = np.sin(phi) * math.copysign(1.0, t_disc)   # a reversed torque loads the other half
     loaded = sin_phi > 0.0
     shape = np.where(loaded, sin_phi / np.sqrt(s2), 0.0)
     if exact_moment:
         moment_sum = np.sum(np.where(loaded, sin_phi**2 / s2, 0.0), axis=0)
-        f_max = t_disc / (e * zc * moment_sum)
+        f_max = abs(t_disc) / (e * zc * moment_sum)
     else:
-        f_max = np.full(th.shape, 4.0 * t_disc / (k1 * zc * rp))
+        f_max = np.full(th.shape, 4.0 * abs(t_disc) / (k1 * zc * rp))
     magnitude = f_max[None, :] * shape
 
     ux, uy = np.cos(th)[None, :], np.sin(th)[None, :]

@@ -175,7 +175,6 @@ def test_bad_choices_list_the_options_and_suggest(case_text, tmp_path, table, ke
         ("cycloid", "central_hole_radius", "-1.0", "must be positive"),
         ("crank_bearing", "bore_radius", "-18.0", "must be positive"),
         ("crank_bearing", "radial_clearance", "-0.005", "must be non-negative"),
-        ("loads", "torque_Nm", "-412.0", "must be positive"),
         ("loads", "discs", "0", "must be positive"),
         ("material", "youngs_modulus", "-1.0", "must be positive"),
         ("analysis", "equivalent_load_exponent", "0.0", "must be positive"),
@@ -471,9 +470,31 @@ def test_crank_angles_must_be_distinct(case_text, tmp_path):
     expect_error(tmp_path, case_text, "cranks.angles_deg", "must be distinct")
 
 
-def test_duty_cycle_needs_a_positive_torque(case_text, tmp_path):
+def test_duty_cycle_needs_a_non_zero_torque(case_text, tmp_path):
     case_text.append("[[loads.duty_cycle]]\ntime_share = 1.0\nspeed_rpm = 15.0\ntorque_Nm = 0.0")
-    expect_error(tmp_path, case_text, "loads.duty_cycle", "at least one row with a positive torque")
+    expect_error(tmp_path, case_text, "loads.duty_cycle", "at least one row with a non-zero torque")
+
+
+def test_zero_torque_is_refused_and_a_negative_one_reverses(case_text, tmp_path):
+    case_text.set("loads", "torque_Nm", "0.0")
+    expect_error(tmp_path, case_text, "loads.torque_Nm", "at least 0.001 N·m in magnitude")
+    case_text.set("loads", "torque_Nm", "-412.0")
+    case_text.append("[[loads.duty_cycle]]\ntime_share = 1.0\nspeed_rpm = 15.0\ntorque_Nm = -300.0")
+    case = load_case(case_text.write(tmp_path))
+    assert case.loads.torque_Nm == -412.0 and case.loads.disc_torque_Nmm < 0
+    assert case.loads.duty_cycle[0].torque_Nm == -300.0
+
+
+def test_pin_models_of_the_case_format(case_text, tmp_path):
+    for name in ("hertz", "rigid", "palmgren"):
+        case_text.set("pins", "model", f'"{name}"')
+        assert load_case(case_text.write(tmp_path)).pins.model == name
+    case_text.set("pins", "model", '"linear"')
+    expect_error(tmp_path, case_text, "pins.linear_stiffness_N_per_mm", "required when pins.model = 'linear'")
+    case_text.set("pins", "linear_stiffness_N_per_mm", "1e4")
+    assert load_case(case_text.write(tmp_path)).pins.linear_stiffness_N_per_mm == 1e4
+    case_text.set("pins", "model", '"hertz_palmgren"')
+    expect_error(tmp_path, case_text, "pins.model", "palmgren")
 
 
 def test_duty_cycle_torque_below_a_milli_newton_metre(case_text, tmp_path):
@@ -657,3 +678,13 @@ def test_p2_mesh_estimate_counts_edge_nodes(case_text, tmp_path):
     p1 = load_case(case_text.write(tmp_path))
     p2 = load_case(case_text.set("analysis", "element_order", "2").write(tmp_path))
     assert estimated_mesh_nodes(p2)["total"] == pytest.approx(4 * estimated_mesh_nodes(p1)["total"], rel=1e-12)
+
+
+def test_two_tooth_difference_case_is_valid_and_outside_the_handbook(case_text, tmp_path):
+    from rvfem.rigid import handbook_applicable
+
+    case_text.set("cycloid", "teeth", "38")
+    case = load_case(case_text.write(tmp_path))
+    assert case.pins.count - case.cycloid.teeth == 2
+    ok, reason = handbook_applicable(case)
+    assert not ok and "not defined for Zp − Zc ≠ 1" in reason

@@ -292,3 +292,82 @@ def test_pin_resultant_over_a_pitch_matches_the_handbook_components(crv80e):
     bx, by = bearings.fx.sum(axis=0), bearings.fy.sum(axis=0)
     b_radial = bx * np.cos(theta) + by * np.sin(theta)
     assert (radial + b_radial).mean() == pytest.approx(0.0, abs=5e-7 * c.sum_py)   # measured 1.9e-7·ΣP_y
+
+
+# --------------------------------------------------------------------------------------------
+# Reverse torque and the applicability of the handbook
+# --------------------------------------------------------------------------------------------
+
+
+def _reversed(case, crank_angles=None):
+    cranks = case.cranks if crank_angles is None else dataclasses.replace(case.cranks, angles_deg=crank_angles)
+    return case.replace(loads=dataclasses.replace(case.loads, torque_Nm=-case.loads.torque_Nm), cranks=cranks)
+
+
+def test_reverse_torque_is_the_mirror_image_of_forward_torque(rv40e):
+    """Cranks at 0°, 120°, 240° (symmetric about the x axis, as is the unmodified profile and the
+    pin ring at θ = 0): reversing the torque at −θ gives the mirror image (x, −y) of forward
+    torque at θ, bearing at α mapped to the bearing at −α, pin j to pin Zp − j."""
+    fwd = rv40e.replace(cranks=dataclasses.replace(rv40e.cranks, angles_deg=(0.0, 120.0, 240.0)))
+    rev = _reversed(fwd)
+    theta = np.radians(np.arange(0.0, 360.0, 7.0))
+    a, b = handbook_bearing_loads(fwd, theta), handbook_bearing_loads(rev, -theta)
+    mirror = [0, 2, 1]
+    scale = a.magnitude.max()
+    np.testing.assert_allclose(b.fx[mirror], a.fx, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(b.fy[mirror], -a.fy, rtol=0, atol=1e-12 * scale)
+    pa, pb = classical_pin_forces(fwd, theta), classical_pin_forces(rev, -theta)
+    zp = fwd.pins.count
+    pins = (zp - np.arange(zp)) % zp
+    np.testing.assert_allclose(pb.fx[pins], pa.fx, rtol=0, atol=1e-12 * pa.magnitude.max())
+    np.testing.assert_allclose(pb.fy[pins], -pa.fy, rtol=0, atol=1e-12 * pa.magnitude.max())
+    # the extremes of a reversed torque: the same magnitudes, the local angles mirrored
+    fa, fb = handbook_load_extremes(a.components), handbook_load_extremes(b.components)
+    assert fb[0] == pytest.approx(fa[0], rel=1e-15) and fb[2] == pytest.approx(fa[2], rel=1e-15)
+    assert (fb[1] + fa[1]) % (2 * math.pi) == pytest.approx(0.0, abs=1e-12) or \
+        (fb[1] + fa[1]) % (2 * math.pi) == pytest.approx(2 * math.pi, abs=1e-12)
+
+
+def test_reversed_bearing_forces_balance_the_reversed_pins(rv40e):
+    rev = _reversed(rv40e)
+    zc = rev.cycloid.teeth
+    theta = 2 * np.pi / zc * np.arange(256) / 256
+    pins = classical_pin_forces(rev, theta, exact_moment=True)
+    bearings = handbook_bearing_loads(rev, theta)
+    # the classical pins' moment about the disc centre is −T_disc (here +|T_disc|)
+    moment = (pins.x * pins.fy - pins.y * pins.fx).sum(axis=0)
+    np.testing.assert_allclose(moment, -rev.loads.disc_torque_Nmm, rtol=1e-12)
+    r0 = rev.cranks.circle_radius
+    bx, by = r0 * np.cos(bearings.crank_angles)[:, None], r0 * np.sin(bearings.crank_angles)[:, None]
+    np.testing.assert_allclose((bx * bearings.fy - by * bearings.fx).sum(axis=0), rev.loads.disc_torque_Nmm, rtol=1e-14)
+    # on average over a pin pitch the reversed pins push with +|ΣP_x| along u⊥ and ΣP_y along u
+    # (the mirror image of forward torque: the radial part does not change sign)
+    c = handbook_components(rev)
+    pins = classical_pin_forces(rev, theta)
+    fx, fy = pins.fx.sum(axis=0), pins.fy.sum(axis=0)
+    radial = fx * np.cos(theta) + fy * np.sin(theta)
+    tangential = -fx * np.sin(theta) + fy * np.cos(theta)
+    assert c.sum_px < 0 < c.sum_py
+    assert -tangential.mean() == pytest.approx(c.sum_px, rel=3e-16)
+    assert radial.mean() == pytest.approx(c.sum_py, rel=5e-7)
+
+
+def test_handbook_applicable_says_why_not(rv40e):
+    from rvfem.rigid import handbook_applicable
+
+    assert handbook_applicable(rv40e) == (True, "")
+    ok, reason = handbook_applicable(rv40e.replace(cycloid=dataclasses.replace(rv40e.cycloid, teeth=38)))
+    assert not ok and reason.startswith("not defined for Zp − Zc ≠ 1") and "pins.count" in reason
+
+
+def test_duty_cycle_rows_with_reversed_torque_count_with_their_magnitude(rv40e):
+    from rvfem.case import DutyRow
+    from rvfem.iso281 import case_duty_cycle_life
+
+    rows = (DutyRow(0.5, 15.0, 412.0), DutyRow(0.5, 15.0, 300.0))
+    fwd = rv40e.replace(loads=dataclasses.replace(rv40e.loads, duty_cycle=rows))
+    mixed = rv40e.replace(loads=dataclasses.replace(
+        rv40e.loads, torque_Nm=-412.0, duty_cycle=(DutyRow(0.5, 15.0, -412.0), DutyRow(0.5, 15.0, 300.0))))
+    a, b = case_duty_cycle_life(fwd, [1000.0]), case_duty_cycle_life(mixed, [1000.0])
+    assert b.service_life_h == pytest.approx(a.service_life_h, rel=1e-15)
+    assert b.equivalent_torque_Nm == pytest.approx(a.equivalent_torque_Nm, rel=1e-15)

@@ -40,6 +40,7 @@ from .profile import (
     build_profile,
     check_undercut,
     pitch_errors,
+    profile_curvature,
     profile_eval,
     trochoid_curvature,
 )
@@ -56,6 +57,7 @@ __all__ = [
     "PinContacts",
     "build_profile",
     "profile_eval",
+    "profile_curvature",
     "pin_centres",
     "crank_centres",
     "pin_profile_contacts",

@@ -57,6 +57,7 @@ __all__ = [
     "Profile",
     "build_profile",
     "profile_eval",
+    "profile_curvature",
     "pitch_errors",
     "trochoid_curvature",
     "check_undercut",
@@ -253,6 +254,18 @@ def profile_eval(profile: Profile, segment, s, derivatives: bool = False):
     Q1 = P1 + 1j * dl1 * P
     Q2 = P2 + 2j * dl1 * P1 + 1j * dl2 * P - dl1 * dl1 * P
     return phase * P, phase * Q1, phase * Q2
+
+
+def profile_curvature(profile: Profile, segment, s) -> np.ndarray:
+    """Signed curvature of the actual profile at base parameter ``s`` of ``segment``, 1/mm.
+
+    κ = Im(conj(P′)·P″)/|P′|³ from the exact derivatives of :func:`profile_eval` (modifications
+    and pitch-error blends included). The profile runs counter-clockwise, so κ > 0 where it is
+    convex (near the tips) and κ < 0 where it is concave (near the roots); 1/|κ| is the local
+    radius of curvature of the flank.
+    """
+    _, P1, P2 = profile_eval(profile, segment, s, derivatives=True)
+    return np.imag(np.conj(P1) * P2) / np.abs(P1) ** 3
 
 
 def _half_range(R: float, e: float, a: float, r: float, zc: int, d: int) -> float:
