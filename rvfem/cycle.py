@@ -208,7 +208,7 @@ def pin_contacts(system: DiscSystem, theta: float):
     return ContactGroup(
         W=W, signorini=np.full(zp, rigid), gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
         offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
-        laws=[] if rigid else [(np.arange(zp), law)], names=[f"pin {j}" for j in range(zp)],
+        laws=[] if rigid else [(np.arange(zp), law)], names=[f"pin {j + 1}" for j in range(zp)],
         bearing=np.full(zp, -1), W_load=W_load)
 
 

@@ -57,7 +57,8 @@ class ContactGroup:
     laws : list of (ndarray of local indices, law)
         Force laws of the spring contacts.
     names : list of str
-        One name per contact, for messages (``bearing 1 roller 3``).
+        One name per contact, for messages, numbered from 1 like everything a user reads
+        (``pin 7``, ``bearing 1 roller 3``).
     bearing : ndarray int (m,)
         Index of the crank bearing each contact belongs to, −1 for pins.
     W_load : scipy.sparse.csc_matrix or None
@@ -184,7 +185,7 @@ class RollerBearing:
             rows.append(cc.ravel())
             cols.append(np.repeat(np.arange(n, n + z), 2))
             vals.append(ww.ravel())
-            names += [f"bearing {i} roller {k}" for k in range(z)]
+            names += [f"bearing {i + 1} roller {k + 1}" for k in range(z)]
             bearing += [i] * z
             n += z
         return _group(interface.n_columns, rows, cols, vals, n, signorini=np.zeros(n, dtype=bool),
@@ -228,7 +229,7 @@ class RigidBoreBearing:
                 rows.append(colsb)
                 cols.append(np.full(grid.count, n))
                 vals.append(2.0 / grid.count * w)
-                names.append(f"bearing {i} {comp}")
+                names.append(f"bearing {i + 1} {comp}")
                 bearing.append(i)
                 n += 1
         return _group(interface.n_columns, rows, cols, vals, n, signorini=np.zeros(n, dtype=bool),

@@ -47,7 +47,7 @@ class LinearBoreSpring:
                 rows.append(grid.offset + np.arange(grid.count))
                 cols.append(np.full(grid.count, len(names)))
                 vals.append(w)
-                names.append(f"bearing {i} {'xy'[k]}")
+                names.append(f"bearing {i + 1} {'xy'[k]}")
                 bearing.append(i)
         n = len(names)
         W = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),

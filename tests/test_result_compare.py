@@ -114,7 +114,9 @@ def test_holes_against_solid_from_case_files(tmp_path, monkeypatch, capsys):
     c = json.loads(capsys.readouterr().out)
     assert c["a"]["label"] == "rv40e_solid" and c["b"]["label"] == "rv40e_fanholes"
     assert c["overall"]["ratio"]["handbook_max_load_N"] == 1.0
-    assert c["overall"]["ratio"]["max_load_N"] > 1.03
+    # the holes raise the largest load; by how much depends on the reducer stage (two discs on
+    # crankshafts with Hertz pins: about 2 points, one disc with T/2: about 10; docs/theory.md § 9)
+    assert c["overall"]["ratio"]["max_load_N"] > 1.0
     assert c["overall"]["ratio"]["peak_away_from_contacts_MPa"] > 1.5  # the hole fillets
     for row in c["bearings"]:
         r = row["ratio"]
