@@ -95,9 +95,10 @@ def case_text() -> CaseText:
     return CaseText.shipped("rv40e")
 
 
-END_TO_END_MODULES = ("test_run.py", "test_notebooks.py")
-"""Test modules that run the whole job (result folders, images, the notebook) rather than one stage
-of the science core: every test in them counts as ``slow``."""
+END_TO_END_MODULES = ("test_run.py", "test_notebooks.py", "test_study.py", "test_result_compare.py",
+                      "test_fuzz.py")
+"""Test modules that run the whole job (result folders, images, notebooks, Dask studies, the fuzzed
+command line) rather than one stage of the science core: every test in them counts as ``slow``."""
 
 
 def pytest_collection_modifyitems(config, items):
