@@ -122,7 +122,9 @@ def _thetas() -> np.ndarray:
 E, NU, THICK = 2.1e5, 0.3, 10.0
 
 
-def _quads_to_tris(idx: np.ndarray) -> np.ndarray:
+def quads_to_triangles(idx: np.ndarray) -> np.ndarray:
+    """Two triangles per quad of a structured (rows × columns) grid of vertex indices, the diagonal
+    alternating like a chequerboard (no preferred direction)."""
     a, b = idx[:-1, :-1], idx[1:, :-1]
     c, d = idx[1:, 1:], idx[:-1, 1:]
     alt = (np.add.outer(np.arange(a.shape[0]), np.arange(a.shape[1])) % 2).astype(bool)
@@ -137,7 +139,7 @@ def structured_annulus(ri: float, ro: float, nr: int, nt: int):
     th = np.linspace(0.0, 2.0 * np.pi, nt, endpoint=False)
     pts = np.stack([np.outer(r, np.cos(th)), np.outer(r, np.sin(th))], -1).reshape(-1, 2)
     ids = np.arange((nr + 1) * nt).reshape(nr + 1, nt)
-    tris = _quads_to_tris(np.concatenate([ids, ids[:, :1]], axis=1))
+    tris = quads_to_triangles(np.concatenate([ids, ids[:, :1]], axis=1))
     ring = lambda row: np.column_stack([row, np.roll(row, -1)])  # noqa: E731
     return pts, tris, ring(ids[0]), ring(ids[-1])
 
@@ -152,7 +154,7 @@ def structured_plate_with_hole(a: float, w: float, nt: int, nr: int, grading: fl
     r = a + np.outer(eta, r_out - a)
     pts = np.stack([r * c, r * s], -1).reshape(-1, 2)
     ids = np.arange((nr + 1) * nt).reshape(nr + 1, nt)
-    tris = _quads_to_tris(np.concatenate([ids, ids[:, :1]], axis=1))
+    tris = quads_to_triangles(np.concatenate([ids, ids[:, :1]], axis=1))
     ring = lambda row: np.column_stack([row, np.roll(row, -1)])  # noqa: E731
     return pts, tris, ring(ids[0]), ring(ids[-1])
 
@@ -325,21 +327,18 @@ def fe_core_section() -> Section:
 # ------------------------------------------------------------------------------------------------
 
 
-def hertz_cylinder(approach: float = 0.02) -> tuple[float, float, float, float]:
-    """An elastic cylinder (R = 10 mm, L = 1 mm) squeezed between rigid plates, Signorini contacts on
-    a 0.03 mm mesh: (FE half-width, Hertz half-width, FE peak pressure, Hertz peak pressure)."""
-    import scipy.sparse as sp
-
-    from . import contact, fem
+def squeezed_cylinder_mesh(radius: float, size: float):
+    """Gmsh mesh of a disc of ``radius`` (mm), ``size`` mm elements within |x| < 1 mm of the two
+    poles (the contact zones against flat plates), growing away from them: points (n, 2),
+    triangles (m, 3) and the rim's edges (k, 2)."""
     from .mesh import gmsh_session
 
-    R, L, Ec, nu, h = 10.0, 1.0, 2.0e5, 0.3, 0.03
     with gmsh_session("cylinder") as gmsh:
-        gmsh.model.occ.addDisk(0, 0, 0, R, R)
+        gmsh.model.occ.addDisk(0, 0, 0, radius, radius)
         gmsh.model.occ.synchronize()
         field = gmsh.model.mesh.field
         f = field.add("MathEval")
-        field.setString(f, "F", f"{h} + 0.2*Max(Abs(x) - 1.0, 0) + 0.2*Max({R} - 0.8 - Abs(y), 0)")
+        field.setString(f, "F", f"{size} + 0.2*Max(Abs(x) - 1.0, 0) + 0.2*Max({radius} - 0.8 - Abs(y), 0)")
         field.setAsBackgroundMesh(f)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
@@ -351,9 +350,19 @@ def hertz_cylinder(approach: float = 0.02) -> tuple[float, float, float, float]:
         _, _, lines = gmsh.model.mesh.getElements(1)
     index = np.zeros(int(tags.max()) + 1, dtype=int)
     index[tags.astype(int)] = np.arange(len(tags))
-    points = xyz.reshape(-1, 3)[:, :2]
-    triangles = index[tri[0].astype(int)].reshape(-1, 3)
-    rim = index[lines[0].astype(int)].reshape(-1, 2)
+    return (xyz.reshape(-1, 3)[:, :2], index[tri[0].astype(int)].reshape(-1, 3),
+            index[lines[0].astype(int)].reshape(-1, 2))
+
+
+def hertz_cylinder(approach: float = 0.02) -> tuple[float, float, float, float]:
+    """An elastic cylinder (R = 10 mm, L = 1 mm) squeezed between rigid plates, Signorini contacts on
+    a 0.03 mm mesh: (FE half-width, Hertz half-width, FE peak pressure, Hertz peak pressure)."""
+    import scipy.sparse as sp
+
+    from . import contact, fem
+
+    R, L, Ec, nu, h = 10.0, 1.0, 2.0e5, 0.3, 0.03
+    points, triangles, rim = squeezed_cylinder_mesh(R, h)
     model = fem.build_model(points, triangles, Ec, nu, L, order=1)
     factor = fem.factorize(model)
     iface = contact.build_interface(model, {"rim": rim}, fem.rigid_body_modes(model), {}, {"rim": 0.25 * h})

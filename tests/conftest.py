@@ -12,6 +12,46 @@ ROOT = Path(__file__).resolve().parents[1]
 CASES_DIR = ROOT / "cases"
 
 
+def documented_keys(after: str | None = None) -> set[str]:
+    """Key paths of a key table of docs/outputs.md: the first ``| key | type | meaning |`` table
+    (after the heading ``after``, if given). A row's backquoted names are full paths; an indented
+    row (``&nbsp;``) lists keys of each object named in the row above it."""
+    text = (ROOT / "docs" / "outputs.md").read_text(encoding="utf-8")
+    if after is not None:
+        text = text[text.index(after):]
+    table = text[text.index("| key | type | meaning |"):]
+    table = table[: table.index("\n\n")]
+    keys: set[str] = set()
+    parents: list[str] = []
+    for row in table.splitlines()[2:]:
+        first = row.split("|")[1].strip()
+        names = re.findall(r"`([^`]+)`", first)
+        if first.startswith("&nbsp;"):
+            keys.update(p + n for p in parents for n in names)
+        else:
+            keys.update(names)
+            parents = names
+    return keys
+
+
+def written_keys(obj, opaque=frozenset(), prefix: str = "") -> set[str]:
+    """Key paths of a JSON object; an array of objects is ``name[]`` and its entries' keys
+    ``name[].key``; the objects named in ``opaque`` (keys that are names) count as one key."""
+    keys = {prefix} if prefix else set()
+    if prefix in opaque:
+        return keys
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            name = f"{prefix}.{k}" if prefix else k
+            if isinstance(v, list) and v and isinstance(v[0], dict):
+                keys.add(name + "[]")
+                for entry in v:
+                    keys |= written_keys(entry, opaque, name + "[]")
+            else:
+                keys |= written_keys(v, opaque, name)
+    return keys
+
+
 def coarse_case(name: str, **changes):
     """A shipped case on a coarse mesh (0.6 mm at the flanks and bores, 4 mm inside) with the given
     tables updated (``coarse_case("rv40e_solid", crank_bearing={"stiffness_law": "linear", ...})``):

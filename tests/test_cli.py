@@ -12,7 +12,7 @@ import pytest
 import rvfem
 from rvfem import __version__, cli
 
-from conftest import CASES_DIR
+from conftest import CASES_DIR, documented_keys, written_keys
 
 CRV80E = str(CASES_DIR / "crv80e.toml")
 
@@ -242,44 +242,6 @@ def test_run_progress_draws_stages_and_the_cycle(tty):
         assert "rvfem run: cycle 36/36" not in text and "cycle 18/36 angles (50 %)" in text
 
 
-def _rigid_documented_keys() -> set[str]:
-    """Key paths of the `rvfem rigid --json` table in docs/outputs.md (same rules as summary.json's)."""
-    import re
-    from pathlib import Path
-
-    text = (Path(__file__).resolve().parents[1] / "docs" / "outputs.md").read_text(encoding="utf-8")
-    table = text[text.index("## `rvfem rigid --json`"):]
-    table = table[table.index("| key | type | meaning |"):]
-    table = table[: table.index("\n\n")]
-    keys: set[str] = set()
-    parents: list[str] = []
-    for row in table.splitlines()[2:]:
-        first = row.split("|")[1].strip()
-        names = re.findall(r"`([^`]+)`", first)
-        if first.startswith("&nbsp;"):
-            keys.update(p + n for p in parents for n in names)
-        else:
-            keys.update(names)
-            parents = names
-    return keys
-
-
-def _keys(obj, prefix=""):
-    out = {prefix} if prefix else set()
-    if prefix in ("environment",):
-        return out
-    if isinstance(obj, dict):
-        for k, v in obj.items():
-            name = f"{prefix}.{k}" if prefix else k
-            if isinstance(v, list) and v and isinstance(v[0], dict):
-                out.add(name + "[]")
-                for entry in v:
-                    out |= _keys(entry, name + "[]")
-            else:
-                out |= _keys(v, name)
-    return out
-
-
 def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
     from rvfem.case import file_sha256, load_case
     from rvfem.outputs import RIGID_SCHEMA_VERSION
@@ -294,7 +256,7 @@ def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
         assert report["case_sha256"] == file_sha256(path)
         assert report["case_digest"] == load_case(path).digest()
         assert report["environment"]["versions"]["numpy"]
-        written |= _keys(report)
-    documented = _rigid_documented_keys()
+        written |= written_keys(report, {"environment"})
+    documented = documented_keys("## `rvfem rigid --json`")
     assert written - documented == set(), "keys written but not documented"
     assert documented - written == set(), "keys documented but not written"

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from rvfem import contact, fem
 from rvfem.errors import ContactError
-from rvfem.mesh import gmsh_session
+from rvfem.verification import squeezed_cylinder_mesh
 
 R, L, E, NU = 10.0, 1.0, 2.0e5, 0.3
 H_CONTACT = 0.03  # element size in the contact zones, mm
@@ -25,26 +25,8 @@ H_CONTACT = 0.03  # element size in the contact zones, mm
 @pytest.fixture(scope="module")
 def squeezed_cylinder():
     """P1 model of the cylinder, its rim interface and the Signorini contact set near the poles."""
-    with gmsh_session("cylinder") as gmsh:
-        gmsh.model.occ.addDisk(0, 0, 0, R, R)
-        gmsh.model.occ.synchronize()
-        field = gmsh.model.mesh.field
-        f = field.add("MathEval")
-        # uniform H_CONTACT within |x| < 1 near both poles, growing away from them
-        field.setString(f, "F", f"{H_CONTACT} + 0.2*Max(Abs(x) - 1.0, 0) + 0.2*Max({R} - 0.8 - Abs(y), 0)")
-        field.setAsBackgroundMesh(f)
-        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", 1.0)
-        gmsh.model.mesh.generate(2)
-        tags, xyz, _ = gmsh.model.mesh.getNodes()
-        _, _, tri = gmsh.model.mesh.getElements(2)
-        _, _, lines = gmsh.model.mesh.getElements(1)
-    index = np.zeros(int(tags.max()) + 1, dtype=int)
-    index[tags.astype(int)] = np.arange(len(tags))
-    points = xyz.reshape(-1, 3)[:, :2]
-    triangles = index[tri[0].astype(int)].reshape(-1, 3)
-    rim = index[lines[0].astype(int)].reshape(-1, 2)
+    # uniform H_CONTACT within |x| < 1 near both poles, growing away from them
+    points, triangles, rim = squeezed_cylinder_mesh(R, H_CONTACT)
     model = fem.build_model(points, triangles, E, NU, L, order=1)
     factor = fem.factorize(model)
     iface = contact.build_interface(model, {"rim": rim}, fem.rigid_body_modes(model), {},

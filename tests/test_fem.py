@@ -22,10 +22,15 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector, FacetBasis, Functional, LinearForm, asm
+from skfem import FacetBasis, LinearForm, asm
 
 from rvfem import fem
 from rvfem.errors import MeshError
+# the structured meshes, the Lamé closed form and the Dirichlet-Lamé error norms are the ones the
+# verification manual reports (one implementation for both)
+from rvfem.verification import lame_dirichlet_errors, quads_to_triangles
+from rvfem.verification import lame_solution as lame
+from rvfem.verification import structured_annulus as annulus
 
 E, NU, THICK = 2.1e5, 0.3, 10.0
 
@@ -33,29 +38,6 @@ E, NU, THICK = 2.1e5, 0.3, 10.0
 # --------------------------------------------------------------------------------------------
 # Meshes
 # --------------------------------------------------------------------------------------------
-
-
-def _quads_to_tris(idx: np.ndarray) -> np.ndarray:
-    """Split the structured quads of an (ni+1, nj+1) index grid, alternating diagonals."""
-    a, b = idx[:-1, :-1], idx[1:, :-1]
-    c, d = idx[1:, 1:], idx[:-1, 1:]
-    alt = (np.add.outer(np.arange(a.shape[0]), np.arange(a.shape[1])) % 2).astype(bool)
-    t1 = np.where(alt[..., None], np.stack([a, b, c], -1), np.stack([a, b, d], -1))
-    t2 = np.where(alt[..., None], np.stack([a, c, d], -1), np.stack([b, c, d], -1))
-    return np.concatenate([t1.reshape(-1, 3), t2.reshape(-1, 3)])
-
-
-def annulus(ri: float, ro: float, nr: int, nt: int):
-    """Structured annulus: nr radial intervals, nt around. Returns points, triangles, inner and
-    outer boundary edges (vertices on the circles, straight edges between them)."""
-    r = np.linspace(ri, ro, nr + 1)
-    th = np.linspace(0.0, 2.0 * np.pi, nt, endpoint=False)
-    pts = np.stack([np.outer(r, np.cos(th)), np.outer(r, np.sin(th))], -1).reshape(-1, 2)
-    ids = np.arange((nr + 1) * nt).reshape(nr + 1, nt)
-    idx = np.concatenate([ids, ids[:, :1]], axis=1)  # periodic in θ
-    tris = _quads_to_tris(idx)
-    ring = lambda row: np.column_stack([row, np.roll(row, -1)])  # noqa: E731
-    return pts, tris, ring(ids[0]), ring(ids[-1])
 
 
 def plate_with_hole(a: float, w: float, nt: int, nr: int, grading: float = 1.12):
@@ -72,7 +54,7 @@ def plate_with_hole(a: float, w: float, nt: int, nr: int, grading: float = 1.12)
     pts = np.stack([r * c, r * s], -1).reshape(-1, 2)
     ids = np.arange((nr + 1) * nt).reshape(nr + 1, nt)
     idx = np.concatenate([ids, ids[:, :1]], axis=1)
-    tris = _quads_to_tris(idx)
+    tris = quads_to_triangles(idx)
     ring = lambda row: np.column_stack([row, np.roll(row, -1)])  # noqa: E731
     return pts, tris, ring(ids[0]), ring(ids[-1])
 
@@ -80,27 +62,6 @@ def plate_with_hole(a: float, w: float, nt: int, nr: int, grading: float = 1.12)
 # --------------------------------------------------------------------------------------------
 # Closed forms
 # --------------------------------------------------------------------------------------------
-
-
-def lame(a: float, b: float, p: float):
-    A = p * a * a / (b * b - a * a)
-    B = p * a * a * b * b / (b * b - a * a)
-
-    def u(x, y):
-        r2 = x * x + y * y
-        ur_over_r = ((1 - NU) * A + (1 + NU) * B / r2) / E
-        return ur_over_r * x, ur_over_r * y
-
-    def grad(x, y):  # ∂u_i/∂x_j of u = f(r²) (x, y), f = ((1−ν)A + (1+ν)B/r²)/E
-        r2 = x * x + y * y
-        f = ((1 - NU) * A + (1 + NU) * B / r2) / E
-        df = -(1 + NU) * B / (E * r2 * r2)                 # d f / d(r²)
-        return np.array([[f + 2 * df * x * x, 2 * df * x * y], [2 * df * x * y, f + 2 * df * y * y]])
-
-    def stress_polar(r):
-        return A - B / r**2, A + B / r**2
-
-    return u, grad, stress_polar
 
 
 def kirsch(a: float, s0: float):
@@ -367,54 +328,9 @@ def test_lame_ring_p2_errors_and_the_geometric_limit():
 # --------------------------------------------------------------------------------------------
 
 
-def _dirichlet_lame_errors(order: int, nr: int) -> tuple[float, float, float]:
-    """Solve K u = 0 inside with u = u_Lamé on the polygonal boundary; return h, L2 and energy
-    errors. The Lamé field is an exact solution of the homogeneous Navier equations in any
-    domain that avoids r = 0, so the polygonal domain carries no geometric error and the rates
-    are those of the elements alone."""
-    a, b = 10.0, 20.0
-    pts, tris, inner, outer = annulus(a, b, nr, 8 * nr)
-    m = fem.build_model(pts, tris, E, NU, 1.0, order)
-    u_ex, g_ex, _ = lame(a, b, 100.0)
-    r = np.hypot(*m.node_coords.T)
-    on_bnd = (np.abs(r - a) < 1e-9) | (np.abs(r - b) < 1e-9)
-    # P2 midpoints of boundary edges sit inside the circle, on the chord: find them by edge
-    bnd_edges = fem.edge_indices(m, np.vstack([inner, outer]))
-    if order == 2:
-        on_bnd[m.n_vertices + bnd_edges] = True
-    d = m.node_dofs[on_bnd].ravel()
-    g = np.zeros(m.n_dofs)
-    gx, gy = u_ex(*m.node_coords[on_bnd].T)
-    g[m.node_dofs[on_bnd, 0]], g[m.node_dofs[on_bnd, 1]] = gx, gy
-    free = np.setdiff1d(np.arange(m.n_dofs), d)
-    k = m.stiffness.tocsr()
-    u = g.copy()
-    u[free] = spla.spsolve(k[free][:, free].tocsc(), -(k[free][:, d] @ g[d]))
-
-    basis = Basis(m.mesh, ElementVector(ElementTriP1() if order == 1 else ElementTriP2()), intorder=8)
-    lam, mu = fem.plane_stress_constants(E, NU)
-
-    @Functional
-    def l2(w):
-        ex, ey = u_ex(w.x[0], w.x[1])
-        return (w.uh[0] - ex) ** 2 + (w.uh[1] - ey) ** 2
-
-    @Functional
-    def energy(w):
-        ge = g_ex(w.x[0], w.x[1])
-        e = w.uh.grad - ge
-        eps = 0.5 * (e + np.swapaxes(e, 0, 1))
-        tr = eps[0, 0] + eps[1, 1]
-        return lam * tr * tr + 2 * mu * (eps * eps).sum(axis=(0, 1))
-
-    uh = basis.interpolate(u)
-    h = (b - a) / nr
-    return h, math.sqrt(l2.assemble(basis, uh=uh)), math.sqrt(energy.assemble(basis, uh=uh))
-
-
 @pytest.mark.parametrize("order, levels", [(1, (4, 8, 16, 32)), (2, (4, 8, 16))])
 def test_convergence_rates_match_theory(order, levels):
-    res = [_dirichlet_lame_errors(order, n) for n in levels]
+    res = [lame_dirichlet_errors(order, n) for n in levels]
     h = np.array([r[0] for r in res])
     l2 = np.array([r[1] for r in res])
     en = np.array([r[2] for r in res])

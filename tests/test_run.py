@@ -27,7 +27,7 @@ from rvfem.mesh import mesh_case
 from rvfem.run import IMAGE_SIZE, run_case
 from rvfem.vtkio import CELL_FIELDS, POINT_FIELDS
 
-from conftest import CaseText
+from conftest import CaseText, documented_keys, written_keys
 
 STEP_DEG = 20.0
 
@@ -560,50 +560,13 @@ def test_analyse_writes_nothing_and_gives_the_summary_numbers(coarse_case_file, 
     assert json.loads(json.dumps(built, allow_nan=False)) == built
 
 
-def _documented_keys() -> set[str]:
-    """Key paths of the summary.json table in docs/outputs.md (see the rules above the table)."""
-    import re
-
-    text = (Path(__file__).resolve().parents[1] / "docs" / "outputs.md").read_text(encoding="utf-8")
-    table = text[text.index("| key | type | meaning |"):]
-    table = table[: table.index("\n\n")]
-    keys: set[str] = set()
-    parents: list[str] = []
-    for row in table.splitlines()[2:]:
-        first = row.split("|")[1].strip()
-        names = re.findall(r"`([^`]+)`", first)
-        if first.startswith("&nbsp;"):
-            keys.update(p + n for p in parents for n in names)
-        else:
-            keys.update(names)
-            parents = names
-    return keys
-
-
 OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timings_s", "environment.versions"}
 """Objects whose keys are names (case keys, files, stages), documented as a whole."""
 
 
-def _written_keys(obj, prefix: str = "") -> set[str]:
-    """Key paths of a summary; an array of objects is ``name[]`` and its entries' keys ``name[].key``."""
-    keys = {prefix} if prefix else set()
-    if prefix in OPAQUE_KEYS:
-        return keys
-    if isinstance(obj, dict):
-        for k, v in obj.items():
-            name = f"{prefix}.{k}" if prefix else k
-            if isinstance(v, list) and v and isinstance(v[0], dict):
-                keys.add(name + "[]")
-                for entry in v:
-                    keys |= _written_keys(entry, name + "[]")
-            else:
-                keys |= _written_keys(v, name)
-    return keys
-
-
 def test_summary_keys_are_the_documented_ones(summary, duty_run):
-    written = _written_keys(summary) | _written_keys(duty_run[1])
-    documented = _documented_keys()
+    written = written_keys(summary, OPAQUE_KEYS) | written_keys(duty_run[1], OPAQUE_KEYS)
+    documented = documented_keys()
     assert written - documented == set(), "keys written but not in docs/outputs.md"
     assert documented - written == set(), "keys in docs/outputs.md that no run writes"
 
