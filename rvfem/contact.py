@@ -54,6 +54,7 @@ __all__ = [
     "FootprintGrid",
     "Interface",
     "Compliance",
+    "column_rotation",
     "ContactSet",
     "AngleSolution",
     "build_interface",
@@ -238,18 +239,46 @@ def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
 
 
 class Compliance:
-    """C = Bᵀ K_s⁻¹ B, computed a batch of columns at a time when first needed and cached.
+    """C = Bᵀ K⁺ B, computed a batch of columns at a time when first needed and cached.
 
     Holds the only mutable state of a solve (the cache); one instance per disc model.
+
+    With ``rigid_modes`` the compliance is the floating disc's, free of the 3-DOF support of
+    K_s: every column load is first balanced by a rigid-mode load on the mesh vertices and the
+    displacement is then freed of its rigid motion (the vertices' least-squares rigid fit is
+    zero), ``C = Bᵀ Π K_s⁻¹ Πᵀ B`` with Π = I − R (R_vᵀ R)⁻¹ R_vᵀ (R the rigid modes, R_v their
+    vertex rows). For the self-equilibrated loads of a contact solve this changes C only by
+    rigid-motion terms, which the rigid-motion unknowns of the solve absorb: the contact forces
+    are those of the supported form. Its value is that C no longer depends on where the support
+    sits, so that it inherits the disc's symmetry: with ``rotation`` (the column map Q of a
+    rotation by 2π/N, :func:`column_rotation`), ``C = Q C Qᵀ`` and only the columns of one
+    360°/N sector are back-substituted; the others follow as ``C[:, c] = Qᵏ C[:, J] Qᵏ[c, J]ᵀ``,
+    J the columns of the grid point that Qᵏ carries onto column c's.
 
     Parameters
     ----------
     solve : callable
         ``solve(rhs)`` → K_s⁻¹·rhs for a dense (n_dofs, m) array.
     B : sparse (n_dofs, n_cols)
+    batch : int
+        Right-hand sides per back-substitution call.
+    workers : int, optional
+        Threads for the back-substitutions (default min(4, cores)).
+    rigid_modes : ndarray (n_dofs, 3), optional
+        Rigid-body modes (:func:`rvfem.fem.rigid_body_modes`); None keeps the supported form
+        ``Bᵀ K_s⁻¹ B`` (then ``rotation`` is not allowed).
+    vertex_dofs : ndarray of int, optional
+        DOFs of the mesh vertices (default all DOFs): the rigid fit uses these only, so that a P1
+        and a P2 model of the same mesh give the rigid motion the same meaning.
+    rotation : sparse (n_cols, n_cols), optional
+        Column map of the disc's N-fold rotation symmetry (:func:`column_rotation`).
+    order : int
+        N, the order of ``rotation``.
     """
 
-    def __init__(self, solve, B: sp.csc_matrix, batch: int = 16, workers: int | None = None):
+    def __init__(self, solve, B: sp.csc_matrix, batch: int = 16, workers: int | None = None, *,
+                 rigid_modes: np.ndarray | None = None, vertex_dofs: np.ndarray | None = None,
+                 rotation: sp.spmatrix | None = None, order: int = 1):
         self._solve = solve
         self.batch = batch  # right-hand sides per back-substitution call (measured optimum)
         self.workers = workers or min(4, os.cpu_count() or 1)
@@ -260,23 +289,87 @@ class Compliance:
         self.solve_seconds = 0.0
         self.version = 0
         self.columns_solved = 0
+        self.columns_mapped = 0
+        self._rigid = None
+        if rigid_modes is not None:
+            R = np.asarray(rigid_modes, dtype=float)
+            Rv = np.zeros_like(R)
+            rows = slice(None) if vertex_dofs is None else np.asarray(vertex_dofs, dtype=int)
+            Rv[rows] = R[rows]
+            H = np.linalg.inv(Rv.T @ R)                     # (R_vᵀ R)⁻¹, 3×3
+            self._rigid = (R, Rv, H, np.asarray(B.T @ R))   # Bᵀ R: (n_cols, 3)
+        elif rotation is not None:
+            raise ValueError("a rotation map needs the floating compliance (give rigid_modes)")
+        self.order = int(order) if rotation is not None else 1
+        self._orbits = None if rotation is None else _column_orbits(sp.csr_matrix(rotation), self.order)
+
+    @property
+    def symmetric(self) -> bool:
+        """True when columns are mapped by the disc's rotation symmetry."""
+        return self._orbits is not None
+
+    def rotation_power(self, k: int) -> sp.csr_matrix:
+        """Qᵏ, the column map of a rotation by k·2π/N (identity for k = 0)."""
+        if self._orbits is None:
+            raise ValueError("this compliance has no rotation map")
+        return self._orbits[2][int(k) % self.order]
+
+    def field(self, load: np.ndarray) -> np.ndarray:
+        """Displacement (n_dofs,) or (n_dofs, m) of the disc under nodal loads, mm, in the frame
+        of this compliance (support-free with ``rigid_modes``); add the rigid motion of a solve."""
+        load = np.asarray(load, dtype=float)
+        if self._rigid is None:
+            return self._solve(load)
+        R, Rv, H, _ = self._rigid
+        u = self._solve(load - Rv @ (H.T @ (R.T @ load)))      # Πᵀ·load: balanced on the vertices
+        return u - R @ (H @ (Rv.T @ u))                        # Π·u: no rigid fit on the vertices
+
+    def _direct(self, part: np.ndarray) -> np.ndarray:
+        """C[:, part] by back-substitution."""
+        Bp = self.B[:, part]
+        if self._rigid is None:
+            return np.asarray(self.B.T @ self._solve(Bp.toarray()))
+        R, Rv, H, BtR = self._rigid
+        X = self._solve(Bp.toarray() - Rv @ (H.T @ np.asarray(Bp.T @ R).T))   # K_s⁻¹ Πᵀ B_part
+        return np.asarray(self.B.T @ X) - BtR @ (H @ (Rv.T @ X))               # Bᵀ Π X
 
     def ensure(self, columns: np.ndarray) -> None:
         """Make sure ``C[:, columns]`` is available.
 
         Missing columns are back-substituted in batches of :attr:`batch` right-hand sides, on
-        :attr:`workers` threads (SciPy's SuperLU releases the GIL: 1.6× on two cores, measured).
+        :attr:`workers` threads (SciPy's SuperLU releases the GIL: 1.6× on two cores, measured);
+        with a rotation map only those of one sector, the rest are rotated copies.
         """
         columns = np.asarray(columns, dtype=int)
         need = np.unique(columns[~self.known[columns]])
         if need.size == 0:
             return
         t0 = time.perf_counter()
+        if self._orbits is None:
+            self._back_substitute(need)
+        else:
+            root, power, powers = self._orbits
+            masters = np.unique(np.concatenate([root[c] for c in need]))
+            self._back_substitute(masters[~self.known[masters]])
+            mapped = need[~self.known[need]]
+            ks = np.array([power[c] for c in mapped], dtype=int)
+            for k in np.unique(ks):
+                cs = mapped[ks == k]
+                J = np.unique(np.concatenate([root[c] for c in cs]))
+                Qk = powers[k]
+                self.C[:, cs] = Qk @ (self.C[:, J] @ Qk[cs][:, J].toarray().T)
+            self.known[mapped] = True
+            self.columns_mapped += mapped.size
+        self.version += 1
+        self.solve_seconds += time.perf_counter() - t0
+
+    def _back_substitute(self, need: np.ndarray) -> None:
+        if need.size == 0:
+            return
         parts = [need[i:i + self.batch] for i in range(0, need.size, self.batch)]
 
         def fill(part):
-            X = self._solve(self.B[:, part].toarray())
-            self.C[:, part] = np.asarray(self.B.T @ X)
+            self.C[:, part] = self._direct(part)
 
         if len(parts) > 1 and self.workers > 1:
             with ThreadPoolExecutor(self.workers) as pool:
@@ -285,9 +378,92 @@ class Compliance:
             for part in parts:
                 fill(part)
         self.known[need] = True
-        self.version += 1
-        self.solve_seconds += time.perf_counter() - t0
         self.columns_solved += need.size
+
+
+def column_rotation(iface: Interface, order: int, tol: float = 1e-9) -> sp.csr_matrix | None:
+    """The column map Q of a rotation of the disc by 2π/``order`` about its centre.
+
+    Column c (a unit footprint force at point x_c in direction d_c) turns into the force R·d_c
+    at R·x_c, which the columns at R·x_c represent exactly: Q[c', c] = d_c'·(R·d_c) (one radial
+    bore column, or the x and y columns of a profile point). Exact for an exactly symmetric mesh
+    (the footprint weights of corresponding grid points are then the same); None when some turned
+    point or direction has no columns to take it (the interface is not symmetric).
+
+    Parameters
+    ----------
+    iface : Interface
+    order : int
+        N ≥ 2.
+    tol : float
+        Relative position tolerance (of the largest radius).
+    """
+    from scipy.spatial import cKDTree
+
+    a = 2.0 * np.pi / order
+    Rot = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+    pts, dirs = iface.points, iface.directions
+    sites, site_of = np.unique(pts, axis=0, return_inverse=True)
+    site_of = site_of.ravel()
+    scale = float(np.abs(sites).max())
+    dist, image = cKDTree(sites).query(sites @ Rot.T)
+    if dist.max() > tol * scale:
+        return None
+    cols_of = [[] for _ in range(len(sites))]
+    for c, s in enumerate(site_of):
+        cols_of[s].append(c)
+    rows, cols, vals = [], [], []
+    turned = dirs @ Rot.T
+    for c in range(len(pts)):
+        targets = cols_of[image[site_of[c]]]
+        w = dirs[targets] @ turned[c]
+        if abs(float(np.linalg.norm(dirs[targets].T @ w - turned[c]))) > 1e-9:
+            return None
+        rows += targets
+        cols += [c] * len(targets)
+        vals += list(w)
+    n = len(pts)
+    Q = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    Q.data[np.abs(Q.data) < 1e-15] = 0.0
+    Q.eliminate_zeros()
+    return Q
+
+
+def _column_orbits(Q: sp.csr_matrix, order: int):
+    """Orbits of the interface columns under Q.
+
+    Returns, for every column c, the columns J of its orbit's root grid point and the power k
+    with c among the images of J under Qᵏ; and the powers Q⁰ … Q^(N−1) (CSR). Columns that Q
+    couples (the x and y columns of one profile point) form one grid point.
+    """
+    from scipy.sparse.csgraph import connected_components
+
+    n = Q.shape[0]
+    powers = [sp.identity(n, format="csr")]
+    for _ in range(1, order):
+        powers.append((Q @ powers[-1]).tocsr())
+    pattern = abs(Q)
+    _, site = connected_components(pattern.T @ pattern, directed=False)
+    members = [[] for _ in range(site.max() + 1)]
+    for c, s in enumerate(site):
+        members[s].append(c)
+    members = [np.asarray(m) for m in members]
+    Qc = Q.tocsc()
+    image = np.empty(len(members), dtype=int)
+    image[site] = site[Qc.indices[Qc.indptr[:-1]]]      # grid point each point turns into
+    root_site = np.full(len(members), -1)
+    power_site = np.zeros(len(members), dtype=int)
+    for s in range(len(members)):
+        if root_site[s] >= 0:
+            continue
+        t = s
+        for k in range(order):
+            root_site[t], power_site[t] = s, k
+            t = image[t]
+        if t != s:
+            raise ValueError("the column map is not of the given order")
+    root = [members[root_site[s]] for s in site]
+    return root, power_site[site], powers
 
 
 # ------------------------------------------------------------------------------------------------

@@ -77,6 +77,9 @@ class DiscSystem:
         The model objects.
     setup_seconds : dict
         Wall times of assembly, factorisation and interface build.
+    symmetry : int
+        N when the mesh is exactly N-fold symmetric (built from one 360°/N sector) and the
+        compliance maps columns by rotation; 1 otherwise.
     """
 
     case: Case
@@ -95,6 +98,7 @@ class DiscSystem:
     setup_seconds: dict = field(default_factory=dict)
     bearings: object = None
     pins: object = None
+    symmetry: int = 1
 
 
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
@@ -162,11 +166,19 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     iface = contact.build_interface(model, boundaries, rigid,
                                     {f"bore_{i}": centres[i] for i in range(len(centres))}, half,
                                     {name: column_stride for name in boundaries})
+    symmetry = int(getattr(mesh, "symmetry", 1))
+    rotation = contact.column_rotation(iface, symmetry) if symmetry > 1 else None
+    if symmetry > 1 and rotation is None:
+        log.warning("the mesh is marked %d-fold symmetric but its interface is not; solving the full disc",
+                    symmetry)
+        symmetry = 1
     times["interface"] = time.perf_counter() - t0
-    compliance = Compliance(factor.solve, iface.B)
+    compliance = Compliance(factor.solve, iface.B, rigid_modes=rigid,
+                            vertex_dofs=model.node_dofs[:model.n_vertices].ravel(),
+                            rotation=rotation, order=symmetry)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
                       stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
-                      pin_stiffness_N_per_mm, times, bearings, pins)
+                      pin_stiffness_N_per_mm, times, bearings, pins, symmetry)
 
 
 def pin_contacts(system: DiscSystem, theta: float):
@@ -305,10 +317,148 @@ def angle_result(system: DiscSystem, theta: float, sol: AngleSolution, cset: Con
                        sol.gap[:zp], sol.carrier_rotation, sol, cset)
 
 
+def turn_result(system: DiscSystem, result: AngleResult, k: int,
+                contacts: ContactSet | None = None) -> AngleResult:
+    """The solution at θ + k·2π/N from the one at θ, by the disc's exact N-fold symmetry.
+
+    Turning the whole configuration by 2π/N maps the disc (and its mesh) onto itself, the
+    eccentric of crank i onto that of crank i + 1, the pin ring onto itself (pin j onto pin
+    j + Zp/N·…, whatever the turned positions say) and each roller cage onto the next bearing's:
+    the state at θ + 2π/N is the state at θ turned (:func:`roller_angles` phases the cages for
+    this). The contacts of the turned angle are mapped onto the solved ones through the
+    interface: M with W(θ')·M = Qᵏ·W(θ) (a permutation of pins and rollers, a rotation of x/y
+    spring pairs), λ' = M·λ; the rigid motion turns with the disc, φ is unchanged.
+
+    Parameters
+    ----------
+    system : DiscSystem
+        With ``system.symmetry = N > 1``.
+    result : AngleResult
+        Solved at θ.
+    k : int
+        Number of 2π/N steps.
+    contacts : ContactSet, optional
+        The contact set at θ + k·2π/N (built here otherwise).
+
+    Raises
+    ------
+    ValueError
+        If the turned contacts do not match the solved ones (the configuration is not
+        symmetric, e.g. a pin count or a model that breaks the symmetry): solve that angle
+        directly instead.
+    """
+    k = int(k)
+    if k == 0:
+        return result
+    beta = 2.0 * math.pi * k / system.symmetry      # signed: the roller cages are not 2π-periodic
+    theta = result.theta + beta
+    cset = contacts if contacts is not None else contact_set(system, theta)[0]
+    old = result.contacts
+    Qk = system.compliance.rotation_power(k)
+    M = _contact_map(Qk, old.W, cset.W)
+    checks = [(M @ old.gap0, cset.gap0), (M @ old.offset, cset.offset), (M @ old.lever, cset.lever)]
+    if old.W_load is not None or cset.W_load is not None:
+        WL0 = old.W if old.W_load is None else old.W_load
+        WL1 = cset.W if cset.W_load is None else cset.W_load
+        checks.append((np.asarray(WL1 @ M), (Qk @ WL0).toarray()))
+    for mapped, direct in checks:
+        scale = max(float(np.abs(direct).max()), 1e-30) if np.size(direct) else 1.0
+        if np.size(direct) and float(np.abs(mapped - direct).max()) > 1e-8 * scale:
+            raise ValueError(f"the contacts at {math.degrees(theta):.3f}° are not the turned contacts of "
+                             f"{math.degrees(result.theta):.3f}°")
+    sol = result.solution
+    lam = M @ sol.force
+    WL = cset.W if cset.W_load is None else cset.W_load
+    vectors = np.asarray(WL.T @ system.interface.resultants[:, :2]) * lam[:, None]
+    c, s_ = math.cos(beta), math.sin(beta)
+    a = sol.rigid
+    rigid = np.array([c * a[0] - s_ * a[1], s_ * a[0] + c * a[1], a[2]])
+    turned = AngleSolution(lam, vectors, M @ sol.gap, rigid, sol.carrier_rotation, sol.iterations,
+                           dict(sol.residual))
+    return angle_result(system, theta, turned, cset)
+
+
+def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
+                  contacts: ContactSet | None = None) -> AngleResult:
+    """:func:`turn_result` of ``source`` by k steps, checked to land on ``theta``; solved
+    directly (warm-started from ``source``) when the contacts do not map."""
+    if k == 0:
+        return source
+    try:
+        out = turn_result(system, source, k, contacts)
+    except ValueError as exc:
+        log.warning("%s; solving %.2f° directly", exc, math.degrees(theta))
+        return solve_angle(system, theta, source)
+    if abs(out.theta - theta) > 1e-9:
+        raise ValueError(f"turned angle {out.theta} does not land on {theta}")
+    return out
+
+
+def _contact_map(Qk: sp.spmatrix, W0: sp.spmatrix, W1: sp.spmatrix) -> np.ndarray:
+    """M (n_contacts × n_contacts) with W1·M = Qk·W0; ValueError if there is none."""
+    target = sp.csc_matrix(Qk @ W0)
+    W1 = sp.csc_matrix(W1)
+    if W1.shape != target.shape:
+        raise ValueError("the turned angle has a different number of contacts")
+    A = (W1.T @ W1).toarray()
+    M = np.linalg.solve(A, (W1.T @ target).toarray())
+    M[np.abs(M) < 1e-12] = 0.0
+    err = float(np.abs(W1 @ M - target.toarray()).max())
+    if err > 1e-8 * max(float(np.abs(W0.data).max()), 1e-30):
+        raise ValueError("the turned contacts are not the solved ones")
+    return M
+
+
+def symmetry_plan(thetas: np.ndarray, order: int = 1, mirror: bool = False):
+    """Which crank angles to solve and how to obtain the others by symmetry.
+
+    The angles must be a uniform full revolution (θ_j = θ_0 + j·2π/n). The load cycle of an
+    N-fold symmetric disc repeats, turned, every 2π/N (``order`` = N); a mirrored pair of discs
+    repeats, with the discs swapped, every π (``mirror``). Together the angle indices repeat
+    every g = gcd(n, n/N, n/2) and only the first g angles are solved.
+
+    Returns
+    -------
+    solve : ndarray of int
+        Indices of the angles to solve (0 … g − 1), or all of them when nothing applies.
+    source : list of (i, swap, k)
+        For every angle j: the solved index i, whether the discs are swapped (0/1) and the
+        number k of 2π/N turns (of either sign, so that θ_i + swap·π + k·2π/N is θ_j itself).
+    """
+    thetas = np.asarray(thetas, dtype=float)
+    n = len(thetas)
+    steps = np.mod(np.diff(np.append(thetas, thetas[0] + 2 * math.pi)), 2 * math.pi) if n else np.zeros(0)
+    uniform = n > 1 and np.allclose(steps, 2 * math.pi / n, rtol=0, atol=1e-9)
+    shifts = []
+    if uniform and order > 1 and n % order == 0:
+        shifts.append((n // order, "turn"))
+    if uniform and mirror and n % 2 == 0:
+        shifts.append((n // 2, "swap"))
+    if not shifts:
+        return np.arange(n), [(j, 0, 0) for j in range(n)]
+    g = n
+    for sh, _ in shifts:
+        g = math.gcd(g, sh)
+    turn = n // order if (uniform and order > 1 and n % order == 0) else 0
+    half = n // 2 if (uniform and mirror and n % 2 == 0) else 0
+    # every offset d = j − i is reached exactly (no wrap past 2π: the roller cages advance by
+    # (1 − γ)·π per revolution, so θ and θ + 2π are different states) with turns of either sign
+    options = sorted(((swap * half + k * turn, swap, k) for swap in ((0, 1) if half else (0,))
+                      for k in (range(-order + 1, order) if turn else (0,))), key=lambda o: abs(o[2]))
+    source = []
+    for j in range(n):
+        i, d = j % g, j - j % g
+        swap, k = next((sw, k) for off, sw, k in options if off == d)
+        source.append((i, swap, k))
+    return np.arange(g), source
+
+
 def displacement(system: DiscSystem, result: AngleResult) -> np.ndarray:
     """Displacement field (n_dofs,) of the disc at a solved angle, mm (rigid motion included)."""
-    f = system.interface.B @ (result.contacts.W @ result.solution.force)
-    return system.solve(np.asarray(f)) + system.rigid_modes @ result.solution.rigid
+    cset = result.contacts
+    W = cset.W if cset.W_load is None else cset.W_load      # the loads (friction included)
+    f = system.interface.B @ (W @ result.solution.force)
+    return system.compliance.field(np.asarray(f)) + system.rigid_modes @ result.solution.rigid
 
 
 @dataclass(frozen=True)
@@ -446,16 +596,20 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
     extras = {}
     with threadpool_limits(limits=1, user_api="blas"):
         if stage is None:
-            results: list[AngleResult] = []
-            prev = None
+            solve_at, source = symmetry_plan(thetas, system.symmetry)
             sets = [contact_set(system, float(th)) for th in thetas]
-            system.compliance.ensure(likely_columns(system, [c for c, _ in sets]))
+            system.compliance.ensure(likely_columns(system, [sets[i][0] for i in solve_at]))
             t_prefetch = time.perf_counter() - t0
-            for i, th in enumerate(thetas):
-                prev = solve_angle(system, float(th), prev, contacts=sets[i])
-                results.append(prev)
+            solved: list[AngleResult] = []
+            prev = None
+            for i in solve_at:
+                prev = solve_angle(system, float(thetas[i]), prev, contacts=sets[i])
+                solved.append(prev)
                 if progress is not None:
-                    progress(i + 1, len(thetas))
+                    progress(len(solved) * len(thetas) // len(solve_at), len(thetas))
+            results = [turn_or_solve(system, solved[i], k, float(thetas[j]), sets[j][0])
+                       for j, (i, _, k) in enumerate(source)]
+            extras = {"pair_solves": len(solve_at)}
         else:
             results, extras = reducer.solve_stage_cycle(stage, thetas, progress)
             t_prefetch = 0.0

@@ -380,9 +380,15 @@ def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = Non
         coupling=H, start=None if start is None else [r.solution for r in start.results],
         max_iterations=case.analysis.max_active_set_iterations,
         label=f"at crank angle {math.degrees(theta):.2f}° ", names=names)
-    results = tuple(angle_result(s, th, sol, c) for s, th, sol, (c, _) in zip(systems, thetas, sols, sets))
+    return _pair(stage, tuple(angle_result(s, th, sol, c)
+                              for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)))
+
+
+def _pair(stage: ReducerStage, results: tuple) -> PairResult:
+    """A PairResult from each disc's solution (disc A first)."""
+    phases = [0.0, stage.second_phase][:len(results)]
     forces = np.stack([r.bearing_forces @ _rotation(beta).T for r, beta in zip(results, phases)])
-    torque = np.array([sol.residual["torque_Nmm"] for sol in sols])
+    torque = np.array([r.solution.residual["torque_Nmm"] for r in results])
     w = np.zeros_like(forces)
     if stage.influence is not None:
         w = -np.einsum("kl,lnj->knj", stage.influence, forces)
@@ -406,9 +412,11 @@ def default_stage(system) -> ReducerStage | None:
 def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
     """Solve the stage at every crank angle, warm-starting from the previous one.
 
-    With :attr:`ReducerStage.mirrored_pairs` and an even number of uniformly spaced angles, only
-    the first half of the angles is solved: the pair at θ + 180° is the pair at θ with the discs
-    swapped. ``progress(done, n)`` counts the crank angles of disc A obtained so far.
+    Only the angles that symmetry does not give are solved (:func:`rvfem.cycle.symmetry_plan`):
+    with :attr:`ReducerStage.mirrored_pairs` the pair at θ + 180° is the pair at θ with the discs
+    swapped; with N-fold symmetric discs the pair at θ + 360°/N is the pair at θ turned
+    (:func:`rvfem.cycle.turn_result`). ``progress(done, n)`` counts the crank angles of disc A
+    obtained so far.
 
     Returns
     -------
@@ -419,41 +427,62 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
         stage's description).
     """
+    from .cycle import contact_set, likely_columns, symmetry_plan, turn_result
+
     thetas = np.asarray(thetas, dtype=float)
     n = len(thetas)
-    half = n // 2
-    uniform = n % 2 == 0 and np.allclose(np.mod(thetas[half:] - thetas[:half], 2 * math.pi), math.pi,
-                                         atol=1e-12)
-    mirrored = stage.discs == 2 and stage.mirrored_pairs and uniform
-    solve_at = thetas[:half] if mirrored else thetas
-    from .cycle import contact_set, likely_columns
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    order = min(s.symmetry for s in systems)
+    mirrored = stage.discs == 2 and stage.mirrored_pairs
+    solve_at, source = symmetry_plan(thetas, order, mirrored)
+    step = 2.0 * math.pi / order
 
     t0 = time.perf_counter()
-    systems = [stage.first] if stage.second is None or stage.second is stage.first else [stage.first, stage.second]
-    for s in systems:
-        sets = [contact_set(s, float(th)) for th in thetas]
-        s.compliance.ensure(likely_columns(s, [c for c, _ in sets]))
+    sets = {}                                    # (disc, angle) → contact set, built once
+
+    def cset(k, theta):
+        key = (k, round(theta, 12))
+        if key not in sets:
+            sets[key] = contact_set(systems[k], theta)[0]
+        return sets[key]
+
+    offsets = [0.0] if stage.second is None else [0.0, math.pi - stage.second_phase]
+    distinct = {id(s): s for s in systems}
+    for sid, s in distinct.items():
+        ks = [k for k, t in enumerate(systems) if t is s]
+        s.compliance.ensure(likely_columns(s, [cset(k, float(thetas[i]) + offsets[k])
+                                               for i in solve_at for k in ks]))
     log.info("stage compliance prefetch %.2f s", time.perf_counter() - t0)
     pairs: list[PairResult] = []
     prev = None
-    per_solve = 2 if mirrored else 1               # crank angles of disc A each pair solve gives
-    for i, th in enumerate(solve_at):
-        prev = solve_pair(stage, float(th), prev)
+    for i in solve_at:
+        prev = solve_pair(stage, float(thetas[i]), prev)
         pairs.append(prev)
         if progress is not None:
-            progress(min(per_solve * (i + 1), n), n)
-    if mirrored:
-        order = [(j, 0) for j in range(half)] + [(j, 1) for j in range(half)]
-    else:
-        order = [(j, 0) for j in range(n)]
+            progress(len(pairs) * n // len(solve_at), n)
     results, torque, forces, w = [], [], [], []
-    for j, k in order:
-        p = pairs[j]
-        swap = [k, 1 - k] if stage.discs == 2 else [0]
-        results.append(p.results[k])
-        torque.append(p.torque_Nmm[swap])
-        forces.append(p.bearing_forces[swap])
-        w.append(p.eccentric_displacement[swap])
+    for j, (i, swap, k) in enumerate(source):
+        src = pairs[i].results
+        if swap:
+            src = src[::-1]                      # mirrored pair: disc B is disc A at θ + π
+        if (swap, k) == (0, 0):
+            p = pairs[i]
+        else:
+            # each disc's solution turned by k steps; disc B may land at θ_j + π − 2π when the
+            # discs are swapped, a state that differs from θ_j + π by the roller cages' phase
+            # only (as the mirrored pairs always did)
+            try:
+                p = _pair(stage, tuple(turn_result(systems[d], r, k, cset(d, r.theta + k * step))
+                                       for d, r in enumerate(src)))
+            except ValueError as exc:
+                log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(thetas[j]))
+                p = solve_pair(stage, float(thetas[j]), pairs[i])
+            if abs(p.results[0].theta - thetas[j]) > 1e-9:
+                raise RuntimeError(f"symmetry plan lands at {p.results[0].theta} instead of {thetas[j]}")
+        results.append(p.results[0])
+        torque.append(p.torque_Nmm)
+        forces.append(p.bearing_forces)
+        w.append(p.eccentric_displacement)
     extras = {
         "disc_torque_Nmm": np.array(torque),
         "disc_bearing_forces": np.array(forces),
