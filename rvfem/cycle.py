@@ -17,6 +17,7 @@ angle reuses it through the lazily filled column compliance of :mod:`rvfem.conta
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import time
@@ -80,6 +81,8 @@ class DiscSystem:
     symmetry : int
         N when the mesh is exactly N-fold symmetric (built from one 360°/N sector) and the
         compliance maps columns by rotation; 1 otherwise.
+    node_rotation : ndarray of int or None
+        The FE node that each node turns into by 2π/N (symmetric meshes).
     """
 
     case: Case
@@ -99,6 +102,7 @@ class DiscSystem:
     bearings: object = None
     pins: object = None
     symmetry: int = 1
+    node_rotation: np.ndarray | None = field(default=None, repr=False)
 
 
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
@@ -167,18 +171,27 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
                                     {f"bore_{i}": centres[i] for i in range(len(centres))}, half,
                                     {name: column_stride for name in boundaries})
     symmetry = int(getattr(mesh, "symmetry", 1))
-    rotation = contact.column_rotation(iface, symmetry) if symmetry > 1 else None
-    if symmetry > 1 and rotation is None:
-        log.warning("the mesh is marked %d-fold symmetric but its interface is not; solving the full disc",
-                    symmetry)
-        symmetry = 1
+    rotation = node_rotation = None
+    if symmetry > 1:
+        from .errors import MeshError
+        from .mesh import rotation_permutation
+
+        rotation = contact.column_rotation(iface, symmetry)
+        try:
+            node_rotation = rotation_permutation(model.node_coords, symmetry)
+        except MeshError:
+            rotation = None
+        if rotation is None:
+            log.warning("the mesh is marked %d-fold symmetric but its interface is not; solving the "
+                        "full disc", symmetry)
+            symmetry, node_rotation = 1, None
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B, rigid_modes=rigid,
                             vertex_dofs=model.node_dofs[:model.n_vertices].ravel(),
                             rotation=rotation, order=symmetry)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
                       stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
-                      pin_stiffness_N_per_mm, times, bearings, pins, symmetry)
+                      pin_stiffness_N_per_mm, times, bearings, pins, symmetry, node_rotation)
 
 
 def pin_contacts(system: DiscSystem, theta: float):
@@ -271,6 +284,10 @@ class AngleResult:
     carrier_rotation : float
         φ, rad (carrier relative to the pin housing, about the disc centre).
     solution : contact.AngleSolution
+    contacts : contact.ContactSet
+    origin : (AngleResult, int) or None
+        For a result obtained by symmetry (:func:`turn_result`): the solved result and the number
+        of 2π/N turns; its displacement field is the solved one's, turned.
     """
 
     theta: float
@@ -283,6 +300,7 @@ class AngleResult:
     carrier_rotation: float
     solution: AngleSolution
     contacts: ContactSet
+    origin: tuple | None = field(default=None, repr=False, compare=False)
 
     @property
     def bearing_loads(self) -> np.ndarray:
@@ -375,7 +393,8 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     rigid = np.array([c * a[0] - s_ * a[1], s_ * a[0] + c * a[1], a[2]])
     turned = AngleSolution(lam, vectors, M @ sol.gap, rigid, sol.carrier_rotation, sol.iterations,
                            dict(sol.residual))
-    return angle_result(system, theta, turned, cset)
+    root, k0 = result.origin if result.origin is not None else (result, 0)
+    return dataclasses.replace(angle_result(system, theta, turned, cset), origin=(root, k0 + k))
 
 
 def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
@@ -453,8 +472,45 @@ def symmetry_plan(thetas: np.ndarray, order: int = 1, mirror: bool = False):
     return np.arange(g), source
 
 
+def turn_field(system: DiscSystem, u: np.ndarray, k: int) -> np.ndarray:
+    """A displacement field (n_dofs,) turned by k·2π/N with the disc: the vector of node n
+    turned by k·2π/N moves to the node n turns into (exact on the symmetric mesh)."""
+    k = int(k)
+    if k == 0:
+        return u
+    perm = system.node_rotation
+    if perm is None:
+        raise ValueError("the disc model has no node rotation (its mesh is not symmetric)")
+    target = np.arange(len(perm))
+    step = perm if k > 0 else np.argsort(perm)
+    for _ in range(abs(k)):
+        target = step[target]
+    a = 2.0 * math.pi * k / system.symmetry
+    c, s_ = math.cos(a), math.sin(a)
+    dofs = system.model.node_dofs
+    ux, uy = u[dofs[:, 0]], u[dofs[:, 1]]
+    out = np.empty_like(u)
+    out[dofs[target, 0]] = c * ux - s_ * uy
+    out[dofs[target, 1]] = s_ * ux + c * uy
+    return out
+
+
+def displacements(system: DiscSystem, results):
+    """The displacement field of each result in turn (:func:`displacement`), solving each
+    distinct solved angle once: a result obtained by symmetry is its origin's field, turned."""
+    cache = {}
+    for r in results:
+        root, k = r.origin if r.origin is not None else (r, 0)
+        if id(root) not in cache:
+            cache[id(root)] = (root, displacement(system, root))
+        yield turn_field(system, cache[id(root)][1], k)
+
+
 def displacement(system: DiscSystem, result: AngleResult) -> np.ndarray:
     """Displacement field (n_dofs,) of the disc at a solved angle, mm (rigid motion included)."""
+    if result.origin is not None and system.node_rotation is not None:
+        root, k = result.origin
+        return turn_field(system, displacement(system, root), k)
     cset = result.contacts
     W = cset.W if cset.W_load is None else cset.W_load      # the loads (friction included)
     f = system.interface.B @ (W @ result.solution.force)
@@ -662,8 +718,8 @@ def _von_mises_envelope(system: DiscSystem, results: list[AngleResult]) -> tuple
     nv = system.model.n_vertices
     envelope = np.full(nv, -np.inf)
     envelope_theta = np.zeros(nv)
-    for r in results:
-        sxx, syy, sxy = (stress_op @ displacement(system, r)).reshape(3, nv)
+    for r, u in zip(results, displacements(system, results)):
+        sxx, syy, sxy = (stress_op @ u).reshape(3, nv)
         vm = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
         higher = vm > envelope
         envelope[higher] = vm[higher]

@@ -543,7 +543,7 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     p2_factor : dict, optional
         Name → P2/P1 ratio at the hot spot (see :class:`HotSpotHistory`).
     """
-    from .cycle import displacement
+    from .cycle import displacements
     from .fem import StressState, nodal_stress_operator
 
     points = np.asarray(system.mesh.points, dtype=float)
@@ -553,7 +553,7 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     op = nodal_stress_operator(system.model)
     rows = np.concatenate([np.asarray(vertices) + c * nv for c in range(3)])
     sub = op[rows]
-    comps = np.stack([sub @ displacement(system, r) for r in cycle.solutions])   # (n, 3·hot spots)
+    comps = np.stack([sub @ u for u in displacements(system, cycle.solutions)])   # (n, 3·hot spots)
     k = len(vertices)
     state = StressState.from_components(comps[:, :k], comps[:, k:2 * k], comps[:, 2 * k:])
     factors = tuple(float((p2_factor or {}).get(n, 1.0)) for n in names)
