@@ -442,6 +442,8 @@ class MeshSettings:
 
     ``size_hole`` is the size on the central hole and the lightening holes (their fillets carry
     the structural stress peaks); None means twice ``size_bore``, capped by ``size_interior``.
+    ``symmetric`` lets the mesher build an exactly N-fold symmetric mesh from one sector when the
+    disc is N-fold symmetric (see :func:`rvfem.mesh.symmetry_order`).
     """
 
     size_flank: float = param(0.4, unit="mm", low=0.01, high=100.0, doc="element size along the tooth flanks")
@@ -452,6 +454,9 @@ class MeshSettings:
                                     default_doc="2 × `size_bore` (≤ `size_interior`)",
                                     doc="element size on the central hole and the lightening holes (their "
                                         "fillets carry the structural stress peaks)")
+    symmetric: bool = param(True, doc="mesh one 360°/N sector and copy it by rotation when the disc is N-fold "
+                                      "symmetric (exactly symmetric mesh; the load cycle then solves one sector "
+                                      "of crank angles)")
 
 
 @dataclass(frozen=True)

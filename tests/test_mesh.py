@@ -142,7 +142,7 @@ def test_boundary_nodes_lie_on_their_features(fan_case, fan_mesh):
     for i, c in enumerate(centres):
         xy = fan_mesh.points[fan_mesh.boundary_nodes(f"bore_{i}")]
         np.testing.assert_allclose(np.hypot(xy[:, 0] - c[0], xy[:, 1] - c[1]), 18.0, rtol=0,
-                                   atol=2e-14)                                  # measured 7.1e-15 mm
+                                   atol=5e-14)              # measured 2.1e-14 mm (rotated sector copies)
     xy = fan_mesh.points[fan_mesh.boundary_nodes("central_hole")]
     np.testing.assert_allclose(np.hypot(xy[:, 0], xy[:, 1]), 12.0, rtol=0, atol=5e-15)   # measured 1.8e-15 mm
     # profile nodes: on the spline through the analytical profile (< 0.1 µm off), radius between
