@@ -379,9 +379,8 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
         WL0 = old.W if old.W_load is None else old.W_load
         WL1 = cset.W if cset.W_load is None else cset.W_load
         checks.append((np.asarray(WL1 @ M), (Qk @ WL0).toarray()))
-    for mapped, direct in checks:
-        scale = max(float(np.abs(direct).max()), 1e-30) if np.size(direct) else 1.0
-        if np.size(direct) and float(np.abs(mapped - direct).max()) > 1e-8 * scale:
+    for mapped, direct in checks:     # gaps, offsets and levers (mm; 1e-9 mm absolute), weights
+        if np.size(direct) and not np.allclose(mapped, direct, rtol=1e-8, atol=1e-9):
             raise ValueError(f"the contacts at {math.degrees(theta):.3f}° are not the turned contacts of "
                              f"{math.degrees(result.theta):.3f}°")
     sol = result.solution

@@ -133,15 +133,22 @@ def roller_angles(case, theta: float) -> np.ndarray:
 
     Measured about each bore centre from the disc's x axis. The eccentric turns by θ relative to
     the disc (the disc only translates relative to the carrier), so the cage turns by
-    θ·(1 − γ)/2 with γ = D_we/D_m (outer ring fixed). The cages of the N bearings are phased by
-    Δ_i·(1 + γ)/2 for a crank at Δ_i from the first, which makes the N bearings equivalent by the
-    disc's N-fold symmetry (their load curves are then exact 360°/N shifts when Zc is divisible
-    by N). Rollers of one bearing are 2π/Z apart.
+    θ·(1 − γ)/2 with γ = D_we/D_m (outer ring fixed). The cage of the bearing of a crank at Δ_i
+    from the first is where the first bearing's cage is at θ − Δ_i, turned by Δ_i, with that
+    crank angle taken modulo one revolution: ψ_i = ((θ − Δ_i) mod 2π)·(1 − γ)/2 + Δ_i. A cage
+    does not return to its place after one crank revolution (it has turned by π(1 − γ)), so a
+    load cycle is one revolution's sample of the cage phases; taking that revolution the same
+    way for every bearing makes the cycle 2π-periodic and, on an N-fold symmetric disc, the
+    state at θ + 2π/N exactly the state at θ turned, with bearing i + 1 in the place of bearing
+    i (:func:`rvfem.cycle.turn_result`). Rollers of one bearing are 2π/Z apart.
     """
     b = case.crank_bearing
     gamma = b.roller_diameter / b.pitch_diameter
     alpha = np.radians(case.cranks.angles_deg)
-    cage = theta * (1.0 - gamma) / 2.0 + (alpha - alpha[0]) * (1.0 + gamma) / 2.0
+    shift = alpha - alpha[0]
+    # the revolution starts 1e-9 rad before θ = Δ_i, so that crank angles that are Δ_i up to
+    # round-off (θ = 120° as 12·10° or as 210° − 90°) all fall on the same side of it
+    cage = (np.mod(theta - shift + 1e-9, 2.0 * np.pi) - 1e-9) * (1.0 - gamma) / 2.0 + shift
     return cage[:, None] + 2.0 * np.pi * np.arange(b.rollers)[None, :] / b.rollers
 
 

@@ -118,6 +118,7 @@ def test_turned_angles_equal_directly_solved_angles(fan_system):
     s = fan_system
     result = cycle.load_cycle(s, THETA, saved_angles_deg=(), stage=None)
     assert result.timings["pair_solves"] == 12
+    assert all(r.origin is not None for r in result.solutions[12:])    # none solved directly
     for j in (13, 25, 31):          # turned once or twice
         direct = cycle.solve_angle(s, float(THETA[j]))
         scale = direct.bearing_loads.max()
@@ -135,6 +136,7 @@ def test_turned_pairs_equal_directly_solved_pairs(fan_system):
     stage = reducer.build_stage(fan_system)
     result = cycle.load_cycle(fan_system, THETA, saved_angles_deg=(), stage=stage)
     assert result.timings["pair_solves"] == 6       # 60° of pairs: 120° turns and 180° swaps
+    assert sum(r.origin is None for r in result.solutions) == 12       # 6 solved, 6 swapped
     for j in (7, 20, 33):
         direct = reducer.solve_pair(stage, float(THETA[j]))
         scale = np.abs(direct.bearing_forces).max()
