@@ -138,8 +138,8 @@ class DiscMesh:
     symmetry : int
         N if the mesh was built from one 360°/N sector, else 1. The mesh is then exactly N-fold
         symmetric: ``rotation_permutation(points, N)`` maps it onto itself (nodes, triangles,
-        ``profile`` onto ``profile``, the central hole onto itself, each bore and hole onto the next
-        one of the same kind).
+        ``profile`` onto ``profile``, the central hole onto itself, every bore onto a bore and every
+        hole onto a hole: ``bore_i`` onto ``bore_{i+1}`` for cranks numbered counter-clockwise).
     """
 
     points: np.ndarray = field(repr=False)
