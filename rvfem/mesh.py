@@ -136,9 +136,10 @@ class DiscMesh:
     from_cache : bool
         True if the mesh was read from an existing file rather than generated.
     symmetry : int
-        N if the mesh was built from one 360°/N sector (it is then exactly N-fold symmetric:
-        :func:`rotation_permutation` maps it onto itself, node ``i`` onto node ``(i + n/N) mod
-        n``), else 1.
+        N if the mesh was built from one 360°/N sector, else 1. The mesh is then exactly N-fold
+        symmetric: ``rotation_permutation(points, N)`` maps it onto itself (nodes, triangles,
+        ``profile`` onto ``profile``, the central hole onto itself, every bore onto a bore and every
+        hole onto a hole: ``bore_i`` onto ``bore_{i+1}`` for cranks numbered counter-clockwise).
     """
 
     points: np.ndarray = field(repr=False)
