@@ -83,6 +83,9 @@ class DiscSystem:
         compliance maps columns by rotation; 1 otherwise.
     node_rotation : ndarray of int or None
         The FE node that each node turns into by 2π/N (symmetric meshes).
+    contact_sets : dict
+        Cache of :func:`contact_set` by crank angle (mutable, like the compliance): the cycles of
+        the attribution revisit the case cycle's angles.
     """
 
     case: Case
@@ -103,6 +106,7 @@ class DiscSystem:
     pins: object = None
     symmetry: int = 1
     node_rotation: np.ndarray | None = field(default=None, repr=False)
+    contact_sets: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
@@ -242,7 +246,15 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     (the bearing model's).
 
     Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
+    Built once per angle and system (:attr:`DiscSystem.contact_sets`).
     """
+    key = round(float(theta), 12)
+    if key not in system.contact_sets:
+        system.contact_sets[key] = _contact_set(system, theta)
+    return system.contact_sets[key]
+
+
+def _contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
     pins = pin_contacts(system, theta)
     centres = crank_centres(system.case)
     bearings = system.bearings.contacts(system.interface, centres, theta)
@@ -421,8 +433,8 @@ def _contact_map(Qk: sp.spmatrix, W0: sp.spmatrix, W1: sp.spmatrix) -> np.ndarra
     A = (W1.T @ W1).toarray()
     M = np.linalg.solve(A, (W1.T @ target).toarray())
     M[np.abs(M) < 1e-12] = 0.0
-    err = float(np.abs(W1 @ M - target.toarray()).max())
-    if err > 1e-8 * max(float(np.abs(W0.data).max()), 1e-30):
+    err = abs(W1 @ sp.csc_matrix(M) - target)
+    if err.nnz and err.max() > 1e-8 * max(float(np.abs(W0.data).max()), 1e-30):
         raise ValueError("the turned contacts are not the solved ones")
     return M
 

@@ -438,13 +438,9 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
     step = 2.0 * math.pi / order
 
     t0 = time.perf_counter()
-    sets = {}                                    # (disc, angle) → contact set, built once
 
     def cset(k, theta):
-        key = (k, round(theta, 12))
-        if key not in sets:
-            sets[key] = contact_set(systems[k], theta)[0]
-        return sets[key]
+        return contact_set(systems[k], theta)[0]
 
     offsets = [0.0] if stage.second is None else [0.0, math.pi - stage.second_phase]
     distinct = {id(s): s for s in systems}

@@ -27,6 +27,7 @@ References
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,6 +111,12 @@ class BoundaryChain:
         """Outward unit normals ``(..., 2)`` of the edges containing arc lengths ``s``."""
         return self.normals[self._edge_of(self._wrap(s))]
 
+    @functools.cached_property
+    def _vertex_tree(self):
+        from scipy.spatial import cKDTree
+
+        return cKDTree(self.points[:-1])
+
     def locate(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Arc length of the closest point of the chain to each of ``points``.
 
@@ -128,6 +135,27 @@ class BoundaryChain:
         q = np.asarray(points, dtype=np.float64).reshape(-1, 2)
         a, d = self.points[:-1], np.diff(self.points, axis=0)
         ll = np.einsum("ij,ij->i", d, d)
+        # points near the chain (contact points): the closest point lies on an edge next to one of
+        # the nearest vertices; the others get the exhaustive search below
+        k = len(a)
+        if k > 16:
+            _, near = self._vertex_tree.query(q, 2)
+            cand = np.concatenate([near, near - 1], axis=1) % k                    # (m, 4) edges
+            t = np.clip(np.einsum("mcj,mcj->mc", q[:, None] - a[cand], d[cand]) / ll[cand], 0.0, 1.0)
+            r = q[:, None] - (a[cand] + t[..., None] * d[cand])
+            d2 = np.einsum("mcj,mcj->mc", r, r)
+            c = np.argmin(d2, axis=1)
+            rows = np.arange(len(q))
+            j, tj = cand[rows, c], t[rows, c]
+            s_near = self.s[j] + tj * (self.s[j + 1] - self.s[j])
+            dist_near = np.sqrt(d2[rows, c])
+            close = dist_near <= 0.1 * np.sqrt(ll[j])     # well inside the neighbourhood
+            if not close.all():
+                s_near[~close], dist_near[~close] = self._locate_exhaustive(q[~close], a, d, ll)
+            return s_near, dist_near
+        return self._locate_exhaustive(q, a, d, ll)
+
+    def _locate_exhaustive(self, q, a, d, ll):
         s_out = np.empty(len(q))
         dist = np.empty(len(q))
         chunk = max(1, 2_000_000 // max(len(a), 1))
