@@ -12,20 +12,30 @@ On ``cases/rv40e_fanholes.toml`` at its default mesh (or the case given), measur
    as an independent FE contact problem (a code that re-factorises at every active-set
    iteration would be slower still);
 
-4. the reducer stage's cycle: two discs sharing the carrier (with the case's crankshafts), 180° of
-   pair solves, from an empty compliance cache like the single disc;
+4. the reducer stage's cycle: two discs sharing the carrier (with the case's crankshafts), from an
+   empty compliance cache like the single disc;
+5. all of the above side by side for the case's exactly symmetric mesh (one 360°/N sector copied
+   by rotation: compliance columns of one sector, crank angles of one sector, the rest turned)
+   and for the full-disc mesh (``mesh.symmetric = false``), with the bearing loads of both;
+6. ``rvfem run`` of the case, wall time by stage (a subprocess, as a user runs it; the mesh is
+   cached by the runs before).
 
 and prints the ratios the design asks for: cycle / (assembly + factorisation), naive / condensed
-per angle and two-disc / single-disc cycle, plus the peak memory of the process.
+per angle, two-disc / single-disc cycle and symmetric / full, plus the peak memory of the
+process and of the ``rvfem run`` subprocess.
 
-Run: ``python benchmarks/bench_cycle.py [CASE] [--naive-angles 5] [--step 1]``.
+Run: ``python benchmarks/bench_cycle.py [CASE] [--naive-angles 5] [--step 1] [--no-run]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import json
 import resource
+import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -71,71 +81,131 @@ class NaiveCompliance(contact.Compliance):
         self.columns_solved += need.size
 
 
+def measure(case, mesh_dir: str, thetas: np.ndarray) -> dict:
+    """Set-up, single-disc cycle and reducer-stage cycle of one case, from empty caches."""
+    out = {}
+    t0 = time.perf_counter()
+    mesh = mesh_case(case, mesh_dir)
+    out["mesh_s"] = time.perf_counter() - t0
+    out["mesh_cached"] = mesh.from_cache
+    system = cycle.build_system(case, mesh)
+    setup = system.setup_seconds
+    out.update(nodes=mesh.n_nodes, dofs=system.model.n_dofs, columns=system.interface.n_columns,
+               symmetry=system.symmetry, assembly_s=setup["assembly"], factorization_s=setup["factorization"],
+               interface_s=setup["interface"])
+    t0 = time.perf_counter()
+    result = cycle.load_cycle(system, thetas, stage=None)
+    out["cycle_s"] = time.perf_counter() - t0
+    tm = result.timings
+    out.update(columns_solved=tm["columns_solved"], columns_mapped=system.compliance.columns_mapped,
+               column_s=tm["column_solve"], solves=tm["pair_solves"],
+               iterations=float(result.iterations.mean()), max_load=float(result.bearing_loads.max()))
+    out["system"] = system
+    if case.loads.discs == 2:
+        pair_system = cycle.build_system(case, mesh)
+        stage = reducer.build_stage(pair_system, discs=2)
+        t0 = time.perf_counter()
+        pair = cycle.load_cycle(pair_system, thetas, stage=stage)
+        out["pair_s"] = time.perf_counter() - t0
+        out.update(pair_solves=pair.timings["pair_solves"], pair_columns=pair.timings["columns_solved"],
+                   pair_max_load=float(pair.bearing_loads.max()), stage=stage.describe())
+    return out
+
+
+def run_stages(case_path: str) -> tuple[float, dict, float]:
+    """``rvfem run`` in a subprocess: wall time, its stage timings and its peak memory (MiB)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        cmd = [sys.executable, "-m", "rvfem.cli", "run", case_path, "-o", str(Path(tmp) / "out")]
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        wall = time.perf_counter() - t0
+        timings = json.loads((Path(tmp) / "out" / "summary.json").read_text())["timings_s"]
+    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+    return wall, timings, peak
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("case", nargs="?", default=str(Path(__file__).resolve().parents[1] / "cases" / "rv40e_fanholes.toml"))
     ap.add_argument("--naive-angles", type=int, default=5)
     ap.add_argument("--step", type=float, default=1.0, help="crank-angle step of the cycle, deg")
     ap.add_argument("--mesh-dir", default="meshes")
+    ap.add_argument("--no-run", action="store_true", help="skip the rvfem run subprocess")
     args = ap.parse_args(argv)
 
     case = load_case(args.case)
-    t0 = time.perf_counter()
-    mesh = mesh_case(case, args.mesh_dir)
-    t_mesh = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    system = cycle.build_system(case, mesh)
-    t_setup = time.perf_counter() - t0
-    setup = system.setup_seconds
-    af = setup["assembly"] + setup["factorization"]
-    print(f"case {case.name}: {mesh.n_nodes} nodes, {system.model.n_dofs} DOFs, "
-          f"{system.interface.n_columns} interface columns")
-    print(f"mesh {t_mesh:.2f} s ({'cached' if mesh.from_cache else 'generated'}); "
-          f"assembly {setup['assembly']:.3f} s, factorisation {setup['factorization']:.3f} s "
-          f"({fem.available_solvers()[0]}), interface {setup['interface']:.3f} s, set-up total {t_setup:.2f} s")
-
+    full_case = dataclasses.replace(case, mesh=dataclasses.replace(case.mesh, symmetric=False))
     thetas = np.radians(np.arange(0.0, 360.0, args.step))
-    t0 = time.perf_counter()
-    result = cycle.load_cycle(system, thetas, stage=None)
-    t_cycle = time.perf_counter() - t0
-    tm = result.timings
-    print(f"cycle of {len(thetas)} angles: {t_cycle:.2f} s = {t_cycle / len(thetas) * 1e3:.1f} ms/angle "
-          f"(columns {tm['columns_solved']} in {tm['column_solve']:.2f} s, prefetch {tm['prefetch']:.2f} s, "
-          f"Newton iterations per angle: mean {result.iterations.mean():.1f}, max {result.iterations.max()})")
-    print(f"  ratio cycle / (assembly + factorisation) = {t_cycle / af:.1f}")
+    rows = {"symmetric": measure(case, args.mesh_dir, thetas), "full": measure(full_case, args.mesh_dir, thetas)}
+    print(f"case {case.name}, {len(thetas)} crank angles at {args.step}°, solver {fem.available_solvers()[0]}")
+    print(f"{'':34s}{'symmetric mesh':>16s}{'full mesh':>16s}")
 
-    # the reducer stage: two discs sharing the carrier (and the case's crankshafts), each from an
-    # empty compliance cache like the single disc above
-    if case.loads.discs == 2:
-        pair_system = cycle.build_system(case, mesh)
-        stage = reducer.build_stage(pair_system, discs=2)
-        t0 = time.perf_counter()
-        pair = cycle.load_cycle(pair_system, thetas, stage=stage)
-        t_pair = time.perf_counter() - t0
-        print(f"two-disc cycle ({stage.describe()}): {t_pair:.2f} s, {pair.timings['pair_solves']} pair solves, "
-              f"columns {pair.timings['columns_solved']}")
-        print(f"  ratio two-disc cycle / single-disc cycle = {t_pair / t_cycle:.2f}")
+    def line(label, key, fmt="{:.3f}"):
+        print(f"{label:34s}" + "".join(f"{fmt.format(rows[k][key]) if key in rows[k] else '-':>16s}" for k in rows))
 
-    # naive: a handful of angles, no reuse
+    line("mesh symmetry (N)", "symmetry", "{:d}")
+    line("nodes", "nodes", "{:d}")
+    line("interface columns", "columns", "{:d}")
+    line("assembly, s", "assembly_s")
+    line("factorisation, s", "factorization_s")
+    for r in rows.values():
+        r["af"] = r["assembly_s"] + r["factorization_s"]
+        r["ratio"] = r["cycle_s"] / r["af"]
+        r["per_angle_ms"] = 1e3 * r["cycle_s"] / len(thetas)
+        if "pair_s" in r:
+            r["pair_ratio"] = r["pair_s"] / r["af"]
+    line("single-disc cycle, s", "cycle_s", "{:.2f}")
+    line("  crank angles solved", "solves", "{:d}")
+    line("  columns back-substituted", "columns_solved", "{:d}")
+    line("  columns by rotation", "columns_mapped", "{:d}")
+    line("  column time, s", "column_s", "{:.2f}")
+    line("  cost per angle, ms", "per_angle_ms", "{:.1f}")
+    line("  Newton iterations per angle", "iterations", "{:.1f}")
+    line("  cycle / (assembly + fact.)", "ratio", "{:.1f}")
+    line("  max bearing load, N", "max_load", "{:.1f}")
+    line("reducer-stage cycle, s", "pair_s", "{:.2f}")
+    line("  pair solves", "pair_solves", "{:d}")
+    line("  columns back-substituted", "pair_columns", "{:d}")
+    line("  cycle / (assembly + fact.)", "pair_ratio", "{:.1f}")
+    line("  max bearing load, N", "pair_max_load", "{:.1f}")
+    sym, full = rows["symmetric"], rows["full"]
+    print(f"symmetric / full: single-disc cycle {sym['cycle_s'] / full['cycle_s']:.2f}"
+          + (f", stage cycle {sym['pair_s'] / full['pair_s']:.2f}" if "pair_s" in sym else "")
+          + f"; max bearing load differs by {100 * (sym['max_load'] / full['max_load'] - 1):+.3f} % (one disc)"
+          + (f", {100 * (sym['pair_max_load'] / full['pair_max_load'] - 1):+.3f} % (stage)" if "pair_s" in sym else ""))
+    if "stage" in sym:
+        print(f"stage model: {sym['stage']}")
+
+    # naive: a handful of angles, no reuse (full mesh, so that every angle is a real solve)
+    system = full["system"]
     picks = thetas[:: max(1, len(thetas) // args.naive_angles)][: args.naive_angles]
     naive = NaiveCompliance(system.model, system.interface.B)
-    naive_system = cycle.DiscSystem(**{**system.__dict__, "compliance": naive})
+    naive_system = dataclasses.replace(system, compliance=naive, contact_sets={})
     t0 = time.perf_counter()
     for th in picks:
         naive.new_angle()
         cycle.solve_angle(naive_system, float(th))
     t_naive = (time.perf_counter() - t0) / len(picks)
-    # condensed, per angle, amortised over the cycle
-    t_cond = t_cycle / len(thetas)
+    t_cond = full["cycle_s"] / len(thetas)
     print(f"naive: {t_naive:.2f} s/angle ({naive.factorizations / len(picks):.1f} factorisations per angle) "
-          f"vs condensed {t_cond * 1e3:.1f} ms/angle: ratio {t_naive / t_cond:.0f}x")
-    # same answers?
+          f"vs condensed {t_cond * 1e3:.1f} ms/angle (full mesh): ratio {t_naive / t_cond:.0f}x")
     ref = cycle.solve_angle(system, float(picks[-1]))
     naive.new_angle()
     nv = cycle.solve_angle(naive_system, float(picks[-1]))
     print(f"  max difference of bearing loads naive vs condensed: "
           f"{np.abs(ref.bearing_loads - nv.bearing_loads).max():.2e} N")
-    print(f"peak memory (max RSS) {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
+    print(f"peak memory of this process (max RSS) {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
+
+    if not args.no_run:
+        walls = []
+        for _ in range(3):
+            wall, timings, peak = run_stages(args.case)
+            walls.append((wall, timings))
+        wall, timings = min(walls, key=lambda w: w[0])
+        print(f"rvfem run {Path(args.case).name}: {wall:.1f} s wall (best of 3, subprocess incl. start-up); "
+              f"peak memory {peak:.0f} MiB")
+        print("  stages, s: " + ", ".join(f"{k} {v:.2f}" for k, v in timings.items()
+                                         if k not in ("total", "cycle_per_angle") and v >= 0.005))
     return 0
 
 
