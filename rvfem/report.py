@@ -222,6 +222,18 @@ def key_field_angles(summary: dict, case: Case) -> list[float]:
     return sorted(key)
 
 
+def _symmetry_sentence(m: dict) -> str:
+    """How the mesh was built and how many crank angles were solved."""
+    n = m.get("mesh_symmetry", 1)
+    solved = m.get("angles_solved", m["angles"])
+    mesh = (f"mesh exactly {n}-fold symmetric (one {360 / n:g}° sector copied by rotation)" if n > 1
+            else "full-disc mesh")
+    if solved < m["angles"]:
+        return (f"{mesh}; {solved} of the {m['angles']} crank angles solved, the others follow from them "
+                "by symmetry (exact);")
+    return f"{mesh}; every crank angle solved;"
+
+
 def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str | os.PathLike) -> Path:
     """Write ``report.html``.
 
@@ -256,7 +268,8 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
         parts.append(f"<p>{_e(c['description'])}</p>")
     parts.append(f"<p class='meta'>Model: bearing model <b>{_e(m['bearing_model'])}</b>, P{m['element_order']} "
                  f"elements, {m['nodes']} nodes, {m['dofs']} dofs, {m['elements']} elements; {m['angles']} crank "
-                 f"angles (step {m['angle_step_deg']:g}°); wall time {summary['timings_s']['total']:.1f} s.</p>")
+                 f"angles (step {m['angle_step_deg']:g}°); {_symmetry_sentence(m)} wall time "
+                 f"{summary['timings_s']['total']:.1f} s.</p>")
 
     # -- results ---------------------------------------------------------------------------------
     parts.append("<h2>Crank-bearing loads and lives: rigid handbook vs flexible disc</h2>")
