@@ -483,19 +483,26 @@ def symmetry_plan(thetas: np.ndarray, order: int = 1, mirror: bool = False):
     return np.arange(g), source
 
 
+def turned_nodes(system: DiscSystem, k: int) -> np.ndarray:
+    """The FE node that each node turns into by k·2π/N (k of either sign); vertices come first
+    and turn into vertices."""
+    perm = system.node_rotation
+    if perm is None:
+        raise ValueError("the disc model has no node rotation (its mesh is not symmetric)")
+    target = np.arange(len(perm))
+    step = perm if k > 0 else np.argsort(perm)
+    for _ in range(abs(int(k))):
+        target = step[target]
+    return target
+
+
 def turn_field(system: DiscSystem, u: np.ndarray, k: int) -> np.ndarray:
     """A displacement field (n_dofs,) turned by k·2π/N with the disc: the vector of node n
     turned by k·2π/N moves to the node n turns into (exact on the symmetric mesh)."""
     k = int(k)
     if k == 0:
         return u
-    perm = system.node_rotation
-    if perm is None:
-        raise ValueError("the disc model has no node rotation (its mesh is not symmetric)")
-    target = np.arange(len(perm))
-    step = perm if k > 0 else np.argsort(perm)
-    for _ in range(abs(k)):
-        target = step[target]
+    target = turned_nodes(system, k)
     a = 2.0 * math.pi * k / system.symmetry
     c, s_ = math.cos(a), math.sin(a)
     dofs = system.model.node_dofs
@@ -729,9 +736,17 @@ def _von_mises_envelope(system: DiscSystem, results: list[AngleResult]) -> tuple
     nv = system.model.n_vertices
     envelope = np.full(nv, -np.inf)
     envelope_theta = np.zeros(nv)
-    for r, u in zip(results, displacements(system, results)):
-        sxx, syy, sxy = (stress_op @ u).reshape(3, nv)
-        vm = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+    solved = {}
+    for r in results:
+        root, k = r.origin if r.origin is not None else (r, 0)
+        if id(root) not in solved:
+            sxx, syy, sxy = (stress_op @ displacement(system, root)).reshape(3, nv)
+            solved[id(root)] = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+        vm = solved[id(root)]
+        if k:                              # von Mises is invariant: the values move with the disc
+            turned = np.empty(nv)
+            turned[turned_nodes(system, k)[:nv]] = vm
+            vm = turned
         higher = vm > envelope
         envelope[higher] = vm[higher]
         envelope_theta[higher] = r.theta
