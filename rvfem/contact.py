@@ -10,11 +10,12 @@ The model (docs/theory.md) in the disc's body frame:
   radially outward from the bore centre, i.e. into the disc material). A contact between grid points
   shares its force between the two neighbouring columns (linear interpolation), so its load and
   its displacement are work-conjugate.
-* **Condensation** (docs/theory.md): the compliance of the disc between grid columns,
-  C = Bᵀ K_s⁻¹ B, is computed lazily, column by column, the first time a column carries load, and
-  reused for every later crank angle. K_s is K with a statically determinate 3-DOF support; for the
-  self-equilibrated loads the contact problem produces, it differs from the floating disc only by
-  a rigid-body motion ``a`` (2 translations, 1 rotation), which is an unknown of the small system.
+* **Condensation** (docs/theory.md § 6): the compliance of the floating disc between grid columns,
+  C = Bᵀ Π K_s⁻¹ Πᵀ B, is computed lazily, column by column, the first time a column carries load,
+  and reused for every later crank angle (K_s is K with a statically determinate 3-DOF support, Π
+  removes the rigid motion; see :class:`Compliance`). The disc's rigid-body motion ``a``
+  (2 translations, 1 rotation) is an unknown of the small system. On an exactly N-fold symmetric
+  mesh only one sector's columns are back-substituted (:func:`column_rotation`, § 9a).
 * Pins are rigid (Signorini: gap ≥ 0, force ≥ 0, force·gap = 0, primal–dual active set) or
   compliant: the Hertz pin–flank line contact (:func:`hertz_pin_law`), Palmgren's roller formula
   or a linear spring (:mod:`rvfem.models`). Rollers are compression-only springs along their
