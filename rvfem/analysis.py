@@ -333,12 +333,18 @@ class RigidBearing:
 class RigidAnalysis:
     """The rigid handbook evaluation of a case: loads, rating, lives, Hertz, duty cycle.
 
+    Where the handbook model is not defined (Zp − Zc ≠ 1) the evaluation keeps its layout with
+    nothing made up: ``loads`` are NaN (:func:`rvfem.rigid.undefined_loads`), ``bearings`` is
+    empty, ``duty_cycle`` is None and ``references`` says why.
+
     Attributes
     ----------
     case : Case
     loads : rvfem.rigid.RigidLoads
-        Bearing forces over the sampled crank angles (and the handbook components k, k_y, ΣP…).
+        Bearing forces over the sampled crank angles (and the handbook components k, k_y, ΣP…);
+        NaN where the handbook is not defined.
     bearings : tuple of RigidBearing
+        One per bearing; empty where the handbook is not defined.
     rating_N : float
         ISO 281 dynamic load rating C of the crank bearing, N.
     bearing_speed_rpm : float
@@ -349,7 +355,11 @@ class RigidAnalysis:
         Factor of Stribeck's Q_max = factor·F/Z.
     duty_cycle : rvfem.iso281.DutyCycleLife or None
         Service life of the case's duty cycle from the shortest bearing life (None without a duty
-        cycle).
+        cycle, or where the handbook is not defined).
+    references : rvfem.rigid.References or None
+        Which rigid references are defined for the case and why (:func:`rvfem.rigid.references`,
+        as for the rigid evaluation alone: the equal share of the FE pin resultant is not part of
+        it).
     """
 
     case: Case
@@ -360,11 +370,17 @@ class RigidAnalysis:
     exponent: float
     stribeck_factor: float
     duty_cycle: iso281.DutyCycleLife | None
+    references: rigid.References | None = None
 
     @property
     def angle_step_deg(self) -> float:
         """Crank-angle step actually used, degrees."""
         return 360.0 / self.loads.theta.size
+
+    @property
+    def defined(self) -> bool:
+        """True if the handbook model applies to the case (the loads are numbers, not NaN)."""
+        return bool(self.bearings)
 
 
 def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
@@ -380,16 +396,24 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
     Returns
     -------
     RigidAnalysis
+        For Zp − Zc ≠ 1 the handbook is not defined: NaN loads, no bearings, and the reason in
+        ``references``.
 
     Raises
     ------
     CaseError
-        If the case lies outside the handbook model (Zp − Zc ≠ 1, unequally spaced cranks).
+        If the cranks are not equally spaced (no rigid reference applies).
     """
-    loads = rigid.handbook_bearing_loads(case, theta)
+    refs = rigid.references(case, fe=False)
     exponent = case.analysis.equivalent_load_exponent
     rating = iso281.crank_bearing_rating(case.crank_bearing)
     speed = iso281.case_bearing_speed_rpm(case)
+    if not refs.handbook.defined and case.pins.count - case.cycloid.teeth != 1:
+        log.info("%s: the handbook model is %s", case.name, refs.handbook.why)
+        return RigidAnalysis(case=case, loads=rigid.undefined_loads(case, theta), bearings=(), rating_N=rating,
+                             bearing_speed_rpm=speed, exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR,
+                             duty_cycle=None, references=refs)
+    loads = rigid.handbook_bearing_loads(case, theta)
     mat = case.material
     bearings = []
     for s in rigid.summarize_bearing_loads(loads, exponent):
@@ -404,7 +428,7 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
         ))
     duty = iso281.case_duty_cycle_life(case, [b.loads.L10h for b in bearings])
     return RigidAnalysis(case=case, loads=loads, bearings=tuple(bearings), rating_N=rating, bearing_speed_rpm=speed,
-                         exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR, duty_cycle=duty)
+                         exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR, duty_cycle=duty, references=refs)
 
 
 # --------------------------------------------------------------------------------------------
@@ -495,9 +519,10 @@ class DutyCycleFE:
 class DutyCycleResult:
     """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives
     (both scaled linearly with the torque, Gao et al. eq. 18), and the flexible one from the FE
-    at every duty-cycle torque (``flexible_fe``, None when not computed)."""
+    at every duty-cycle torque (``flexible_fe``, None when not computed). ``rigid`` is None where
+    the handbook is not defined (Zp − Zc ≠ 1)."""
 
-    rigid: iso281.DutyCycleLife
+    rigid: iso281.DutyCycleLife | None
     flexible: iso281.DutyCycleLife
     flexible_fe: DutyCycleFE | None = None
 
@@ -574,13 +599,16 @@ class Analysis:
     theta : ndarray (n,)
         Crank angles of the cycle, rad.
     rigid : RigidAnalysis
-        The handbook evaluation at the same angles (``rigid.loads`` are the handbook curves).
-    classical : rvfem.rigid.PinForces
-        Classical rigid pin forces at the same angles (moment exact at every angle).
+        The handbook evaluation at the same angles (``rigid.loads`` are the handbook curves; NaN
+        where the handbook is not defined, Zp − Zc ≠ 1).
+    classical : rvfem.rigid.PinForces or None
+        Classical rigid pin forces at the same angles (moment exact at every angle); None where the
+        distribution does not hold (Zp − Zc ≠ 1, :func:`rvfem.rigid.classical_applicable`).
     cycle : rvfem.cycle.CycleResult
         The flexible load cycle.
     comparison : rvfem.compare.Comparison
-        Rigid, flexible and equal-share load statistics and lives per bearing.
+        Rigid, flexible and equal-share load statistics and lives per bearing; the deltas are
+        against ``references.bearing_loads``.
     stress : StressResult
     hertz : dict of str to rvfem.hertz.RollerHertz
         ``fe_rollers`` (bearing model ``rollers`` only), ``stribeck_rigid``, ``stribeck_flexible``.
@@ -593,8 +621,11 @@ class Analysis:
         ``cycle_per_angle``.
     attribution : rvfem.reducer.Attribution
         The flexibility effect step by step: handbook → equal share of the FE pin resultant →
-        one disc with T/discs → two discs sharing the carrier → crankshafts (those that apply);
-        ``attribution.final`` is the case's own model (``cycle``).
+        one disc with T/discs → two discs sharing the carrier → crankshafts (those that apply;
+        without the handbook where it is not defined); ``attribution.final`` is the case's own
+        model (``cycle``).
+    references : rvfem.rigid.References or None
+        The rigid references the run is compared with, and why (:func:`rvfem.rigid.references`).
     """
 
     case: Case
@@ -613,6 +644,7 @@ class Analysis:
     duty_cycle: DutyCycleResult | None = None
     timings: dict = field(default_factory=dict)
     attribution: Any = None
+    references: rigid.References | None = None
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -622,11 +654,31 @@ class Analysis:
         return max_load_index(self.cycle.bearing_forces)
 
     @property
-    def rigid_forces(self) -> np.ndarray:
+    def rigid_forces(self) -> np.ndarray | list[None]:
         """Handbook force of every bearing on the disc, (n, N, 2), N (the layout of
-        ``cycle.bearing_forces``)."""
+        ``cycle.bearing_forces``); where the handbook is not defined (Zp − Zc ≠ 1) a list of n
+        None, one per crank angle (nothing to draw or compare)."""
+        if not self.rigid.defined:
+            return [None] * len(self.theta)
         hb = self.rigid.loads
         return np.stack([hb.fx.T, hb.fy.T], axis=2)
+
+    @property
+    def equal_share_forces(self) -> np.ndarray:
+        """Equal share of the FE pin resultant for every bearing, (n, N, 2), N
+        (:func:`rvfem.compare.equal_share_forces`): the bearing-load reference for any tooth
+        difference."""
+        from .compare import equal_share_forces
+
+        return equal_share_forces(self.case, self.cycle)
+
+    @property
+    def reference_loads(self) -> np.ndarray:
+        """|F| of the bearing-load reference the deltas are against, (n, N), N: the handbook, or the
+        equal share of the FE pin resultant where the handbook is not defined."""
+        if self.comparison.reference == "handbook":
+            return np.asarray(self.rigid.loads.magnitude).T
+        return np.linalg.norm(self.equal_share_forces, axis=2)
 
     @property
     def pin_centres(self) -> np.ndarray:
@@ -787,10 +839,15 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     system = cycle_module.build_system(case, mesh)
     stages.end("model", t)
 
-    # the rigid model before the cycle: a case outside the handbook's assumptions fails fast
+    # the rigid model before the cycle: a case outside every rigid reference fails fast
     t = stages.start("rigid")
+    references = rigid.references(case)
+    if not (references.handbook.defined or references.equal_share.defined):
+        raise CaseError(f"{case.source}: {references.equal_share.why}")
     rigid_analysis = analyse_rigid(case, thetas)
-    classical = rigid.classical_pin_forces(case, thetas, exact_moment=True)
+    classical = (rigid.classical_pin_forces(case, thetas, exact_moment=True)
+                 if references.classical_pin_forces.defined else None)
+    log.info("%s: bearing loads compared with %s", case.name, rigid.REFERENCE_NAMES[references.bearing_loads])
     stages.end("rigid", t)
 
     n = len(thetas)
@@ -831,16 +888,20 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     history = postprocess.hot_spot_history(system, cycle, spots, factors)
     stress = StressResult(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
                           recovered=recovered, history=history)
-    # the first bearing among equals (the handbook curves are exact shifts of each other)
-    rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
+    if rigid_analysis.defined:
+        # the first bearing among equals (the handbook curves are exact shifts of each other)
+        rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
+        rigid_peak = (rigid_max.rigid.max_N, rigid_max.rigid.max_at_deg, rigid_max.bearing)
+    else:
+        rigid_peak = (None, None, None)
     roller_hertz = hertz.most_loaded_roller_hertz(case, cycle.theta, cycle.bearing_forces, cycle.roller_loads,
-                                                  rigid_max.rigid.max_N, rigid_max.rigid.max_at_deg,
-                                                  rigid_max.bearing)
+                                                  *rigid_peak)
     stiffness = cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm)
     duty = None
     if case.loads.duty_cycle:
         duty = DutyCycleResult(
-            rigid=iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings]),
+            rigid=(iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings])
+                   if rigid_analysis.defined else None),
             flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
     stages.seconds["evaluation"] += time.perf_counter() - t
     if duty is not None and duty_fe:
@@ -862,4 +923,4 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
                     theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
                     comparison=comparison, stress=stress, hertz=roller_hertz,
                     torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
-                    attribution=attribution)
+                    attribution=attribution, references=references)

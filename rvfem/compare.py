@@ -15,6 +15,10 @@ For every crank bearing, three load curves over one crank revolution are compare
 
 Deltas are in percent of the rigid values; the life ratio is L_flex/L_rigid = (F_m,rigid/F_m,flex)^(10/3)
 (ISO 281 life exponent for roller bearings), e.g. +15 % equivalent load costs about 37 % life.
+
+For a tooth difference Zp − Zc ≠ 1 the handbook model is not defined (:func:`rvfem.rigid.references`):
+``rigid`` is None and the deltas and life ratios are against ``equal_share``, the reference that
+exists for any tooth difference (:attr:`Comparison.reference` names it).
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ import numpy as np
 
 from . import iso281, rigid
 from .case import Case
+from .errors import CaseError
 from .cycle import CycleResult
 from .geometry import crank_centres
 from .rigid import BearingLoadSummary
@@ -35,10 +40,12 @@ __all__ = ["BearingComparison", "Comparison", "equal_share_forces", "rigid_vs_fl
 @dataclass(frozen=True)
 class BearingComparison:
     """One bearing: the three models (load statistics with their L10h, N, degrees, hours) and the
-    flexible-vs-rigid deltas (percent)."""
+    deltas (percent) of the flexible loads against the reference of :attr:`Comparison.reference`
+    (the handbook ``rigid``, or ``equal_share`` where the handbook is not defined; ``rigid`` is
+    then None)."""
 
     bearing: int
-    rigid: BearingLoadSummary
+    rigid: BearingLoadSummary | None
     flexible: BearingLoadSummary
     equal_share: BearingLoadSummary
     delta_max_percent: float
@@ -62,7 +69,11 @@ class Comparison:
         n_b, rpm.
     pin_resultant_ratio : float
         Mean |P_y/P_x| of the finite-element pin resultant over the cycle (the handbook's k_y).
-    handbook_k_y : float
+    handbook_k_y : float or None
+        None where the handbook is not defined (Zp − Zc ≠ 1).
+    reference : str
+        What the deltas and life ratios are against: ``"handbook"`` (the ``rigid`` statistics) or
+        ``"equal_share"`` (:attr:`rvfem.rigid.References.bearing_loads`).
     """
 
     bearings: tuple[BearingComparison, ...]
@@ -70,7 +81,8 @@ class Comparison:
     rating_N: float
     bearing_speed_rpm: float
     pin_resultant_ratio: float
-    handbook_k_y: float
+    handbook_k_y: float | None
+    reference: str = "handbook"
 
 
 def equal_share_forces(case: Case, result: CycleResult) -> np.ndarray:
@@ -103,27 +115,43 @@ def rigid_vs_flexible(case: Case, result: CycleResult) -> Comparison:
     case : Case
     result : CycleResult
         A full revolution sampled uniformly (the handbook curve is evaluated at the same angles).
+
+    Notes
+    -----
+    Where the handbook is not defined (Zp − Zc ≠ 1, :func:`rvfem.rigid.references`) the ``rigid``
+    statistics are None and the deltas are against the equal share.
+
+    Raises
+    ------
+    CaseError
+        Unequally spaced cranks: neither the handbook nor the equal share applies.
     """
     p = case.analysis.equivalent_load_exponent
     rating = iso281.crank_bearing_rating(case.crank_bearing)
     speed = iso281.case_bearing_speed_rpm(case)
     theta = result.theta
-    hb = rigid.handbook_bearing_loads(case, theta)
+    refs = rigid.references(case)
+    hb = rigid.handbook_bearing_loads(case, theta) if refs.handbook.defined else None
+    if not refs.equal_share.defined:   # unequally spaced cranks: no rigid reference at all
+        raise CaseError(f"{case.source}: {refs.equal_share.why}")
     flex = result.bearing_loads.T
     eq = np.linalg.norm(equal_share_forces(case, result), axis=2).T
-    rs, fs, es = (_stats(theta, m, p, rating, speed) for m in (hb.magnitude, flex, eq))
+    fs, es = (_stats(theta, m, p, rating, speed) for m in (flex, eq))
+    rs = _stats(theta, hb.magnitude, p, rating, speed) if hb is not None else [None] * len(fs)
     bearings = []
     for i, (r, f, e) in enumerate(zip(rs, fs, es)):
+        ref = r if refs.bearing_loads == "handbook" else e
         bearings.append(BearingComparison(
             bearing=i, rigid=r, flexible=f, equal_share=e,
-            delta_max_percent=100.0 * (f.max_N / r.max_N - 1.0),
-            delta_min_percent=100.0 * (f.min_N / r.min_N - 1.0),
-            delta_equivalent_percent=100.0 * (f.equivalent_N / r.equivalent_N - 1.0),
-            life_ratio=iso281.life_ratio(r.equivalent_N, f.equivalent_N),
+            delta_max_percent=100.0 * (f.max_N / ref.max_N - 1.0),
+            delta_min_percent=100.0 * (f.min_N / ref.min_N - 1.0),
+            delta_equivalent_percent=100.0 * (f.equivalent_N / ref.equivalent_N - 1.0),
+            life_ratio=iso281.life_ratio(ref.equivalent_N, f.equivalent_N),
         ))
     # pin resultant in the eccentric's frame: P_x ⟂ eccentric, P_y along it
     p_res = -result.bearing_forces.sum(axis=1)
     u = np.stack([np.cos(theta), np.sin(theta)], axis=1)
     u_perp = np.stack([-np.sin(theta), np.cos(theta)], axis=1)
     ratio = float(np.mean(np.abs(np.einsum("ij,ij->i", p_res, u) / np.einsum("ij,ij->i", p_res, u_perp))))
-    return Comparison(tuple(bearings), p, rating, speed, ratio, hb.components.k_y)
+    return Comparison(tuple(bearings), p, rating, speed, ratio, None if hb is None else hb.components.k_y,
+                      refs.bearing_loads)

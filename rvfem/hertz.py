@@ -309,7 +309,7 @@ def _case_contacts(case: Case, q: float) -> tuple[HertzLineContact, HertzLineCon
 
 
 def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.ndarray,
-                             roller_loads: np.ndarray | None, rigid_max_N: float,
+                             roller_loads: np.ndarray | None, rigid_max_N: float | None,
                              rigid_max_at_deg: float | None = None,
                              rigid_max_bearing: int | None = None) -> dict[str, RollerHertz]:
     """Hertz pressures of the most loaded roller of a load cycle, from the FE roller loads and from
@@ -325,8 +325,9 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
         FE force of every bearing on the disc, N.
     roller_loads : ndarray (n, N, Z) or None
         FE roller loads, N (None for a bearing model without discrete rollers).
-    rigid_max_N : float
-        Largest handbook bearing load over the cycle, N.
+    rigid_max_N : float or None
+        Largest handbook bearing load over the cycle, N; None where the handbook is not defined
+        (Zp − Zc ≠ 1).
     rigid_max_at_deg : float, optional
         Its crank angle, degrees.
     rigid_max_bearing : int, optional
@@ -335,8 +336,8 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
     Returns
     -------
     dict of str to RollerHertz
-        ``"stribeck_rigid"`` and ``"stribeck_flexible"`` always (Q_max = 4.6·F_max/Z, Gao et al.'s
-        eq. 21), ``"fe_rollers"`` when ``roller_loads`` is given.
+        ``"stribeck_flexible"`` always and ``"stribeck_rigid"`` with a handbook load (Q_max =
+        4.6·F_max/Z, Gao et al.'s eq. 21), ``"fe_rollers"`` when ``roller_loads`` is given.
     """
     z = case.crank_bearing.rollers
     out = {}
@@ -345,9 +346,10 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
         q = float(roller_loads[k, i, j])
         out["fe_rollers"] = RollerHertz("fe_rollers", q, *_case_contacts(case, q), bearing=int(i), roller=int(j),
                                         theta_deg=math.degrees(float(theta[k])))
-    q = stribeck_max_roller_load(rigid_max_N, z)
-    out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_case_contacts(case, q), bearing=rigid_max_bearing,
-                                        theta_deg=rigid_max_at_deg)
+    if rigid_max_N is not None:
+        q = stribeck_max_roller_load(rigid_max_N, z)
+        out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_case_contacts(case, q),
+                                            bearing=rigid_max_bearing, theta_deg=rigid_max_at_deg)
     loads = np.linalg.norm(bearing_forces, axis=2)
     k, i = np.unravel_index(int(np.argmax(loads)), loads.shape)
     q = stribeck_max_roller_load(float(np.linalg.norm(bearing_forces[k, i])), z)

@@ -61,6 +61,7 @@ __all__ = [
     "build_summary",
     "summary_text",
     "stress_lines",
+    "reference_lines",
     "rigid_summary",
     "rigid_text",
     "write_case_json",
@@ -390,11 +391,23 @@ def _piece_model(a, ctx: SummaryContext) -> dict:
     }}
 
 
+def _references_dict(refs) -> dict:
+    """The ``references`` object of ``summary.json`` and ``rvfem rigid --json``."""
+    return {
+        "bearing_loads": refs.bearing_loads,
+        **{key: {"defined": ref.defined, "why": ref.why} for key, ref in refs.items()},
+    }
+
+
+def _piece_references(a, ctx: SummaryContext) -> dict:
+    return {"references": _references_dict(a.references)}
+
+
 def _piece_bearings(a, ctx: SummaryContext) -> dict:
     bearings = [{
         "bearing": bc.bearing + 1,
         "crank_angle_deg": a.case.cranks.angles_deg[bc.bearing],
-        "rigid": _stats_dict(bc.rigid),
+        "rigid": None if bc.rigid is None else _stats_dict(bc.rigid),
         "flexible": _stats_dict(bc.flexible),
         "equal_share": _stats_dict(bc.equal_share),
         "delta_max_percent": bc.delta_max_percent,
@@ -493,7 +506,7 @@ def _piece_hertz(a, ctx: SummaryContext) -> dict:
     return {"hertz": {
         "stribeck_factor": STRIBECK_FACTOR,
         "fe_rollers": _hertz_dict(h["fe_rollers"]) if "fe_rollers" in h else None,
-        "stribeck_rigid": _hertz_dict(h["stribeck_rigid"]),
+        "stribeck_rigid": _hertz_dict(h["stribeck_rigid"]) if "stribeck_rigid" in h else None,
         "stribeck_flexible": _hertz_dict(h["stribeck_flexible"]),
     }}
 
@@ -503,7 +516,7 @@ def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
         return {}
     fe = a.duty_cycle.flexible_fe
     return {"duty_cycle": {
-        "rigid": dataclasses.asdict(a.duty_cycle.rigid),
+        "rigid": None if a.duty_cycle.rigid is None else dataclasses.asdict(a.duty_cycle.rigid),
         "flexible": dataclasses.asdict(a.duty_cycle.flexible),
         "flexible_fe": None if fe is None else {
             "torques_Nm": list(fe.torques_Nm),
@@ -573,6 +586,7 @@ def _piece_files(a, ctx: SummaryContext) -> dict:
 SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_header,
     _piece_model,
+    _piece_references,
     _piece_bearings,
     _piece_cycle,
     _piece_stress,
@@ -634,16 +648,20 @@ def write_case_json(analysis, folder: str | os.PathLike) -> list[Path]:
 
 def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
     """Write the CSV tables of the load cycle (:mod:`rvfem.tables`): ``bearing_loads.csv``,
-    ``roller_loads.csv`` (discrete rollers only), ``pin_forces.csv``, ``cycle.csv``."""
+    ``roller_loads.csv`` (discrete rollers only), ``pin_forces.csv``, ``cycle.csv``. The handbook
+    and classical columns are NaN where those references are not defined (Zp − Zc ≠ 1)."""
     from . import tables
 
     folder = Path(folder)
     a, cy, th = analysis, analysis.cycle, analysis.theta
-    out = [tables.write_bearing_loads(folder / "bearing_loads.csv", th, cy.bearing_forces, a.rigid_forces)]
+    hb = a.rigid.loads   # NaN where the handbook is not defined
+    out = [tables.write_bearing_loads(folder / "bearing_loads.csv", th, cy.bearing_forces,
+                                      np.stack([hb.fx.T, hb.fy.T], axis=2), a.equal_share_forces)]
     if cy.roller_loads is not None:
         out.append(tables.write_roller_loads(folder / "roller_loads.csv", th, cy.roller_angles, cy.roller_loads))
-    out.append(tables.write_pin_forces(folder / "pin_forces.csv", th, a.pin_centres, cy.pin_forces,
-                                       a.classical.magnitude.T))
+    classical = (np.full(cy.pin_forces.shape, np.nan) if a.classical is None  # not defined for Zp − Zc ≠ 1
+                 else a.classical.magnitude.T)
+    out.append(tables.write_pin_forces(folder / "pin_forces.csv", th, a.pin_centres, cy.pin_forces, classical))
     out.append(tables.write_cycle_table(folder / "cycle.csv", th, cy.pins_in_contact, cy.carrier_rotation,
                                         cy.equilibrium_residual, cy.iterations))
     if a.stress.history is not None:
@@ -777,8 +795,9 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
 
 
 def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
-    """Draw ``plots/``: bearing loads over θ (rigid vs flexible), roller loads and pin forces at the
-    angle of the largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
+    """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
+    the equal share where it is not defined), roller loads and pin forces at the angle of the
+    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
     from . import plots
 
     a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
@@ -786,17 +805,22 @@ def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
     folder.mkdir(exist_ok=True)
     k_max, _ = a.max_load_index
     th_max = math.degrees(float(th[k_max]))
-    classical = a.classical.magnitude
+    classical = None if a.classical is None else a.classical.magnitude
+    handbook = a.comparison.reference == "handbook"
+    label = "rigid (handbook)" if handbook else "equal share of the FE pin resultant"
     out = [plots.bearing_loads_plot(
-        folder / "bearing_loads.png", th, cy.bearing_loads, a.rigid.loads.magnitude.T,
-        title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs rigid handbook")]
+        folder / "bearing_loads.png", th, cy.bearing_loads, a.reference_loads, reference_label=label,
+        title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs "
+              + ("rigid handbook" if handbook else "equal share (handbook not defined for Zp − Zc ≠ 1)"))]
     if cy.roller_loads is not None:
         out.append(plots.roller_loads_plot(folder / "roller_loads.png", cy.roller_angles[k_max],
                                            cy.roller_loads[k_max], cy.bearing_forces[k_max], theta_deg=th_max))
     out.append(plots.pin_forces_plot(folder / "pin_forces.png", np.arange(1, case.pins.count + 1),
-                                     cy.pin_forces[k_max], classical[:, k_max], theta_deg=th_max))
+                                     cy.pin_forces[k_max], None if classical is None else classical[:, k_max],
+                                     theta_deg=th_max))
     out.append(plots.pins_in_contact_plot(folder / "pins_in_contact.png", th, cy.pins_in_contact, case.pins.count,
-                                          classical=np.count_nonzero(classical > 0, axis=0)))
+                                          classical=None if classical is None
+                                          else np.count_nonzero(classical > 0, axis=0)))
     return out
 
 
@@ -845,20 +869,30 @@ def summary_text(summary: dict) -> str:
         f"  {'bearing':>7} {'model':<9} {'max N':>8} {'at °':>6} {'min N':>8} {'at °':>6} {'F_m N':>8} {'L10h h':>9}",
     ]
 
+    refs = summary["references"]
+    handbook = refs["bearing_loads"] == "handbook"
+    rows = ("rigid", "flexible") if handbook else ("rigid", "equal_share", "flexible")
+    names = {"rigid": "rigid", "flexible": "flexible", "equal_share": "eq. share"}
     for b in summary["bearings"]:
-        for key in ("rigid", "flexible"):
+        for key in rows:
             s = b[key]
-            lines.append(f"  {b['bearing'] if key == 'rigid' else '':>7} {key:<9} {_num(s['max_load_N'], '8.0f')} "
+            head = f"  {b['bearing'] if key == 'rigid' else '':>7} {names[key]:<9} "
+            if s is None:
+                lines.append(head + "not defined for Zp − Zc ≠ 1")
+                continue
+            lines.append(head + f"{_num(s['max_load_N'], '8.0f')} "
                          f"{_num(s['max_at_deg'], '6.1f')} {_num(s['min_load_N'], '8.0f')} {_num(s['min_at_deg'], '6.1f')} "
                          f"{_num(s['equivalent_load_N'], '8.0f')} {_num(s['L10h_h'], '9.0f')}")
         lines.append(f"  {'':>7} {'delta':<9} {_num(b['delta_max_percent'], '+7.1f')}% {'':>6} "
                      f"{_num(b['delta_min_percent'], '+7.1f')}% {'':>6} {_num(b['delta_equivalent_percent'], '+7.1f')}%  "
-                     f"life ratio {_num(b['life_ratio'], '.2f')}")
+                     f"life ratio {_num(b['life_ratio'], '.2f')}" + ("" if handbook else "  (vs equal share)"))
+    lines += [""] + reference_lines(refs)
     rs = summary["reducer_stage"]
     lines += ["", f"  reducer stage: {rs['model']}"]
     if rs["torque_share"]:
         lines[-1] += (f"; torque of disc A {rs['torque_share']['min']:.3f}–{rs['torque_share']['max']:.3f} × T/2")
-    lines.append(f"  what the delta of bearing 1 is made of (against the handbook):")
+    lines.append(f"  what the delta of bearing 1 is made of (against the "
+                 f"{'handbook' if handbook else 'equal share of the FE pin resultant'}):")
     for r in summary["attribution"]:
         if r["bearing"] == 1:
             lines.append(f"    {r['step']:<12} max {_num(r['delta_max_percent'], '+6.1f')}%  min "
@@ -872,8 +906,9 @@ def summary_text(summary: dict) -> str:
         f"N·m/arcmin per disc; equilibrium residual {summary['equilibrium_residual']:.1e}",
     ]
     sr = h["stribeck_rigid"]
-    hertz = (f"  Hertz, most loaded roller: rigid Stribeck Q = {sr['roller_load_N']:.0f} N, p_in "
-             f"{sr['inner']['peak_pressure_MPa']:.0f} / p_out {sr['outer']['peak_pressure_MPa']:.0f} MPa")
+    hertz = ("  Hertz, most loaded roller: " + (
+        f"rigid Stribeck Q = {sr['roller_load_N']:.0f} N, p_in {sr['inner']['peak_pressure_MPa']:.0f} / p_out "
+        f"{sr['outer']['peak_pressure_MPa']:.0f} MPa" if sr else "rigid Stribeck not defined for Zp − Zc ≠ 1"))
     if fe:
         hertz += (f"; FE Q = {fe['roller_load_N']:.0f} N, p_in {fe['inner']['peak_pressure_MPa']:.0f} / p_out "
                   f"{fe['outer']['peak_pressure_MPa']:.0f} MPa")
@@ -885,9 +920,10 @@ def summary_text(summary: dict) -> str:
     duty = summary.get("duty_cycle")
     if duty:
         lines.append("  duty cycle: service life " + ", ".join(
-            f"{key} {_num(duty[key]['service_life_h'], '.0f')} h" for key in ("rigid", "flexible"))
-            + f" (equivalent torque {duty['rigid']['equivalent_torque_Nm']:.1f} N·m, "
-              f"speed {duty['rigid']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
+            f"{key} {_num(duty[key]['service_life_h'], '.0f')} h" if duty[key] else f"{key} not defined"
+            for key in ("rigid", "flexible"))
+            + f" (equivalent torque {duty['flexible']['equivalent_torque_Nm']:.1f} N·m, "
+              f"speed {duty['flexible']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
         fe = duty.get("flexible_fe")
         if fe:
             lines.append(
@@ -899,6 +935,23 @@ def summary_text(summary: dict) -> str:
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")
     return "\n".join(lines)
+
+
+def reference_lines(references: dict) -> list[str]:
+    """What a run or the rigid evaluation is compared with, and why (the ``references`` object of
+    ``summary.json`` or ``rvfem rigid --json``), as screen lines."""
+    from .rigid import REFERENCE_NAMES
+
+    used = [k for k, r in references.items() if isinstance(r, dict) and r["defined"]]
+    main = references["bearing_loads"]
+    head = (f"bearing loads compared with {REFERENCE_NAMES[main]}" if main in used else
+            "no bearing-load reference computed here")
+    others = [REFERENCE_NAMES[k] for k in used if k != main]
+    lines = ["  references: " + head + ("; also " + ", ".join(others) if others else "")]
+    for key, r in references.items():   # why the reference is not the handbook, why others are missing
+        if isinstance(r, dict) and (not r["defined"] or (key == references["bearing_loads"] != "handbook")):
+            lines.append(f"    {REFERENCE_NAMES[key]}: {r['why']}")
+    return lines
 
 
 def stress_lines(stress: dict) -> list[str]:
@@ -947,7 +1000,14 @@ def rigid_summary(result) -> dict:
         "hertz_inner": dataclasses.asdict(b.hertz_inner),
         "hertz_outer": dataclasses.asdict(b.hertz_outer),
     } for b in result.bearings]
+    if not result.defined:   # the handbook is not defined (Zp − Zc ≠ 1): the same keys, null
+        bearings = [{
+            "bearing": i + 1, "crank_angle_deg": angle, "max_load_N": None, "max_at_deg": None, "min_load_N": None,
+            "min_at_deg": None, "equivalent_load_N": None, "L10h_h": None, "max_roller_load_N": None,
+            "hertz_inner": None, "hertz_outer": None,
+        } for i, angle in enumerate(case.cranks.angles_deg)]
     from .case import file_sha256
+    from .rigid import references
 
     source = Path(case.source.removesuffix(" (with overrides)"))
     report = {
@@ -972,10 +1032,11 @@ def rigid_summary(result) -> dict:
         "angle_step_deg": result.angle_step_deg,
         "dynamic_load_rating_N": result.rating_N,
         "stribeck_factor": result.stribeck_factor,
+        "references": _references_dict(result.references or references(case, fe=False)),
         "bearings": bearings,
     }
-    if result.duty_cycle is not None:
-        report["duty_cycle"] = dataclasses.asdict(result.duty_cycle)
+    if case.loads.duty_cycle:
+        report["duty_cycle"] = None if result.duty_cycle is None else dataclasses.asdict(result.duty_cycle)
     return json_ready(report)
 
 
@@ -984,20 +1045,27 @@ def rigid_text(report: dict) -> str:
 
     p = report["equivalent_load_exponent"]
     p_text = "10/3" if math.isclose(p, 10.0 / 3.0) else f"{p:g}"
+    defined = report["references"]["handbook"]["defined"]
     lines = [
         f"Case {report['case']} ({report['source']}): {report['model']}",
         f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {report['disc_torque_Nmm'] / 1000:g} N·m, "
         f"output speed {report['output_speed_rpm']:g} rpm, bearing speed {report['bearing_speed_rpm']:g} rpm",
-        f"  k = {report['k']:.4f}, k_y = {report['k_y']:.4f}, ΣPx = {report['sum_px_N']:.1f} N, "
-        f"ΣPy = {report['sum_py_N']:.1f} N, crank-angle step {report['angle_step_deg']:g}°",
+        f"  k = {report['k']:.4f}, k_y = {_num(report['k_y'], '.4f')}, ΣPx = {_num(report['sum_px_N'], '.1f')} N, "
+        f"ΣPy = {_num(report['sum_py_N'], '.1f')} N, crank-angle step {report['angle_step_deg']:g}°",
         f"  dynamic load rating C = {report['dynamic_load_rating_N']:.1f} N; equivalent load exponent p = {p_text}",
     ]
     if report.get("overrides"):
         lines.append(f"  overrides: {', '.join(report['overrides'])}")
+    if not defined:
+        lines += reference_lines(report["references"])
     header = (f"{'bearing':>7} {'max N':>9} {'at °':>6} {'min N':>9} {'at °':>6} {'F_m N':>9} "
               f"{'L10h h':>9} {'Q_max N':>8} {'p_in MPa':>9} {'p_out MPa':>9}")
     lines += ["", header, "-" * len(header)]
     for b in report["bearings"]:
+        if b["max_load_N"] is None and not defined:
+            lines.append(f"{b['bearing']:>7d}  not defined for Zp − Zc ≠ 1 (rvfem run compares the FE with the "
+                         "equal share)")
+            continue
         lines.append(
             f"{b['bearing']:>7d} {b['max_load_N']:9.1f} {b['max_at_deg']:6.1f} {b['min_load_N']:9.1f} "
             f"{b['min_at_deg']:6.1f} {b['equivalent_load_N']:9.1f} {_num(b['L10h_h'], '9.0f')} "
@@ -1010,6 +1078,8 @@ def rigid_text(report: dict) -> str:
         "(p_in: eccentric, p_out: disc bore)",
     ]
     duty = report.get("duty_cycle")
+    if "duty_cycle" in report and duty is None:
+        lines.append("  duty cycle: service life not defined (no handbook bearing lives for Zp − Zc ≠ 1)")
     if duty:
         lines.append(
             f"  duty cycle: equivalent torque {duty['equivalent_torque_Nm']:.1f} N·m, equivalent speed "

@@ -42,8 +42,8 @@ def _degree_axis(ax) -> None:
 
 
 def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.ndarray, rigid: np.ndarray, *,
-                       title: str = "") -> Path:
-    """Bearing load |F| over the crank angle, flexible (solid) and rigid handbook (dashed).
+                       title: str = "", reference_label: str = "rigid (handbook)") -> Path:
+    """Bearing load |F| over the crank angle, flexible (solid) and a rigid reference (dashed).
 
     Parameters
     ----------
@@ -52,8 +52,11 @@ def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.
     theta : ndarray (n,)
         Crank angles, rad.
     flexible, rigid : ndarray (n, N)
-        |F| of each bearing, N.
+        |F| of each bearing, N: FE and the reference (the handbook, or the equal share of the FE pin
+        resultant where the handbook is not defined).
     title : str
+    reference_label : str
+        The reference in the legend.
     """
     fig = _figure((10.0, 5.2))
     ax = fig.subplots()
@@ -62,7 +65,7 @@ def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.
     for i in range(flexible.shape[1]):
         c = COLOURS[i % len(COLOURS)]
         ax.plot(deg[order], flexible[order, i], color=c, lw=1.8, label=f"bearing {i + 1}, flexible (FE)")
-        ax.plot(deg[order], rigid[order, i], color=c, lw=1.2, ls="--", label=f"bearing {i + 1}, rigid (handbook)")
+        ax.plot(deg[order], rigid[order, i], color=c, lw=1.2, ls="--", label=f"bearing {i + 1}, {reference_label}")
     _degree_axis(ax)
     ax.set_ylabel("bearing load |F| [N]")
     ax.set_ylim(bottom=0.0)
@@ -113,7 +116,7 @@ def roller_loads_plot(path: str | os.PathLike, roller_angles: np.ndarray, roller
     return _save(fig, path)
 
 
-def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarray, classical: np.ndarray, *,
+def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarray, classical: np.ndarray | None, *,
                     theta_deg: float, title: str = "") -> Path:
     """Pin forces at one crank angle: FE (bars) against the classical rigid distribution (line).
 
@@ -123,21 +126,26 @@ def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarr
     pin_index : ndarray (Zp,)
         Pin numbers (1-based) to label the x axis.
     fe, classical : ndarray (Zp,)
-        Pin force magnitudes, N.
+        Pin force magnitudes, N; ``classical`` None where the distribution is not defined
+        (Zp − Zc ≠ 1): the FE bars alone.
     theta_deg : float
     title : str
     """
     fig = _figure((10.0, 4.8))
     ax = fig.subplots()
     ax.bar(pin_index, fe, width=0.7, color="tab:blue", label="FE (flexible disc)")
-    ax.plot(pin_index, classical, "o-", color="tab:red", ms=3.5, lw=1.2,
-            label="classical rigid distribution (moment exact)")
+    if classical is not None:
+        ax.plot(pin_index, classical, "o-", color="tab:red", ms=3.5, lw=1.2,
+                label="classical rigid distribution (moment exact)")
+        other = f"classical: {int(np.count_nonzero(classical > 0))}"
+    else:
+        other = "classical distribution not defined for Zp − Zc ≠ 1"
     ax.set_xlabel("pin number")
     ax.set_ylabel("pin force [N]")
     ax.set_xlim(pin_index.min() - 0.8, pin_index.max() + 0.8)
     ax.grid(True, axis="y", lw=0.4, alpha=0.6)
     ax.set_title(title or f"Pin forces at θ = {theta_deg:.1f}° (FE: {int(np.count_nonzero(fe > 0))} pins in "
-                          f"contact, classical: {int(np.count_nonzero(classical > 0))})")
+                          f"contact, {other})")
     ax.legend(fontsize=9)
     fig.tight_layout()
     return _save(fig, path)

@@ -530,7 +530,8 @@ class Attribution:
 
     def table(self, exponent: float) -> list[dict]:
         """Per step and bearing: max, min and equivalent load (N) and their deltas against the
-        handbook (%), and the life ratio (F_hb,m/F_m)^(10/3)."""
+        first step (%), and the life ratio (F_ref,m/F_m)^(10/3). The first step is the handbook, or
+        the equal share where the handbook is not defined (Zp − Zc ≠ 1)."""
         from .evaluation import life_ratio
         from .rigid import equivalent_load
 
@@ -556,6 +557,8 @@ class Attribution:
 STEP_LABELS = {
     "handbook": "handbook (rigid disc, classical pin forces, T/2 per disc)",
     "equal_share": "equal share of the FE pin resultant (pin-force distribution of the flexible disc)",
+    "equal_share_reference": "equal share of this run's FE pin resultant (the reference: handbook not defined "
+                             "for Zp − Zc ≠ 1)",
     "one_disc": "one flexible disc with T/2 on rigid eccentrics (bearing load sharing)",
     "two_discs": "two discs sharing the carrier, rigid crank support",
     "crankshafts": "two discs sharing the carrier, crankshafts as beams",
@@ -577,11 +580,15 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     Notes
     -----
     The equal share is built from the one-disc cycle's pin resultant (the handbook's load sharing
-    applied to the flexible disc's pin forces): F_i = −P/N + T_disc/(N·r0)·t_i.
+    applied to the flexible disc's pin forces): F_i = −P/N + T_disc/(N·r0)·t_i. Where the handbook
+    is not defined (Zp − Zc ≠ 1, :func:`rvfem.rigid.handbook_applicable`) the chain starts at the
+    reference the run's bearing loads are compared with instead, the equal share of the case's own
+    cycle's pin resultant (:func:`rvfem.compare.rigid_vs_flexible`), so that the last row's deltas
+    are the run's.
     """
     from .cycle import load_cycle
     from .compare import equal_share_forces
-    from .rigid import handbook_bearing_loads
+    from .rigid import handbook_applicable, handbook_bearing_loads
 
     case = system.case
     cycles = dict(cycles or {})
@@ -600,10 +607,13 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
         else:
             stage = build_stage(system, discs=discs, influence=f if key == "crankshafts" else None)
         cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
-    steps = [AttributionStep("handbook", STEP_LABELS["handbook"],
-                             handbook_bearing_loads(case, thetas).magnitude)]
-    share = np.linalg.norm(equal_share_forces(case, cycles["one_disc"]), axis=2).T
-    steps.append(AttributionStep("equal_share", STEP_LABELS["equal_share"], share))
+    if handbook_applicable(case)[0]:
+        steps = [AttributionStep("handbook", STEP_LABELS["handbook"], handbook_bearing_loads(case, thetas).magnitude)]
+        base, label = cycles["one_disc"], STEP_LABELS["equal_share"]
+    else:   # Zp − Zc ≠ 1: start at the run's own reference
+        steps, base, label = [], cycles[case_step(case)], STEP_LABELS["equal_share_reference"]
+    share = np.linalg.norm(equal_share_forces(case, base), axis=2).T
+    steps.append(AttributionStep("equal_share", label, share))
     for key in need:
         steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
     return Attribution(np.asarray(thetas), tuple(steps), case_step(case))

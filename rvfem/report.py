@@ -84,6 +84,7 @@ def assumptions(summary: dict, case: Case) -> list[str]:
     from .registry import bearing_model, pin_model
 
     m = summary["model"]
+    handbook = summary["references"]["bearing_loads"] == "handbook"
     # each model states its own assumptions (rvfem.models)
     bearing = (f"Crank bearings: bearing model <b>{_e(m['bearing_model'])}</b> — "
                f"{_e(bearing_model(m['bearing_model'])(case).describe())}.")
@@ -122,16 +123,20 @@ def assumptions(summary: dict, case: Case) -> list[str]:
         bearing,
         "Carrier: one rigid body that only rotates, about the disc centre in the disc frame; its rotation is the "
         "unknown conjugate to the disc torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
-        "Rigid reference: the handbook model (Gao et al., eqs. 4-10; rigid disc, rigid bearings, equal load sharing, "
-        f"pin-force resultant ratio k_y = {m['handbook_k_y']:.3f}), evaluated at the same crank angles. The FE "
-        f"pin-force resultant ratio |P_y/P_x| comes out {m['fe_pin_resultant_ratio']:.3f} on average.",
+        ("Rigid reference: the handbook model (Gao et al., eqs. 4-10; rigid disc, rigid bearings, equal load sharing, "
+         f"pin-force resultant ratio k_y = {m['handbook_k_y']:.3f}), evaluated at the same crank angles. "
+         if handbook else
+         "Rigid reference: the equal share of the FE pin resultant (rigid disc on rigid, equally loaded eccentrics); "
+         "the handbook model is not defined for Zp − Zc ≠ 1. ")
+        + f"The FE pin-force resultant ratio |P_y/P_x| comes out {m['fe_pin_resultant_ratio']:.3f} on average.",
         f"Life: ISO 281 dynamic load rating C = {m['dynamic_load_rating_N']:.0f} N, equivalent load "
         f"F_m = (mean F^p)^(1/p) with p = {m['equivalent_load_exponent']:.4g} over a uniformly sampled turn, "
         f"L10h = 10⁶/(60·n_b)·(C/F_m)^(10/3), bearing speed n_b = {m['bearing_speed_rpm']:g} rpm; life ratio "
-        "= L_flex/L_rigid.",
+        + ("= L_flex/L_rigid." if handbook else "= L_flex/L_equal_share."),
         f"Hertz: line contact of the most loaded roller on the eccentric (convex, inner) and in the bore (concave, "
         f"outer), from the largest FE roller load and from Stribeck's Q_max = {summary['hertz']['stribeck_factor']:g}·F/Z "
-        "with the rigid (handbook) and the FE bearing load.",
+        + ("with the rigid (handbook) and the FE bearing load." if handbook else
+           "with the FE bearing load (no handbook load for Zp − Zc ≠ 1)."),
         "Stresses: vertex values are area-weighted averages of the adjacent element stresses. Pin and roller forces "
         "are spread over a footprint of about 1.5 elements, so the stress right under a contact depends on the mesh "
         "and is not the Hertz contact stress (see the Hertz table for that); the \"away from contacts\" peak "
@@ -147,6 +152,22 @@ def assumptions(summary: dict, case: Case) -> list[str]:
         "Images: deformation with the disc's rigid-body motion removed, magnified by the factor written on the "
         "image; pins drawn at their nominal positions at that angle (dark: in contact).",
     ]
+
+
+def _references_html(refs: dict) -> str:
+    """Which rigid references the run is compared with, and why (the ``references`` object)."""
+    from .rigid import REFERENCE_NAMES
+
+    main = refs["bearing_loads"]
+    items = []
+    for key, r in refs.items():
+        if not isinstance(r, dict):
+            continue
+        state = ("<b>compared with (deltas)</b>" if key == main else "compared with") if r["defined"] else \
+            "<b>not used</b>"
+        items.append(f"<li>{_e(REFERENCE_NAMES[key])}: {state} — {_e(r['why'])}</li>")
+    return ("<p>References: the flexible bearing loads are compared with <b>"
+            f"{_e(REFERENCE_NAMES[main])}</b>.</p><ul>" + "".join(items) + "</ul>")
 
 
 def _depends_on(summary: dict, case: Case) -> str:
@@ -272,11 +293,22 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
                  f"{summary['timings_s']['total']:.1f} s.</p>")
 
     # -- results ---------------------------------------------------------------------------------
-    parts.append("<h2>Crank-bearing loads and lives: rigid handbook vs flexible disc</h2>")
+    refs = summary["references"]
+    handbook = refs["bearing_loads"] == "handbook"
+    ref_word = "rigid" if handbook else "equal-share"
+    parts.append("<h2>Crank-bearing loads and lives: "
+                 + ("rigid handbook" if handbook else "equal share of the FE pin resultant")
+                 + " vs flexible disc</h2>")
+    parts.append(_references_html(refs))
     rows, classes = [], []
+    keys = ("rigid", "flexible") if handbook else ("rigid", "equal_share", "flexible")
     for b in summary["bearings"]:
-        for key in ("rigid", "flexible"):
+        for key in keys:
             s = b[key]
+            if s is None:
+                rows.append([f"{b['bearing']}", key, "not defined for Zp − Zc ≠ 1"] + [""] * 9)
+                classes.append("")
+                continue
             rows.append([f"{b['bearing']}" if key == "rigid" else "", key, _num(s["max_load_N"], ".0f"),
                          _num(s["max_at_deg"]), _num(s["min_load_N"], ".0f"), _num(s["min_at_deg"]),
                          _num(s["equivalent_load_N"], ".0f"), _num(s["L10h_h"], ".0f"),
@@ -286,9 +318,12 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
                          _num(b["life_ratio"], ".3f") if key == "flexible" else ""])
             classes.append("flex" if key == "flexible" else "")
     parts.append(_table(["bearing", "model", "max N", "at °", "min N", "at °", "F_m N", "L10h h", "Δmax",
-                         "Δmin", "ΔF_m", "L_flex/L_rigid"], rows, left=2, classes=classes))
+                         "Δmin", "ΔF_m", f"L_flex/L_{'rigid' if handbook else 'equal_share'}"], rows, left=2,
+                        classes=classes))
     parts.append("<p class='meta'>Angles are crank angles θ (eccentric relative to the carrier). Deltas in % of "
-                 "the rigid value. The equal-share reference (FE pin resultant shared equally) is in summary.json.</p>")
+                 f"the {ref_word} value. "
+                 + ("The equal-share reference (FE pin resultant shared equally) is in summary.json.</p>"
+                    if handbook else "</p>"))
 
     st = summary["stress"]
     sp, away, cz = st.get("structural_peak"), st.get("away_from_contacts"), st["contact_zone"]
@@ -334,7 +369,8 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
     labels = dict.fromkeys((r["step"], r["label"]) for r in summary["attribution"])
     parts.append(
         "<h2>What the flexibility delta is made of</h2><p>Each step adds one modelling effect, on the same "
-        "crank angles and the same disc model; deltas are against the handbook. "
+        "crank angles and the same disc model; deltas are against the "
+        + ("handbook. " if handbook else "equal share (the handbook is not defined for Zp − Zc ≠ 1). ")
         + "; ".join(f"<b>{_e(k)}</b>: {_e(v)}" for k, v in labels) + ".</p>"
         + _table(["step", "bearing", "max N", "Δmax %", "min N", "Δmin %", "F_m N", "ΔF_m %", "life ratio"], rows))
     parts.append(_depends_on(summary, case))
@@ -362,7 +398,8 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
         parts.append("<h3>Duty cycle (Palmgren–Miner)</h3>" + _table(
             ["model", "rated life h", "equivalent torque N·m", "equivalent speed rpm", "service life h"],
             [[k, _num(d[k]["rated_life_h"], ".0f"), _num(d[k]["equivalent_torque_Nm"]),
-              _num(d[k]["equivalent_speed_rpm"], ".2f"), _num(d[k]["service_life_h"], ".0f")] for k in ("rigid", "flexible")],
+              _num(d[k]["equivalent_speed_rpm"], ".2f"), _num(d[k]["service_life_h"], ".0f")] if d[k] else
+             [k, "not defined for Zp − Zc ≠ 1", "", "", ""] for k in ("rigid", "flexible")],
             left=1))
         parts.append("<p class='meta'>Both lives scale the rated life with (T_i/T0)^(10/3) (Gao et al. eq. 18): "
                      "they assume the bearing loads grow linearly with the torque.</p>")
@@ -380,10 +417,12 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
     pl = summary.get("plots", {})
     parts.append("<h2>Plots</h2><div class='grid'>")
     parts.append(_figure(root, pl.get("bearing_loads"), "Bearing load over the crank angle: flexible (solid) "
-                                                        "and rigid handbook (dashed)."))
+                         + ("and rigid handbook (dashed)." if handbook else
+                            "and the equal share of the FE pin resultant (dashed).")))
     parts.append(_figure(root, pl.get("pins_in_contact"), "Number of pins in contact over the crank angle."))
     parts.append(_figure(root, pl.get("pin_forces"), "Pin forces at the angle of the largest bearing load: FE vs "
-                                                     "the classical rigid distribution."))
+                         + ("the classical rigid distribution." if refs["classical_pin_forces"]["defined"] else
+                            "no rigid reference (the classical distribution is not defined for Zp − Zc ≠ 1).")))
     parts.append(_figure(root, pl.get("roller_loads"), "Roller loads at the angle of the largest bearing load."))
     parts.append("</div>")
     im = summary.get("images", {})

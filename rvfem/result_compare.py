@@ -118,14 +118,14 @@ def _ratio(b: float | None, a: float | None) -> float | None:
 def _overall(r: ResultFolder) -> dict:
     s = r.summary
     flex = [b["flexible"] for b in s["bearings"]]
-    rigid = [b["rigid"] for b in s["bearings"]]
+    rigid = [b["rigid"] for b in s["bearings"] if b.get("rigid")]   # none for Zp − Zc ≠ 1
     away = (s.get("stress") or {}).get("away_from_contacts") or {}
     return {
         "max_load_N": max(f["max_load_N"] for f in flex),
         "equivalent_load_N": max(f["equivalent_load_N"] for f in flex),
         "L10h_h": min(f["L10h_h"] for f in flex),
-        "handbook_max_load_N": max(f["max_load_N"] for f in rigid),
-        "handbook_equivalent_load_N": max(f["equivalent_load_N"] for f in rigid),
+        "handbook_max_load_N": max((f["max_load_N"] for f in rigid), default=None),
+        "handbook_equivalent_load_N": max((f["equivalent_load_N"] for f in rigid), default=None),
         "peak_von_mises_MPa": s.get("peak_von_mises_MPa"),
         "peak_away_from_contacts_MPa": away.get("peak_von_mises_MPa"),
     }

@@ -14,6 +14,14 @@ Sources
 * The classical pin-force distribution of cycloid drives,
   F_i = F_max sin φ_i / √(1 + K1² − 2 K1 cos φ_i), F_max = 4 T_disc / (K1 Zc Rp).
 
+Tooth difference
+----------------
+The handbook model and the classical pin-force distribution are derived for a one-tooth difference
+Zp − Zc = 1. For any other difference they are "not defined" (:func:`handbook_applicable`,
+:func:`classical_applicable` say why) and the flexible results are compared with the reference
+that holds for any tooth difference, the equal share of the FE pin resultant
+(:func:`references`, :func:`rvfem.compare.equal_share_forces`).
+
 Conventions (shared with the flexible model)
 --------------------------------------------
 Carrier frame
@@ -67,6 +75,11 @@ __all__ = [
     "PinForces",
     "load_cycle_angles",
     "handbook_applicable",
+    "classical_applicable",
+    "Reference",
+    "References",
+    "references",
+    "undefined_loads",
     "handbook_components",
     "handbook_bearing_loads",
     "handbook_load_extremes",
@@ -271,31 +284,165 @@ def _as_theta(theta) -> np.ndarray:
     return th
 
 
+def _tooth_difference_reason(case: Case, what: str, why: str) -> str:
+    """"" for a one-tooth difference, else the reason ``what`` is not defined (one line)."""
+    d = case.pins.count - case.cycloid.teeth
+    if d == 1:
+        return ""
+    return f"not defined for Zp − Zc ≠ 1: 'pins.count' − 'cycloid.teeth' = {d}; {what} {why}"
+
+
 def handbook_applicable(case: Case) -> tuple[bool, str]:
-    """Whether the handbook crank-bearing model and the classical pin-force distribution apply.
+    """Whether the handbook crank-bearing model applies.
 
     Returns
     -------
     (bool, str)
-        True and "" if they do; False and the reason (one line, naming the case keys) if not.
-        They assume a one-tooth difference (Zp = Zc + 1: the pitch point at e·Zc from the disc
+        True and "" if it does; False and the reason (one line, naming the case keys) if not.
+        It assumes a one-tooth difference (Zp = Zc + 1: the pitch point at e·Zc from the disc
         centre, k_y and ΣP_x = T/(e·Zc) of Gao et al.) and equally spaced cranks (equal sharing).
-        For Zp − Zc ≠ 1 the FE model runs and is compared with the references that exist (the
-        equal share of its own pin resultant); the handbook column is "not defined for
-        Zp − Zc ≠ 1".
+        For Zp − Zc ≠ 1 the FE model runs and is compared with the reference that exists, the
+        equal share of its own pin resultant (:func:`references`); the handbook column is "not
+        defined for Zp − Zc ≠ 1".
     """
-    zp, zc = case.pins.count, case.cycloid.teeth
-    if zp - zc != 1:
-        return False, (f"not defined for Zp − Zc ≠ 1: 'pins.count' − 'cycloid.teeth' = {zp - zc}, the handbook "
-                       "crank-bearing model and the classical pin-force distribution assume a one-tooth "
-                       "difference (Zp = Zc + 1)")
+    reason = _tooth_difference_reason(
+        case, "the handbook crank-bearing model", "(Gao et al.'s pin-force resultant ΣP_x = T/(e·Zc), "
+        "k_y) assumes a one-tooth difference (Zp = Zc + 1)")
+    reason = reason or _crank_spacing_reason(case)
+    return (not reason), reason
+
+
+def _crank_spacing_reason(case: Case) -> str:
+    """"" for equally spaced cranks, else why equal sharing does not apply (one line)."""
     n = case.cranks.count
     angles = np.sort(np.mod(case.cranks.angles_deg, 360.0))
     gaps = np.diff(np.append(angles, angles[0] + 360.0))
     if not np.allclose(gaps, 360.0 / n, rtol=0.0, atol=1e-6):
-        return False, (f"'cranks.angles_deg' {list(case.cranks.angles_deg)} are not equally spaced by "
-                       f"{360.0 / n:g}°: the handbook equal-share model needs equally spaced cranks")
-    return True, ""
+        return (f"'cranks.angles_deg' {list(case.cranks.angles_deg)} are not equally spaced by "
+                f"{360.0 / n:g}°: the handbook equal-share model needs equally spaced cranks")
+    return ""
+
+
+def classical_applicable(case: Case) -> tuple[bool, str]:
+    """Whether the classical rigid pin-force distribution applies (:func:`classical_pin_forces`).
+
+    Returns
+    -------
+    (bool, str)
+        True and "" for a one-tooth difference; False and the reason otherwise.
+
+    Notes
+    -----
+    Its derivation: a rigid disc turns by a small angle about its centre against equally stiff
+    pins with zero clearance, every pin on the loaded half touches the profile, and each contact
+    normal passes through the pitch point, so each pin force is proportional to its lever arm.
+    For Zp − Zc = 1 every pin touches the unmodified profile at every crank angle (the pin centres
+    run along the one closed trochoid the profile is parallel to), and the stiff-disc FE
+    reproduces the distribution within 0.1 % of the peak pin force. For Zp − Zc > 1 the tooth tips
+    are trimmed corners: only about half the pins touch, and a pin engages over a tip corner
+    through a gap that closes as the square of the crank angle (2.5 µm 10° before contact on the
+    RV-40E stage with Zc = 38), so which pins carry load is set by the compliances, not by the
+    geometry. The stiff-disc FE (disc 10⁶×, bores 10³× stiffer, linear pins of 3·10⁵ to
+    3·10⁷ N/mm) departs from the touching-pin distribution by 76-80 % of the peak pin force there,
+    so no rigid pin-force reference is given for Zp − Zc ≠ 1.
+    """
+    reason = _tooth_difference_reason(
+        case, "the classical pin-force distribution", "assumes that every pin on the loaded half touches the "
+        "profile; with trimmed tooth tips pins engage over the tip corners through micrometre gaps, so "
+        "the load set depends on the compliances")
+    return (not reason), reason
+
+
+@dataclass(frozen=True)
+class Reference:
+    """One rigid reference of the flexible results: whether it is defined for a case, and why.
+
+    Attributes
+    ----------
+    defined : bool
+        True if the reference is computed and compared with.
+    why : str
+        One line: what the reference assumes and why it holds, or why it is not defined.
+    """
+
+    defined: bool
+    why: str
+
+
+@dataclass(frozen=True)
+class References:
+    """The rigid references of a case (:func:`references`).
+
+    Attributes
+    ----------
+    handbook : Reference
+        The handbook crank-bearing loads (Gao et al., eqs. 4-10).
+    classical_pin_forces : Reference
+        The classical rigid pin-force distribution (:func:`classical_pin_forces`).
+    equal_share : Reference
+        The equal share of the FE pin resultant (:func:`rvfem.compare.equal_share_forces`).
+    """
+
+    handbook: Reference
+    classical_pin_forces: Reference
+    equal_share: Reference
+
+    @property
+    def bearing_loads(self) -> str:
+        """The reference the flexible bearing loads are compared with (deltas, life ratios, the first
+        attribution step): ``"handbook"`` where it is defined, else ``"equal_share"``."""
+        return "handbook" if self.handbook.defined else "equal_share"
+
+    def items(self) -> tuple[tuple[str, Reference], ...]:
+        """(key, reference) pairs in the order the outputs list them."""
+        return (("handbook", self.handbook), ("classical_pin_forces", self.classical_pin_forces),
+                ("equal_share", self.equal_share))
+
+
+REFERENCE_NAMES = {
+    "handbook": "the handbook crank-bearing loads",
+    "classical_pin_forces": "the classical pin-force distribution",
+    "equal_share": "the equal share of the FE pin resultant",
+}
+"""The references in words (screen, report)."""
+
+
+def references(case: Case, *, fe: bool = True) -> References:
+    """Which rigid references a case is compared with, and why.
+
+    Parameters
+    ----------
+    case : Case
+    fe : bool
+        True for a run with the FE load cycle (``rvfem run``); False for the rigid evaluation alone
+        (``rvfem rigid``), where the equal share of the FE pin resultant is not computed.
+
+    Returns
+    -------
+    References
+        The handbook and the classical pin-force distribution are defined for a one-tooth
+        difference (:func:`handbook_applicable`, :func:`classical_applicable`); the equal share of
+        the FE pin resultant assumes only a rigid disc on rigid, equally loaded eccentrics and is
+        defined for any tooth difference (with equally spaced cranks).
+    """
+    ok, reason = handbook_applicable(case)
+    handbook = Reference(ok, reason if not ok else
+                         "rigid disc on rigid eccentrics sharing the classical pin-force resultant equally "
+                         "(Gao et al., eqs. 4-10); derived for a one-tooth difference")
+    ok, reason = classical_applicable(case)
+    classical = Reference(ok, reason if not ok else
+                          "every pin touches the unmodified one-tooth-difference profile with its contact normal "
+                          "through the pitch point, so a rigid disc loads each pin in proportion to its lever arm")
+    spacing = _crank_spacing_reason(case)
+    if spacing:
+        share = Reference(False, spacing)
+    elif fe:
+        share = Reference(True, "each bearing carries 1/N of the FE pin-force resultant plus the torque share "
+                                "T_disc/(N·r0) along its tangent: a rigid disc on rigid, equally loaded eccentrics, "
+                                "for any tooth difference")
+    else:
+        share = Reference(False, "needs the FE pin-force resultant: computed by rvfem run, not by rvfem rigid")
+    return References(handbook=handbook, classical_pin_forces=classical, equal_share=share)
 
 
 def _check_handbook_applicable(case: Case) -> None:
@@ -402,6 +549,32 @@ def handbook_bearing_loads(case: Case, theta=None) -> RigidLoads:
         radial=readonly(f_r, dtype=float),
         components=comp,
     )
+
+
+def undefined_loads(case: Case, theta=None) -> RigidLoads:
+    """The handbook curves of a case outside the handbook model: every force NaN.
+
+    Where :func:`handbook_applicable` says no (Zp − Zc ≠ 1), the rigid evaluation still has the
+    layout of :class:`RigidLoads` so that code drawing or tabulating it needs no branch; NaN is
+    "not defined" (``null`` in the JSON outputs). Only k = e·Zp/Rp, T_disc and the torque share
+    F1 = T_disc/(N·r0) of the components are numbers; k_y, ΣP_x, ΣP_y, F2 and F3 are NaN.
+
+    Parameters
+    ----------
+    case : Case
+    theta : float or array_like, optional
+        Crank angles θ, rad; default one turn at ``case.analysis.angle_step_deg``.
+    """
+    th = load_cycle_angles(case.analysis.angle_step_deg) if theta is None else _as_theta(theta)
+    alpha = np.radians(np.asarray(case.cranks.angles_deg, dtype=float))
+    nan = np.full((alpha.size, th.size), np.nan)
+    t_disc = case.loads.disc_torque_Nmm
+    comp = HandbookComponents(k=case.short_amplitude_coefficient, k_y=math.nan, disc_torque_Nmm=t_disc,
+                              sum_px=math.nan, sum_py=math.nan,
+                              f1=t_disc / (case.cranks.count * case.cranks.circle_radius), f2=math.nan, f3=math.nan)
+    return RigidLoads(theta=readonly(th, dtype=float), crank_angles=readonly(alpha, dtype=float),
+                      fx=readonly(nan), fy=readonly(nan), magnitude=readonly(nan), tangential=readonly(nan),
+                      radial=readonly(nan), components=comp)
 
 
 def handbook_load_extremes(components: HandbookComponents) -> tuple[float, float, float, float]:
@@ -546,8 +719,16 @@ def classical_pin_forces(case: Case, theta=None, *, exact_moment: bool = False) 
     -------
     PinForces
         Pin positions (mm) and forces (N) in the disc frame.
+
+    Raises
+    ------
+    CaseError
+        For Zp − Zc ≠ 1, where the distribution does not hold (:func:`classical_applicable` says
+        why). It does not depend on the crank positions.
     """
-    _check_handbook_applicable(case)
+    ok, reason = classical_applicable(case)
+    if not ok:
+        raise CaseError(f"{case.source}: {reason}")
     th = load_cycle_angles(case.analysis.angle_step_deg) if theta is None else _as_theta(theta)
     zp, zc = case.pins.count, case.cycloid.teeth
     rp, e = case.pins.circle_radius, case.cycloid.eccentricity

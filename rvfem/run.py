@@ -6,7 +6,7 @@ load cycle → evaluation → outputs — and writes::
     DIR/summary.json        key numbers (schema: docs/outputs.md)
     DIR/report.html         self-contained report (images embedded)
     DIR/case.json           the case as analysed (after overrides); case_from_dict() reads it back
-    DIR/bearing_loads.csv   θ, per bearing Fx, Fy, |F| flexible and rigid
+    DIR/bearing_loads.csv   θ, per bearing Fx, Fy, |F| flexible, rigid and equal share
     DIR/roller_loads.csv    roller loads (bearing model "rollers")
     DIR/pin_forces.csv      FE and classical pin forces
     DIR/cycle.csv           pins in contact, carrier rotation, residual, iterations per angle

@@ -946,7 +946,7 @@ def study_rows(study: Study, records: dict[str, dict]) -> list[dict]:
         bearings = s["bearings"] if s else []
         base_bearings = base_summary["bearings"] if base_summary else []
         flex = [b["flexible"] for b in bearings]
-        rigid = [b["rigid"] for b in bearings]
+        rigid = [b["rigid"] for b in bearings if b.get("rigid")]   # none where the handbook is not defined
         max_load = max((f["max_load_N"] for f in flex), default=None)
         fm = max((f["equivalent_load_N"] for f in flex), default=None)
         life = min((f["L10h_h"] for f in flex), default=None)
@@ -978,15 +978,16 @@ def study_rows(study: Study, records: dict[str, dict]) -> list[dict]:
             pre = f"bearing{i + 1}_"
             b = bearings[i] if i < len(bearings) else None
             bb = base_bearings[i] if i < len(base_bearings) else None
-            f, g = (b or {}).get("flexible", {}), (b or {}).get("rigid", {})
+            f, g = (b or {}).get("flexible", {}), (b or {}).get("rigid") or {}
+            vs_handbook = bool(g)   # the deltas are against the equal share where there is no handbook
             fb = (bb or {}).get("flexible", {})
             row.update({
                 pre + "max_N": f.get("max_load_N"), pre + "min_N": f.get("min_load_N"),
                 pre + "Fm_N": f.get("equivalent_load_N"), pre + "L10h_h": f.get("L10h_h"),
                 pre + "handbook_max_N": g.get("max_load_N"), pre + "handbook_Fm_N": g.get("equivalent_load_N"),
-                pre + "max_vs_handbook_percent": (b or {}).get("delta_max_percent"),
-                pre + "Fm_vs_handbook_percent": (b or {}).get("delta_equivalent_percent"),
-                pre + "life_ratio": (b or {}).get("life_ratio"),
+                pre + "max_vs_handbook_percent": (b or {}).get("delta_max_percent") if vs_handbook else None,
+                pre + "Fm_vs_handbook_percent": (b or {}).get("delta_equivalent_percent") if vs_handbook else None,
+                pre + "life_ratio": (b or {}).get("life_ratio") if vs_handbook else None,
                 pre + "max_vs_base_percent": _pct(f.get("max_load_N"), fb.get("max_load_N")),
                 pre + "Fm_vs_base_percent": _pct(f.get("equivalent_load_N"), fb.get("equivalent_load_N")),
             })

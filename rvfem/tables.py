@@ -3,8 +3,11 @@
 ``bearing_loads.csv``
     One row per crank angle: ``theta_deg`` and, for every bearing i = 1…N,
     ``bearing{i}_flexible_Fx_N``, ``bearing{i}_flexible_Fy_N``, ``bearing{i}_flexible_F_N`` (FE) and
-    ``bearing{i}_rigid_Fx_N``, ``bearing{i}_rigid_Fy_N``, ``bearing{i}_rigid_F_N`` (handbook): the
-    force of the bearing on the disc in the disc frame and its magnitude.
+    ``bearing{i}_rigid_Fx_N``, ``bearing{i}_rigid_Fy_N``, ``bearing{i}_rigid_F_N`` (handbook; ``nan``
+    where it is not defined, Zp − Zc ≠ 1), then ``bearing{i}_equal_share_Fx_N``,
+    ``bearing{i}_equal_share_Fy_N``, ``bearing{i}_equal_share_F_N`` (the FE pin resultant shared
+    equally) for every bearing: the force of the bearing on the disc in the disc frame and its
+    magnitude.
 ``roller_loads.csv``
     One row per crank angle, bearing and roller (bearing model ``rollers`` only): ``theta_deg``,
     ``bearing``, ``roller`` (1-based), ``roller_angle_deg`` (position about the bore centre, disc
@@ -12,7 +15,8 @@
 ``pin_forces.csv``
     One row per crank angle and pin: ``theta_deg``, ``pin`` (1-based; pin k sits at
     360°·(k − 1)/Zp on the housing), ``x_mm``, ``y_mm`` (pin centre in the disc frame),
-    ``flexible_N`` (FE), ``classical_N`` (classical rigid distribution with the exact moment).
+    ``flexible_N`` (FE), ``classical_N`` (classical rigid distribution with the exact moment;
+    ``nan`` where it is not defined, Zp − Zc ≠ 1).
 ``cycle.csv``
     One row per crank angle: ``theta_deg``, ``pins_in_contact``, ``carrier_rotation_arcmin``,
     ``equilibrium_residual``, ``active_set_iterations``.
@@ -48,7 +52,7 @@ def _write(path: str | os.PathLike, header: list[str], rows) -> Path:
 
 
 def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np.ndarray,
-                        rigid: np.ndarray) -> Path:
+                        rigid: np.ndarray, equal_share: np.ndarray | None = None) -> Path:
     """Write ``bearing_loads.csv``.
 
     Parameters
@@ -57,20 +61,31 @@ def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np
     theta : ndarray (n,)
         Crank angles, rad.
     flexible, rigid : ndarray (n, N, 2)
-        Force of each bearing on the disc, N (FE and handbook).
+        Force of each bearing on the disc, N (FE and handbook; NaN where the handbook is not
+        defined).
+    equal_share : ndarray (n, N, 2), optional
+        The equal share of the FE pin resultant, N (its columns follow the others).
     """
     n_b = flexible.shape[1]
+    models = [("flexible", flexible), ("rigid", rigid)]
+    if equal_share is not None:
+        models.append(("equal_share", equal_share))
     header = ["theta_deg"]
     for i in range(1, n_b + 1):
-        for model in ("flexible", "rigid"):
-            header += [f"bearing{i}_{model}_Fx_N", f"bearing{i}_{model}_Fy_N", f"bearing{i}_{model}_F_N"]
-    fmag, rmag = np.linalg.norm(flexible, axis=2), np.linalg.norm(rigid, axis=2)
+        for name, _ in models[:2]:
+            header += [f"bearing{i}_{name}_Fx_N", f"bearing{i}_{name}_Fy_N", f"bearing{i}_{name}_F_N"]
+    for i in range(1, n_b + 1):
+        for name, _ in models[2:]:
+            header += [f"bearing{i}_{name}_Fx_N", f"bearing{i}_{name}_Fy_N", f"bearing{i}_{name}_F_N"]
+    mags = {name: np.linalg.norm(f, axis=2) for name, f in models}
 
     def rows():
         for k, th in enumerate(theta):
             row = [math.degrees(th)]
-            for i in range(n_b):
-                row += [flexible[k, i, 0], flexible[k, i, 1], fmag[k, i], rigid[k, i, 0], rigid[k, i, 1], rmag[k, i]]
+            for group in (models[:2], models[2:]):
+                for i in range(n_b):
+                    for name, f in group:
+                        row += [f[k, i, 0], f[k, i, 1], mags[name][k, i]]
             yield row
 
     return _write(path, header, rows())

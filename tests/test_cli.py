@@ -72,6 +72,26 @@ def test_rigid_reports_the_duty_cycle(case_text, tmp_path, capsys):
     assert duty["service_life_h"] == pytest.approx(report["bearings"][0]["L10h_h"], rel=1e-12)
 
 
+def test_rigid_says_the_handbook_is_not_defined_for_two_teeth(case_text, tmp_path, capsys):
+    """Zp − Zc = 2: exit 0, the handbook keys null with the reason, the references named."""
+    path = case_text.set("cycloid", "teeth", "38").append(
+        "[[loads.duty_cycle]]\ntime_share = 1.0\nspeed_rpm = 15.0\ntorque_Nm = 412.0").write(tmp_path)
+    assert cli.main(["rigid", str(path), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    refs = report["references"]
+    assert refs["bearing_loads"] == "equal_share"
+    assert not refs["handbook"]["defined"] and refs["handbook"]["why"].startswith("not defined for Zp − Zc ≠ 1")
+    assert not refs["classical_pin_forces"]["defined"] and not refs["equal_share"]["defined"]
+    assert report["k_y"] is None and report["sum_px_N"] is None and report["duty_cycle"] is None
+    assert [b["crank_angle_deg"] for b in report["bearings"]] == [90.0, 210.0, 330.0]
+    assert all(b["max_load_N"] is None and b["hertz_inner"] is None for b in report["bearings"])
+    assert report["bearing_speed_rpm"] == pytest.approx(300.0)
+    assert cli.main(["rigid", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert out.count("not defined for Zp − Zc ≠ 1") >= 3 + 2 and "rvfem run" in out
+    assert "the equal share of the FE pin resultant" in out
+
+
 def test_rigid_rejects_a_case_outside_the_handbook_model(case_text, tmp_path, capsys):
     path = case_text.set("cranks", "angles_deg", "[90, 200, 330]").write(tmp_path)
     assert cli.main(["rigid", str(path)]) == 2
@@ -248,7 +268,7 @@ def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
 
     duty = str(Path(__file__).resolve().parents[1] / "cases" / "crv80e_duty.toml")
     written = set()
-    for path in (CRV80E, duty):
+    for path in (CRV80E, duty, str(CASES_DIR / "rv40e_two_teeth.toml")):
         assert cli.main(["rigid", path, "--json"]) == 0
         report = json.loads(capsys.readouterr().out)
         assert report["schema_version"] == RIGID_SCHEMA_VERSION

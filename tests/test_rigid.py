@@ -371,3 +371,112 @@ def test_duty_cycle_rows_with_reversed_torque_count_with_their_magnitude(rv40e):
     a, b = case_duty_cycle_life(fwd, [1000.0]), case_duty_cycle_life(mixed, [1000.0])
     assert b.service_life_h == pytest.approx(a.service_life_h, rel=1e-15)
     assert b.equivalent_torque_Nm == pytest.approx(a.equivalent_torque_Nm, rel=1e-15)
+
+
+# --------------------------------------------------------------------------------------------
+# Any tooth difference: which references exist
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def two_teeth():
+    return load_case(CASES_DIR / "rv40e_two_teeth.toml")
+
+
+def test_references_of_one_and_two_tooth_differences(rv40e, two_teeth):
+    from rvfem.rigid import references
+
+    one = references(rv40e)
+    assert one.handbook.defined and one.classical_pin_forces.defined and one.equal_share.defined
+    assert one.bearing_loads == "handbook"
+    two = references(two_teeth)
+    assert two_teeth.pins.count - two_teeth.cycloid.teeth == 2
+    assert not two.handbook.defined and not two.classical_pin_forces.defined and two.equal_share.defined
+    assert two.bearing_loads == "equal_share"
+    for ref in (two.handbook, two.classical_pin_forces):
+        assert ref.why.startswith("not defined for Zp − Zc ≠ 1") and "'pins.count' − 'cycloid.teeth' = 2" in ref.why
+    assert "any tooth difference" in two.equal_share.why
+    # the rigid evaluation alone has no FE pin resultant to share
+    alone = references(two_teeth, fe=False)
+    assert not alone.equal_share.defined and "rvfem run" in alone.equal_share.why
+    # unequally spaced cranks: equal sharing does not hold either
+    skewed = references(two_teeth.replace(cranks=dataclasses.replace(two_teeth.cranks, angles_deg=(90.0, 200.0, 330.0))))
+    assert not skewed.equal_share.defined and "equally spaced" in skewed.equal_share.why
+
+
+def test_classical_pin_forces_need_a_one_tooth_difference_not_equal_cranks(rv40e, two_teeth):
+    with pytest.raises(CaseError, match="not defined for Zp − Zc ≠ 1"):
+        classical_pin_forces(two_teeth)
+    # the distribution does not involve the cranks
+    skewed = rv40e.replace(cranks=dataclasses.replace(rv40e.cranks, angles_deg=(90.0, 200.0, 330.0)))
+    theta = load_cycle_angles(30.0)
+    np.testing.assert_array_equal(classical_pin_forces(skewed, theta).magnitude,
+                                  classical_pin_forces(rv40e, theta).magnitude)
+
+
+def test_rigid_evaluation_of_a_two_tooth_difference_is_not_defined(two_teeth):
+    """NaN loads in the layout of the handbook curves, no bearing rows, the reason; the torque share
+    F1 = T_disc/(N·r0) and k = e·Zp/Rp, which do not depend on the pin forces, are numbers."""
+    from rvfem.analysis import analyse_rigid
+    from rvfem.rigid import undefined_loads
+
+    result = analyse_rigid(two_teeth)
+    assert not result.defined and result.bearings == () and result.duty_cycle is None
+    assert result.references.bearing_loads == "equal_share"
+    assert result.loads.magnitude.shape == (3, 360) and np.isnan(result.loads.magnitude).all()
+    c = undefined_loads(two_teeth).components
+    assert c.f1 == pytest.approx(206000.0 / (3 * 36.0), rel=1e-15)
+    assert c.k == pytest.approx(1.3 * 40 / 64.0, rel=1e-15)
+    assert all(math.isnan(x) for x in (c.k_y, c.sum_px, c.sum_py, c.f2, c.f3))
+    assert result.bearing_speed_rpm == pytest.approx(15.0 * 40 / 2, rel=1e-15)   # n_out·Zp/(Zp − Zc)
+
+
+def _touching_pin_distribution(case, theta):
+    """The classical distribution's derivation applied as it stands to any tooth difference: the
+    pins that touch the unmodified profile (gap below 1 nm), forces along the line through the pitch
+    point e·Zc/(Zp − Zc)·u(θ), each in proportion to its lever arm, moment T_disc exactly. Returns
+    the forces (n, Zp), N, and the largest |sin| between a touching pin's contact normal and the
+    line to the pitch point."""
+    from rvfem.geometry import disc_geometry, pin_profile_contacts
+
+    geom = disc_geometry(case)
+    zp, zc, e = case.pins.count, case.cycloid.teeth, case.cycloid.eccentricity
+    t_disc = case.loads.disc_torque_Nmm
+    forces, off_normal = np.zeros((len(theta), zp)), 0.0
+    for k, th in enumerate(theta):
+        pc = pin_profile_contacts(geom, th)
+        touching = np.abs(pc.gap) < 1e-6
+        v = e * zc / (zp - zc) * np.array([math.cos(th), math.sin(th)]) - pc.centres
+        v /= np.linalg.norm(v, axis=1)[:, None]
+        sin = v[:, 0] * pc.normal[:, 1] - v[:, 1] * pc.normal[:, 0]
+        off_normal = max(off_normal, float(np.abs(sin[touching]).max()))
+        arm = pc.centres[:, 0] * v[:, 1] - pc.centres[:, 1] * v[:, 0]
+        loaded = touching & (-math.copysign(1.0, t_disc) * arm > 1e-9)
+        forces[k] = np.where(loaded, abs(t_disc) * np.abs(arm) / np.sum(arm[loaded] ** 2), 0.0)
+    return forces, off_normal
+
+
+@pytest.mark.slow
+def test_two_teeth_rigid_limit_keeps_the_equal_share_but_not_the_classical_distribution(tmp_path):
+    """Why rvfem gives no rigid pin-force reference for Zp − Zc ≠ 1, but keeps the equal share:
+    in the stiff limit (disc 10⁶×, bores 10³× stiffer, linear pins of 3e5 N/mm, as the verification
+    manual's rigid-limit section) the touching pins' normals pass through the pitch point, yet the
+    FE departs from the touching-pin distribution by most of the peak pin force (a pin entering over
+    a trimmed tip corner through a micrometre gap takes load the rigid distribution does not give
+    it), while the FE bearing forces stay the equal share of the FE pin resultant."""
+    from rvfem.compare import equal_share_forces
+    from rvfem.cycle import build_system, load_cycle
+    from rvfem.mesh import mesh_case
+
+    from conftest import coarse_case
+
+    case = coarse_case("rv40e_solid", cycloid={"teeth": 38})
+    theta = load_cycle_angles(10.0)
+    system = build_system(case, mesh_case(case, tmp_path), stiffness_scale=1e6, bearing_model="rigid_bore",
+                          bearing_stiffness_scale=1e3, pin_model="linear", pin_stiffness_N_per_mm=3e5)
+    fe = load_cycle(system, theta, saved_angles_deg=(), stage=None)
+    rigid, off_normal = _touching_pin_distribution(case, theta)
+    assert off_normal < 1e-12                                              # measured 1.0e-14
+    assert np.abs(fe.pin_forces - rigid).max() / rigid.max() > 0.5        # measured 0.80
+    share = equal_share_forces(case, fe)
+    assert np.abs(fe.bearing_forces - share).max() / fe.bearing_loads.max() < 2e-3   # measured 6.9e-4

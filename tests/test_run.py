@@ -286,7 +286,7 @@ def test_csv_tables_agree_with_summary(cli_run, summary):
     assert theta == pytest.approx(np.arange(0.0, 360.0, STEP_DEG))
     for b in summary["bearings"]:
         i = b["bearing"]
-        for model in ("flexible", "rigid"):
+        for model in ("flexible", "rigid", "equal_share"):
             f = np.array([float(r[f"bearing{i}_{model}_F_N"]) for r in rows])
             fx = np.array([float(r[f"bearing{i}_{model}_Fx_N"]) for r in rows])
             fy = np.array([float(r[f"bearing{i}_{model}_Fy_N"]) for r in rows])
@@ -564,8 +564,9 @@ OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timin
 """Objects whose keys are names (case keys, files, stages), documented as a whole."""
 
 
-def test_summary_keys_are_the_documented_ones(summary, duty_run):
-    written = written_keys(summary, OPAQUE_KEYS) | written_keys(duty_run[1], OPAQUE_KEYS)
+def test_summary_keys_are_the_documented_ones(summary, duty_run, two_teeth_run):
+    written = (written_keys(summary, OPAQUE_KEYS) | written_keys(duty_run[1], OPAQUE_KEYS)
+               | written_keys(two_teeth_run[1], OPAQUE_KEYS))
     documented = documented_keys()
     assert written - documented == set(), "keys written but not in docs/outputs.md"
     assert documented - written == set(), "keys in docs/outputs.md that no run writes"
@@ -757,3 +758,78 @@ def test_screen_gives_the_stribeck_pressure_without_roller_loads_and_stiffness_p
     sf = summary["hertz"]["stribeck_flexible"]
     assert f"FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N" in text
     assert "N·m/arcmin per disc" in text
+
+
+# --------------------------------------------------------------------------------------------
+# Zp − Zc = 2: no handbook, the FE against the equal share of its pin resultant
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def two_teeth_run(workspace, cache_dir) -> tuple[Path, dict, str]:
+    """``rvfem run`` of the shipped two-tooth-difference case, coarse (images on: the stress
+    images have no handbook forces to draw)."""
+    text = (CaseText.shipped("rv40e_two_teeth")
+            .set("mesh", "size_flank", "0.7").set("mesh", "size_bore", "0.8").set("mesh", "size_interior", "5.0")
+            .set("analysis", "angle_step_deg", str(STEP_DEG)).set("analysis", "saved_angles_deg", "[0.0]"))
+    path = text.write(workspace, "two_teeth.toml")
+    out = workspace / "two_teeth"
+    import contextlib
+    import io
+
+    screen = io.StringIO()
+    with contextlib.redirect_stdout(screen):
+        code = cli.main(["run", str(path), "-o", str(out), "--cache-dir", str(cache_dir)])
+    assert code == 0
+    return out, json.loads((out / "summary.json").read_text(encoding="utf-8")), screen.getvalue()
+
+
+def test_two_teeth_run_says_which_references_it_compares_with(two_teeth_run):
+    out, s, screen = two_teeth_run
+    refs = s["references"]
+    assert refs["bearing_loads"] == "equal_share"
+    assert refs["equal_share"]["defined"] and "any tooth difference" in refs["equal_share"]["why"]
+    for key in ("handbook", "classical_pin_forces"):
+        assert not refs[key]["defined"] and refs[key]["why"].startswith("not defined for Zp − Zc ≠ 1")
+    assert s["model"]["handbook_k_y"] is None and s["hertz"]["stribeck_rigid"] is None
+    assert s["model"]["bearing_speed_rpm"] == pytest.approx(15.0 * 40 / 2)
+    assert "bearing loads compared with the equal share of the FE pin resultant" in screen
+    assert screen.count("not defined for Zp − Zc ≠ 1") >= 3 + 2
+    import html as html_module
+
+    report = html_module.unescape((out / "report.html").read_text(encoding="utf-8"))
+    assert "equal share of the FE pin resultant vs flexible disc" in report
+    assert refs["handbook"]["why"] in report and refs["classical_pin_forces"]["why"] in report
+    assert "rigid handbook (dashed)" not in report
+
+
+def test_two_teeth_deltas_are_against_the_equal_share_and_the_attribution_starts_there(two_teeth_run):
+    out, s, _ = two_teeth_run
+    for b in s["bearings"]:
+        f, e = b["flexible"], b["equal_share"]
+        assert b["rigid"] is None
+        assert b["delta_max_percent"] == pytest.approx(100 * (f["max_load_N"] / e["max_load_N"] - 1), rel=1e-12)
+        assert b["delta_equivalent_percent"] == pytest.approx(
+            100 * (f["equivalent_load_N"] / e["equivalent_load_N"] - 1), rel=1e-12)
+        assert b["life_ratio"] == pytest.approx((e["equivalent_load_N"] / f["equivalent_load_N"]) ** (10 / 3), rel=1e-12)
+    steps = [r["step"] for r in s["attribution"] if r["bearing"] == 1]
+    assert steps[0] == "equal_share" and "handbook" not in steps
+    for r, b in zip([r for r in s["attribution"] if r["step"] == "equal_share"], s["bearings"]):
+        assert r["max_N"] == pytest.approx(b["equal_share"]["max_load_N"], rel=1e-12)
+        assert r["delta_max_percent"] == 0.0
+    for r, b in zip([r for r in s["attribution"] if r["final"]], s["bearings"]):
+        assert r["delta_max_percent"] == pytest.approx(b["delta_max_percent"], rel=1e-9)
+
+
+def test_two_teeth_tables_leave_the_undefined_references_empty(two_teeth_run):
+    out, s, _ = two_teeth_run
+    rows = _read_csv(out / "bearing_loads.csv")
+    for b in s["bearings"]:
+        i = b["bearing"]
+        assert all(math.isnan(float(r[f"bearing{i}_rigid_F_N"])) for r in rows)
+        share = np.array([float(r[f"bearing{i}_equal_share_F_N"]) for r in rows])
+        assert share.max() == pytest.approx(b["equal_share"]["max_load_N"], rel=1e-9)
+    pins = _read_csv(out / "pin_forces.csv")
+    assert all(math.isnan(float(r["classical_N"])) for r in pins)
+    assert {"bearing_loads", "pin_forces", "pins_in_contact"} <= set(s["plots"])
+    assert any(k.startswith("stress_theta_") for k in s["images"])
