@@ -84,8 +84,9 @@ class DiscSystem:
     node_rotation : ndarray of int or None
         The FE node that each node turns into by 2π/N (symmetric meshes).
     contact_sets : dict
-        Cache of :func:`contact_set` by crank angle (mutable, like the compliance): the cycles of
-        the attribution revisit the case cycle's angles.
+        Cache of :func:`contact_set` by crank angle and the objects the contacts are built from
+        (mutable, like the compliance): the cycles of the attribution revisit the case cycle's
+        angles.
     """
 
     case: Case
@@ -248,10 +249,14 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
     Built once per angle and system (:attr:`DiscSystem.contact_sets`).
     """
-    key = round(float(theta), 12)
-    if key not in system.contact_sets:
-        system.contact_sets[key] = _contact_set(system, theta)
-    return system.contact_sets[key]
+    # a system copied with dataclasses.replace shares the cache: an entry is valid only for the
+    # very objects it was built from (kept in the entry, so that their ids cannot be reused)
+    owner = (system.case, system.interface, system.geometry, system.bearings, system.pins)
+    key = (round(float(theta), 12),) + tuple(id(o) for o in owner)
+    hit = system.contact_sets.get(key)
+    if hit is None or any(a is not b for a, b in zip(hit[0], owner)):
+        hit = system.contact_sets[key] = (owner, _contact_set(system, theta))
+    return hit[1]
 
 
 def _contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:

@@ -151,11 +151,14 @@ def test_mirrored_pairs_equal_direct_pair_solves(fan_system):
     system = cycle.build_system(fan_system.case, fan_system.mesh, bearing_model="rigid_bore")
     stage = reducer.build_stage(system, discs=2, influence=None)
     result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=stage)
-    assert result.timings["pair_solves"] == len(THETA) // 2
+    assert result.timings["pair_solves"] == len(THETA) // 6    # 180° swaps and 120° turns: 60° solved
+    # the solver stops when the spring laws hold to 1e-8·T/r (≈ 6e-5 N here): two independent
+    # solves of one state agree to that, not to round-off
+    atol = 1e-8 * stage.torque_Nmm / float(np.abs(system.interface.points).max())
     for j in (20, 27, 35):
         direct = reducer.solve_pair(stage, float(THETA[j]))
-        assert np.allclose(direct.bearing_forces[0], result.bearing_forces[j], rtol=0, atol=1e-6)
-        assert np.allclose(direct.bearing_forces[1], result.disc_bearing_forces[j, 1], rtol=0, atol=1e-6)
+        assert np.allclose(direct.bearing_forces[0], result.bearing_forces[j], rtol=0, atol=atol)
+        assert np.allclose(direct.bearing_forces[1], result.disc_bearing_forces[j, 1], rtol=0, atol=atol)
         assert direct.torque_Nmm[0] == pytest.approx(result.disc_torque_Nmm[j, 0], rel=1e-9)
 
 
