@@ -32,6 +32,7 @@ import os
 import shutil
 import tempfile
 import uuid
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable, Iterator, Mapping
@@ -717,6 +718,9 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
     """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
     stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.plots.mesh_plot`).
 
+    The stress images share one off-screen plotter (:class:`rvfem.render.StressRenderer`); the
+    mesh picture is drawn by a second thread meanwhile. All files are complete on return.
+
     Raises
     ------
     RenderError
@@ -765,32 +769,39 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
         if tick is not None and len(out) < total:
             tick(len(out), total)
 
-    for snap in snapshots:
-        label = "  (max. bearing load)" if snap.index == k_max else ""
-        done(render.stress_image(images / _stress_image_name(snap.theta_deg), scene(snap, label),
-                                 window_size=IMAGE_SIZE))
-    half = max(5.0, 12.0 * case.mesh.size_bore)
-    rec = a.stress.recovered
-    for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
-                          ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
-        if pk is None:
-            continue
-        snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
-        extra = ""
-        if rec is not None and key == "stress_away_from_contacts_closeup":
-            extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
-        close = dataclasses.replace(
-            scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
-            title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
-                  f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, {pk.feature_label}")
-        done(render.stress_image(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
-                                 marker=(pk.x_mm, pk.y_mm), show_edges=True, window_size=IMAGE_SIZE))
     b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
-    done(mesh_plot(images / "mesh.png", vertices, triangles, mesh.boundaries,
-                   closeup_centre=(float(b0[0]), float(b0[1])),
-                   title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
-                         f"(min quality {mesh.min_quality:.2f})",
-                   closeup_title="close-up: the rim under the bore of bearing 1"))
+    # the mesh picture (matplotlib) is drawn by a second thread while VTK renders the stress images;
+    # the renderer is made first, so that PyVista (which imports matplotlib) is imported by this
+    # thread alone
+    with render.StressRenderer(IMAGE_SIZE) as renderer, \
+            ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-mesh-plot") as pool:
+        mesh_png = pool.submit(
+            mesh_plot, images / "mesh.png", vertices, triangles, mesh.boundaries,
+            closeup_centre=(float(b0[0]), float(b0[1])),
+            title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
+                  f"(min quality {mesh.min_quality:.2f})",
+            closeup_title="close-up: the rim under the bore of bearing 1")
+        for snap in snapshots:
+            label = "  (max. bearing load)" if snap.index == k_max else ""
+            done(renderer.write(images / _stress_image_name(snap.theta_deg), scene(snap, label)))
+        half = max(5.0, 12.0 * case.mesh.size_bore)
+        rec = a.stress.recovered
+        for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
+                              ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
+            if pk is None:
+                continue
+            snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+            extra = ""
+            if rec is not None and key == "stress_away_from_contacts_closeup":
+                extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
+            close = dataclasses.replace(
+                scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
+                title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
+                      f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, "
+                      f"{pk.feature_label}")
+            done(renderer.write(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
+                                marker=(pk.x_mm, pk.y_mm), show_edges=True))
+        done(mesh_png.result())
     return out
 
 

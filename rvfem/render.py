@@ -10,16 +10,21 @@ any OpenGL context may crash the interpreter instead of raising, :func:`check_re
 renders a tiny scene in a child process and turns a failure into a :class:`~rvfem.errors.
 RenderError` with the reason; the image functions call it before touching VTK.
 
-PyVista is imported only inside the functions that draw (importing :mod:`rvfem.render` is cheap).
+A series of stress images is drawn with one :class:`StressRenderer`: one plotter (one OpenGL
+context), the disc mesh built once and updated per image, the PNG files written by a background
+thread. PyVista is imported only inside the functions that draw (importing :mod:`rvfem.render` is
+cheap).
 """
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import re
 import subprocess
 import sys
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,9 +32,12 @@ import numpy as np
 
 from .errors import RenderError
 
+log = logging.getLogger(__name__)
+
 __all__ = [
     "RENDER_WINDOW_VARIABLE",
     "DEFAULT_RENDER_WINDOW",
+    "StressRenderer",
     "StressScene",
     "check_rendering",
     "nice_factor",
@@ -46,6 +54,18 @@ COLORMAP = "turbo"
 ABOVE_COLOUR = "magenta"
 """Colour of stresses above the colour range (the contact spots when the range is clipped)."""
 BACKGROUND = "white"
+PNG_COMPRESS_LEVEL = 4
+"""zlib level of the stress images' PNG files (0-9): 4 writes them in about 60 % of the time of
+the default 6, 4 % larger."""
+
+ANTI_ALIASING = "fxaa"
+"""Anti-aliasing of the stress images: ``"fxaa"`` (a post-processing pass: smooth edges at a
+fraction of the cost of multi-sampling in a software OpenGL such as Mesa's llvmpipe; falls back to
+MSAA where it does not render correctly), ``"msaa"`` (PyVista's default multi-sampling) or
+``"none"``."""
+_ANTI_ALIASING = ("fxaa", "msaa", "none")
+
+_FIELD = "von Mises [MPa]"
 
 _PROBE = r"""
 import pyvista as pv
@@ -235,30 +255,87 @@ def _top_view(plotter, centre: tuple[float, float], half_height: float) -> None:
     plotter.camera.parallel_scale = half_height
 
 
-def _save(plotter, path: Path) -> Path:
-    try:
-        img = plotter.screenshot(str(path), return_img=True)
-    finally:
-        plotter.close()
-    if img is None or np.asarray(img).std() == 0:
-        raise RenderError(f"the rendered image {path.name} is blank; off-screen rendering does not work here")
-    return path
+class _Shapes:
+    """Many copies of a small PyVista shape as one mesh, from a template built once.
+
+    ``pv.Disc`` and ``pv.Arrow`` cost milliseconds each (a VTK source and a transform filter);
+    here each kind of shape is built once and its copies are placed with numpy.
+    """
+
+    def __init__(self, pv):
+        self._pv = pv
+        self._templates: dict[tuple, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+    def _template(self, key: tuple, build) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if key not in self._templates:
+            mesh = build()
+            if mesh.n_lines or mesh.n_strips or mesh.n_verts:  # pragma: no cover - VTK sources make polygons
+                raise RenderError(f"cannot repeat the shape {key[0]}: not made of polygons only")
+            faces = np.asarray(mesh.faces, dtype=np.int64).copy()
+            is_id = np.ones(len(faces), dtype=bool)
+            i = 0
+            while i < len(faces):
+                is_id[i] = False
+                i += int(faces[i]) + 1
+            self._templates[key] = (np.asarray(mesh.points, dtype=float), faces, is_id)
+        return self._templates[key]
+
+    def _copies(self, template, points: np.ndarray):
+        """One mesh of the template's copies with the points ``points`` (k, n, 3)."""
+        _, faces, is_id = template
+        k, n = points.shape[:2]
+        tiled = np.tile(faces, k)
+        tiled[np.tile(is_id, k)] += np.repeat(np.arange(k, dtype=np.int64) * n, int(is_id.sum()))
+        return self._pv.PolyData(points.reshape(-1, 3), tiled)
+
+    def discs(self, centres: np.ndarray, z: float, inner: float, outer: float, c_res: int):
+        """Filled discs (rings if ``inner`` > 0) in the plane ``z`` (as ``pv.Disc``), or None."""
+        centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+        if len(centres) == 0:
+            return None
+        template = self._template(("disc", float(inner), float(outer), int(c_res)),
+                                  lambda: self._pv.Disc(center=(0.0, 0.0, 0.0), inner=inner, outer=outer,
+                                                        c_res=c_res))
+        offsets = np.column_stack([centres, np.full(len(centres), float(z))])
+        return self._copies(template, template[0][None, :, :] + offsets[:, None, :])
+
+    def arrows(self, starts: np.ndarray, vectors: np.ndarray, z: float, *, tip_length: float, tip_radius: float,
+               shaft_radius: float):
+        """Arrows in the plane ``z`` from ``starts`` along ``vectors`` (x, y), as long as the vectors
+        (as ``pv.Arrow(start, direction=vector, scale=|vector|)``), or None."""
+        starts = np.asarray(starts, dtype=float).reshape(-1, 2)
+        vectors = np.asarray(vectors, dtype=float).reshape(-1, 2)
+        if len(starts) == 0:
+            return None
+        template = self._template(("arrow", float(tip_length), float(tip_radius), float(shaft_radius)),
+                                  lambda: self._pv.Arrow(start=(0.0, 0.0, 0.0), direction=(1.0, 0.0, 0.0),
+                                                         scale=1.0, tip_length=tip_length, tip_radius=tip_radius,
+                                                         shaft_radius=shaft_radius))
+        length = np.hypot(vectors[:, 0], vectors[:, 1])
+        c, s = vectors[:, 0] / length, vectors[:, 1] / length
+        # the orientation pv.Arrow gives a direction (c, s, 0): x → (c, s, 0), z → ±z (the sign of
+        # c), y → z × x
+        zs = np.where(c < 0.0, -1.0, 1.0)[:, None]
+        p = template[0]
+        x = c[:, None] * p[None, :, 0] - zs * s[:, None] * p[None, :, 1]
+        y = s[:, None] * p[None, :, 0] + zs * c[:, None] * p[None, :, 1]
+        points = np.stack([x, y, np.broadcast_to(zs * p[None, :, 2], x.shape)], axis=-1) * length[:, None, None]
+        points += np.column_stack([starts, np.full(len(starts), float(z))])[:, None, :]
+        return self._copies(template, points)
 
 
-def _bearing_arrows(pv, pl, scene: StressScene) -> None:
+def _bearing_arrows(shapes: _Shapes, pl, scene: StressScene) -> None:
     """Arrows of the bearing forces at the bore centres (FE black, handbook grey), labels, legend."""
     centres = np.asarray(scene.bore_centres, dtype=float)
     sets = [(np.asarray(scene.bearing_forces, dtype=float), "black", 0.035)]
     if scene.rigid_forces is not None:
         sets.insert(0, (np.asarray(scene.rigid_forces, dtype=float), "#9a9a9a", 0.05))
     for forces, colour, shaft in sets:
-        for c, f in zip(centres, forces):
-            mag = float(np.hypot(*f))
-            if mag <= 0:
-                continue
-            arrow = pv.Arrow(start=(c[0], c[1], 1.0), direction=(f[0], f[1], 0.0), scale=mag * scene.force_scale,
-                             tip_length=0.22, tip_radius=0.09, shaft_radius=shaft)
-            pl.add_mesh(arrow, color=colour, lighting=False)
+        drawn = np.hypot(forces[:, 0], forces[:, 1]) > 0
+        arrows = shapes.arrows(centres[drawn], forces[drawn] * scene.force_scale, 1.0, tip_length=0.22,
+                               tip_radius=0.09, shaft_radius=shaft)
+        if arrows is not None:
+            pl.add_mesh(arrows, color=colour, lighting=False, render=False)
     fe = np.asarray(scene.bearing_forces, dtype=float)
     hb = None if scene.rigid_forces is None else np.asarray(scene.rigid_forces, dtype=float)
     labels, anchors = [], []
@@ -278,7 +355,7 @@ def _bearing_arrows(pv, pl, scene: StressScene) -> None:
     # no box: the labels sit inside the (empty, white) bores, and a box does not fit two centred lines
     pl.add_point_labels(np.column_stack([np.asarray(anchors), np.full(len(anchors), 2.0)]), labels, font_size=16,
                         point_size=1, text_color="black", shape=None, always_visible=True, show_points=False,
-                        justification_horizontal="center")
+                        justification_horizontal="center", render=False)
     key = ["black arrows: FE bearing forces on the disc"]
     if scene.rigid_forces is not None:
         key.append("grey arrows: handbook (rigid) forces")
@@ -286,13 +363,309 @@ def _bearing_arrows(pv, pl, scene: StressScene) -> None:
     top = float(np.max(scene.von_mises))
     if top > scene.clim[1] * (1 + 1e-9):
         key.append(f"{ABOVE_COLOUR}: above {scene.clim[1]:.0f} MPa (contact spots, up to {top:.0f} MPa)")
-    pl.add_text("\n".join(key), position="lower_right", font_size=10, color="black")
+    pl.add_text("\n".join(key), position="lower_right", font_size=10, color="black", render=False)
+
+
+def _same_array(a, b) -> bool:
+    return a is b or (np.shape(a) == np.shape(b) and np.array_equal(a, b))
+
+
+def _same_boundaries(a: dict, b: dict) -> bool:
+    return a is b or (list(a) == list(b) and all(_same_array(a[k], b[k]) for k in a))
+
+
+class StressRenderer:
+    """Stress images of one disc drawn in turn with one off-screen plotter.
+
+    A new plotter costs an OpenGL context, and the first frame of a context uploads the disc mesh
+    and compiles the shaders; a series of images therefore shares one plotter. The disc mesh
+    (points and triangles) is built once; per image its points (the magnified deformation) and
+    its von Mises values are updated in place, with the colour range, the "above" colour and the
+    element edges. What differs between images (pins, force arrows, labels, texts, marker, scale
+    bar, locator inset) is added for one image and removed after its frame. Each image is exactly
+    one rendered frame.
+
+    The PNG files are encoded and written by a background thread while the next image renders:
+    a file is complete only when :meth:`close` has returned (use the renderer as a context
+    manager). The plotter is used only by the thread that created the renderer.
+
+    Parameters
+    ----------
+    window_size : (int, int)
+        Image size in pixels (width, height).
+    compress_level : int
+        zlib level of the PNG files, 0 (none) to 9 (smallest, slowest).
+    anti_aliasing : {"fxaa", "msaa", "none"}
+        Smoothing of the edges (:data:`ANTI_ALIASING`). With ``"fxaa"`` the first image of the
+        whole disc is checked, and the renderer switches to ``"msaa"`` (with a warning in the
+        log) if the pass does not render correctly here.
+
+    Attributes
+    ----------
+    window_size : (int, int)
+    compress_level : int
+    anti_aliasing : str
+        The anti-aliasing in use (``"msaa"`` after a fallback).
+    frames : int
+        Frames rendered so far (one per image, two for an image redrawn after a fallback).
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not available.
+
+    Examples
+    --------
+    >>> with StressRenderer((1500, 1100)) as renderer:            # doctest: +SKIP
+    ...     for k, scene in enumerate(scenes):
+    ...         renderer.write(f"stress_{k}.png", scene)
+    """
+
+    def __init__(self, window_size: tuple[int, int] = (1500, 1100), *, compress_level: int = PNG_COMPRESS_LEVEL,
+                 anti_aliasing: str = ANTI_ALIASING):
+        if anti_aliasing not in _ANTI_ALIASING:
+            raise ValueError(f"anti_aliasing must be one of {', '.join(_ANTI_ALIASING)}, not {anti_aliasing!r}")
+        self.anti_aliasing = anti_aliasing
+        self._pv = _pyvista()
+        self._shapes = _Shapes(self._pv)
+        self.window_size = (int(window_size[0]), int(window_size[1]))
+        self.compress_level = int(compress_level)
+        self.frames = 0
+        self._pl = None
+        self._disc = None
+        self._disc_actor = None
+        self._mesh: tuple | None = None
+        self._writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-png")
+        self._pending: list[Future] = []
+        self._closed = False
+        self._fxaa_checked = False
+        self._plotter()
+
+    def __enter__(self) -> StressRenderer:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close(raise_errors=exc_type is None)
+
+    def _plotter(self):
+        if self._pl is None:
+            pl = self._pv.Plotter(off_screen=True, window_size=list(self.window_size))
+            pl.set_background(BACKGROUND)
+            if self.anti_aliasing != "msaa":
+                pl.disable_anti_aliasing()
+            if self.anti_aliasing == "fxaa":
+                pl.renderer.SetUseFXAA(True)
+            pl.render_window.AddObserver("StartEvent", self._count_frame)
+            self._pl = pl
+        return self._pl
+
+    def _count_frame(self, *_) -> None:
+        self.frames += 1
+
+    def _set_mesh(self, scene: StressScene) -> None:
+        """Build the disc mesh, its colour bar and the undeformed outline (once per mesh)."""
+        if self._mesh is not None:
+            points, triangles, boundaries = self._mesh
+            if (_same_array(points, scene.points) and _same_array(triangles, scene.triangles)
+                    and _same_boundaries(boundaries, scene.boundaries)):
+                return
+        pv, pl = self._pv, self._plotter()
+        pl.clear()
+        pts = np.asarray(scene.points, dtype=float)
+        disc = pv.PolyData.from_regular_faces(_xyz(pts), np.asarray(scene.triangles, dtype=np.int64))
+        disc.point_data[_FIELD] = np.zeros(len(pts))
+        actor = pl.add_mesh(disc, scalars=_FIELD, cmap=COLORMAP, clim=[0.0, 1.0], show_edges=False,
+                            edge_color="#303030", line_width=0.5, lighting=False, render=False,
+                            scalar_bar_args=dict(title=_FIELD, vertical=True, color="black", fmt="%.0f",
+                                                 n_labels=6, position_x=0.87, position_y=0.25, width=0.06,
+                                                 height=0.65, title_font_size=20, label_font_size=18))
+        actor.mapper.lookup_table.above_range_color = ABOVE_COLOUR
+        actor.mapper.lookup_table.SetUseAboveRangeColor(False)
+        bar = pl.scalar_bars[_FIELD]
+        bar.SetAboveRangeAnnotation("above")
+        pl.add_mesh(_outline(pv, pts, scene.boundaries, 0.2), color="#7f7f7f", line_width=1.0, lighting=False,
+                    render=False)
+        self._disc, self._disc_actor = actor.mapper.dataset, actor
+        self._mesh = (scene.points, scene.triangles, scene.boundaries)
+
+    def _update_disc(self, scene: StressScene, show_edges: bool) -> None:
+        """The deformed points, the von Mises values, the colour range and the edges of one image."""
+        pts = np.asarray(scene.points, dtype=float)
+        disc, actor = self._disc, self._disc_actor
+        disc.points = _xyz(pts + scene.magnification * np.asarray(scene.deformation, dtype=float))
+        values = disc.point_data[_FIELD]
+        values[:] = np.asarray(scene.von_mises, dtype=float)
+        disc.GetPointData().GetArray(_FIELD).Modified()
+        disc.Modified()
+        clipped = float(np.max(scene.von_mises)) > scene.clim[1] * (1 + 1e-9)
+        lut = actor.mapper.lookup_table
+        actor.mapper.scalar_range = (float(scene.clim[0]), float(scene.clim[1]))
+        lut.scalar_range = (float(scene.clim[0]), float(scene.clim[1]))
+        lut.SetUseAboveRangeColor(clipped)
+        self._pl.scalar_bars[_FIELD].SetDrawAboveRangeSwatch(clipped)
+        actor.prop.show_edges = bool(show_edges)
+
+    def write(self, path: str | os.PathLike, scene: StressScene, *, focus: tuple[float, float] | None = None,
+              half_height: float | None = None, marker: tuple[float, float] | None = None,
+              show_edges: bool = False) -> Path:
+        """Render von Mises on the deformed disc with pins, bearing force arrows and a colour bar.
+
+        Parameters
+        ----------
+        path : path-like
+            PNG file to write (complete when :meth:`close` returns).
+        scene : StressScene
+        focus : (float, float), optional
+            Centre of a close-up, mm (default: the whole disc, with the bearing forces).
+        half_height : float, optional
+            Half of the visible height, mm (default: the pin ring with a margin; 5 mm for a
+            close-up).
+        marker : (float, float), optional
+            Point to mark with a small ring (e.g. the peak stress), undeformed position, mm.
+        show_edges : bool
+            Draw the element edges (for close-ups).
+
+        Returns
+        -------
+        Path
+
+        Raises
+        ------
+        RenderError
+            If the rendered image is blank (off-screen rendering does not work here), or the
+            renderer is closed.
+        """
+        if self._closed:
+            raise RenderError("the stress renderer is closed")
+        path = Path(path)
+        img = self._frame(scene, focus, half_height, marker, show_edges)
+        if img is None or int(np.min(img)) == int(np.max(img)):
+            raise RenderError(f"the rendered image {path.name} is blank; off-screen rendering does not work here")
+        if self.anti_aliasing == "fxaa" and focus is None and not self._fxaa_checked:
+            # FXAA is a post-processing pass; where it does not work (some OpenGL stacks return a
+            # dark frame) the whole-disc image lacks its wide white margin: use MSAA instead
+            self._fxaa_checked = True
+            if _background_fraction(img) < 0.05:
+                log.warning("FXAA anti-aliasing does not render correctly here; the stress images use MSAA")
+                self._restart("msaa")
+                img = self._frame(scene, focus, half_height, marker, show_edges)
+        self._pending.append(self._writer.submit(_write_png, path, np.array(img, copy=True), self.compress_level))
+        return path
+
+    def _restart(self, anti_aliasing: str) -> None:
+        """A new plotter with another anti-aliasing (the next frame rebuilds the disc)."""
+        if self._pl is not None:
+            self._pl.close()
+        self._pl = self._disc = self._disc_actor = self._mesh = None
+        self.anti_aliasing = anti_aliasing
+
+    def _frame(self, scene: StressScene, focus: tuple[float, float] | None, half_height: float | None,
+               marker: tuple[float, float] | None, show_edges: bool) -> np.ndarray:
+        """Render one image and return its pixels; the per-image actors are removed again."""
+        pv = self._pv
+        self._set_mesh(scene)
+        pl = self._pl
+        self._update_disc(scene, show_edges)
+        window_size = self.window_size
+        before = set(pl.renderer.actors)
+        inset = None
+        try:
+            loaded = np.asarray(scene.pin_loaded, dtype=bool)
+            centres = np.asarray(scene.pin_centres, dtype=float)
+            for flag, colour in ((True, "#4d4d4d"), (False, "#c8c8c8")):
+                pins = self._shapes.discs(centres[loaded == flag], 0.5, 0.0, scene.pin_radius, 48)
+                if pins is not None:
+                    pl.add_mesh(pins, color=colour, lighting=False, render=False)
+            closeup = focus is not None
+            if not closeup:
+                _bearing_arrows(self._shapes, pl, scene)
+            if marker is not None:
+                ring = self._shapes.discs([marker], 3.0, 0.35, 0.5, 32)
+                pl.add_mesh(ring, color="black", lighting=False, render=False)
+            title = pl.add_text(scene.title, position="upper_left", font_size=12 if not closeup else 11,
+                                color="black", render=False)
+            _text_background(title)
+
+            if focus is None:
+                # the whole disc on the left, the colour bar and the legend in the free band on the right
+                r_view = 1.1 * float(np.max(np.hypot(*np.asarray(scene.pin_centres).T)) + scene.pin_radius)
+                aspect = window_size[0] / window_size[1]
+                focus = (max(0.0, r_view * aspect - 1.02 * r_view), 0.0)
+                half_height = r_view if half_height is None else half_height
+            elif half_height is None:
+                half_height = 5.0
+            if closeup:
+                _scale_bar(pv, pl, focus, half_height, window_size[0] / window_size[1])
+                inset = _locator_inset(pv, pl, np.asarray(scene.points, dtype=float), scene.boundaries, focus,
+                                       half_height, window_size[0] / window_size[1],
+                                       fxaa=self.anti_aliasing == "fxaa")
+            _top_view(pl, focus, half_height)
+            pl.render()  # the frame (a no-op before the plotter's first screenshot, which renders it)
+            return pl.screenshot(return_img=True)
+        finally:
+            added = [name for name in pl.renderer.actors if name not in before]
+            if added:
+                pl.remove_actor(added, render=False)
+            if inset is not None:
+                ren, layers = inset
+                pl.render_window.RemoveRenderer(ren)
+                pl.render_window.SetNumberOfLayers(layers)
+
+    def close(self, raise_errors: bool = True) -> None:
+        """Wait for the PNG files, close the plotter; raise the first error of a PNG write.
+
+        Parameters
+        ----------
+        raise_errors : bool
+            Raise an error of a PNG write (else it is logged only).
+
+        Raises
+        ------
+        OSError
+            A PNG file could not be written.
+        """
+        if self._closed:
+            return
+        self._closed = True
+        errors = []
+        for future in self._pending:
+            exc = future.exception()
+            if exc is not None:
+                errors.append(exc)
+        self._pending.clear()
+        self._writer.shutdown(wait=True)
+        if self._pl is not None:
+            self._pl.close()
+            self._pl = None
+        self._disc = self._disc_actor = None
+        for exc in errors[1:] if raise_errors else errors:
+            log.error("writing a stress image failed: %s", exc)
+        if errors and raise_errors:
+            raise errors[0]
+
+
+def _background_fraction(image: np.ndarray) -> float:
+    """Fraction of the pixels in the background colour."""
+    from pyvista import Color
+
+    rgb = np.asarray(Color(BACKGROUND).int_rgb, dtype=image.dtype)
+    return float(np.count_nonzero(np.all(image[..., :3] == rgb, axis=-1))) / (image.shape[0] * image.shape[1])
+
+
+def _write_png(path: Path, image: np.ndarray, compress_level: int) -> Path:
+    from PIL import Image
+
+    Image.fromarray(image).save(path, format="PNG", compress_level=compress_level)
+    return path
 
 
 def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[float, float] | None = None,
                  half_height: float | None = None, marker: tuple[float, float] | None = None,
                  show_edges: bool = False, window_size: tuple[int, int] = (1500, 1100)) -> Path:
     """Render von Mises on the deformed disc with pins, bearing force arrows and a colour bar.
+
+    One image with a plotter of its own; a series of images is faster with one
+    :class:`StressRenderer`.
 
     Parameters
     ----------
@@ -319,55 +692,10 @@ def stress_image(path: str | os.PathLike, scene: StressScene, *, focus: tuple[fl
     RenderError
         If off-screen rendering is not available.
     """
-    pv = _pyvista()
-    path = Path(path)
-    pts = np.asarray(scene.points, dtype=float)
-    disc = pv.PolyData.from_regular_faces(_xyz(pts + scene.magnification * np.asarray(scene.deformation)),
-                                         np.asarray(scene.triangles, dtype=np.int64))
-    disc.point_data["von Mises [MPa]"] = np.asarray(scene.von_mises, dtype=float)
-
-    pl = pv.Plotter(off_screen=True, window_size=list(window_size))
-    pl.set_background(BACKGROUND)
-    clipped = float(np.max(scene.von_mises)) > scene.clim[1] * (1 + 1e-9)
-    pl.add_mesh(disc, scalars="von Mises [MPa]", cmap=COLORMAP, clim=list(scene.clim), show_edges=show_edges,
-                edge_color="#303030", line_width=0.5, lighting=False,
-                above_color=ABOVE_COLOUR if clipped else None,
-                scalar_bar_args=dict(title="von Mises [MPa]", vertical=True, color="black", fmt="%.0f",
-                                     n_labels=6, position_x=0.87, position_y=0.25, width=0.06, height=0.65,
-                                     title_font_size=20, label_font_size=18))
-    pl.add_mesh(_outline(pv, pts, scene.boundaries, 0.2), color="#7f7f7f", line_width=1.0, lighting=False)
-
-    pins = [pv.Disc(center=(x, y, 0.5), inner=0.0, outer=scene.pin_radius, c_res=48)
-            for x, y in np.asarray(scene.pin_centres, dtype=float)]
-    loaded = np.asarray(scene.pin_loaded, dtype=bool)
-    for flag, colour in ((True, "#4d4d4d"), (False, "#c8c8c8")):
-        chosen = [p for p, f in zip(pins, loaded) if bool(f) == flag]
-        if chosen:
-            pl.add_mesh(chosen[0].merge(chosen[1:]) if len(chosen) > 1 else chosen[0], color=colour,
-                        lighting=False)
-
-    closeup = focus is not None
-    if not closeup:
-        _bearing_arrows(pv, pl, scene)
-    if marker is not None:
-        ring = pv.Disc(center=(marker[0], marker[1], 3.0), inner=0.35, outer=0.5, c_res=32)
-        pl.add_mesh(ring, color="black", lighting=False)
-    title = pl.add_text(scene.title, position="upper_left", font_size=12 if not closeup else 11, color="black")
-    _text_background(title)
-
-    if focus is None:
-        # the whole disc on the left, the colour bar and the legend in the free band on the right
-        r_view = 1.1 * float(np.max(np.hypot(*np.asarray(scene.pin_centres).T)) + scene.pin_radius)
-        aspect = window_size[0] / window_size[1]
-        focus = (max(0.0, r_view * aspect - 1.02 * r_view), 0.0)
-        half_height = r_view if half_height is None else half_height
-    elif half_height is None:
-        half_height = 5.0
-    if closeup:
-        _scale_bar(pv, pl, focus, half_height, window_size[0] / window_size[1])
-        _locator_inset(pv, pl, pts, scene.boundaries, focus, half_height, window_size[0] / window_size[1])
-    _top_view(pl, focus, half_height)
-    return _save(pl, path)
+    with StressRenderer(window_size) as renderer:
+        path = renderer.write(path, scene, focus=focus, half_height=half_height, marker=marker,
+                              show_edges=show_edges)
+    return path
 
 
 def _text_background(actor) -> None:
@@ -387,24 +715,30 @@ def _scale_bar(pv, pl, focus: tuple[float, float], half_height: float, aspect: f
     x0 = focus[0] - aspect * half_height * 0.25      # right of the locator inset (lower left)
     y0 = focus[1] - half_height * 0.86
     bar = pv.Box(bounds=(x0, x0 + length, y0, y0 + 0.015 * half_height * 2, 3.0, 3.2))
-    pl.add_mesh(bar, color="black", lighting=False)
+    pl.add_mesh(bar, color="black", lighting=False, render=False)
     pl.add_point_labels([(x0, y0 + 0.06 * half_height, 3.5)], [f"{length:g} mm"], font_size=16,
                         point_size=1, text_color="black", shape_color="white", shape_opacity=0.85,
-                        always_visible=True, show_points=False)
+                        always_visible=True, show_points=False, render=False)
 
 
 def _locator_inset(pv, pl, points: np.ndarray, boundaries: dict, focus: tuple[float, float], half_height: float,
-                   aspect: float) -> None:
-    """A small view of the whole disc in the lower-left corner with a red frame where the close-up is."""
-    import vtk
+                   aspect: float, *, fxaa: bool = False):
+    """A small view of the whole disc in the lower-left corner with a red frame where the close-up is.
 
-    ren = vtk.vtkRenderer()
+    Returns the inset's renderer (added to the plotter's window) and the window's number of
+    layers before it, to remove it again.
+    """
+    from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper, vtkRenderer
+
+    ren = vtkRenderer()
     ren.SetViewport(0.005, 0.005, 0.255, 0.345)
     ren.SetBackground(1.0, 1.0, 1.0)
     ren.SetLayer(1)
     ren.SetPreserveColorBuffer(False)   # its own white background over the close-up
+    ren.SetUseFXAA(fxaa)                # anti-aliased like the close-up (else by the window's MSAA)
     win = pl.render_window
-    win.SetNumberOfLayers(max(2, win.GetNumberOfLayers()))
+    layers = win.GetNumberOfLayers()
+    win.SetNumberOfLayers(max(2, layers))
     outline = _outline(pv, points, boundaries, 0.0)
     w, h = aspect * half_height, half_height
     cx, cy = focus
@@ -414,9 +748,9 @@ def _locator_inset(pv, pl, points: np.ndarray, boundaries: dict, focus: tuple[fl
     backdrop = pv.Plane(center=(0.0, 0.0, -1.0), direction=(0.0, 0.0, 1.0), i_size=4 * r, j_size=4 * r)
     for mesh, colour, width in ((backdrop, (1.0, 1.0, 1.0), 1.0), (outline, (0.3, 0.3, 0.3), 1.0),
                                 (frame, (0.85, 0.0, 0.0), 3.0)):
-        mapper = vtk.vtkPolyDataMapper()
+        mapper = vtkPolyDataMapper()
         mapper.SetInputData(mesh)
-        actor = vtk.vtkActor()
+        actor = vtkActor()
         actor.SetMapper(mapper)
         actor.GetProperty().SetColor(*colour)
         actor.GetProperty().SetLineWidth(width)
@@ -430,3 +764,4 @@ def _locator_inset(pv, pl, points: np.ndarray, boundaries: dict, focus: tuple[fl
     cam.SetParallelScale(r)
     ren.SetInteractive(False)
     win.AddRenderer(ren)
+    return ren, layers
