@@ -634,7 +634,11 @@ def test_p2_recovery_matches_a_full_p2_cycle(coarse_case_file, cache_dir):
     p2 = analyse(coarse_case_file, cache_dir=cache_dir, order=2, recover_stress=False)
     rec, full = p1.stress.recovered, p2.stress.away_from_contacts
     assert rec.peak.von_mises_MPa == pytest.approx(full.von_mises_MPa, rel=0.01)
-    assert (rec.peak.x_mm, rec.peak.y_mm) == pytest.approx((full.x_mm, full.y_mm), abs=1.0)
+    # on the exactly 3-fold symmetric mesh the peak is reached at three places 120° apart: the
+    # same place is one of them
+    n = p1.system.symmetry
+    turns = [np.exp(2j * np.pi * k / n) * complex(rec.peak.x_mm, rec.peak.y_mm) for k in range(n)]
+    assert min(abs(z - complex(full.x_mm, full.y_mm)) for z in turns) <= 1.0
     assert p2.stress.recovered is None and p1.stress.recovered.p1_MPa == p1.stress.away_from_contacts.von_mises_MPa
 
 
