@@ -494,12 +494,20 @@ def palmgren_law(length: float, contacts: int = 2):
     return law
 
 
-def linear_law(stiffness: float, bilateral: bool = False):
-    """Linear spring Q = k·δ (compression only unless ``bilateral``), k in N/mm."""
+def linear_law(stiffness: float, bilateral: bool = False, open_fraction: float = 0.0):
+    """Linear spring Q = k·δ (compression only unless ``bilateral``), k in N/mm.
+
+    ``open_fraction`` > 0 regularises a compression-only spring: at δ ≤ 0 it keeps the stiffness
+    ``open_fraction``·k (a weak tension spring) instead of none. Only the first, linearised solve
+    of a cycle uses it (:func:`solve_bodies`).
+    """
 
     def law(delta):
         if bilateral:
             return stiffness * delta, np.full_like(delta, stiffness)
+        if open_fraction > 0:
+            k = np.where(delta > 0, stiffness, open_fraction * stiffness)
+            return k * delta, k
         return stiffness * np.maximum(delta, 0.0), np.where(delta > 0, stiffness, 0.0)
 
     return law
@@ -789,12 +797,35 @@ def solve_bodies(bodies: list[Body], torque: float | None, *, coupling: np.ndarr
     if start is not None and [s.force.shape for s in start] != [(n,) for n in sizes]:
         start = None
     if start is None and torque is not None and any(b.cset.laws for b in bodies):
-        linear = [dataclasses.replace(b, cset=dataclasses.replace(
-            b.cset, laws=[(idx, linear_law(ks)) for idx, ks in _secant_stiffnesses(b, torque / len(bodies))]))
-            for b in bodies]
-        start = _newton(linear, torque, coupling, None, max_iterations, label, tol_gap, names, rigid_dofs,
-                        engage_all=True)
+        # the secant springs keep the tension side of their laws: a bilateral spring (the
+        # rigid_bore bearings' x and y springs) made compression-only would be a different problem,
+        # one whose disc may be nearly a mechanism once such a spring opens (with pin friction its
+        # active-set iteration then cycles without end)
+        secants = [_secant_stiffnesses(b, torque / len(bodies)) for b in bodies]
+
+        def linearised(open_fraction):
+            return [dataclasses.replace(b, cset=dataclasses.replace(b.cset, laws=[
+                (idx, linear_law(ks, bilateral=bilateral, open_fraction=open_fraction))
+                for idx, ks, bilateral in secant])) for b, secant in zip(bodies, secants)]
+
+        try:
+            start = _newton(linearised(0.0), torque, coupling, None, max_iterations, label, tol_gap, names,
+                            rigid_dofs, engage_all=True)
+        except ContactError:
+            # a step that opens every pin spring of a disc (a clearance all round, e.g. an
+            # equidistant modification, wider than the approaches of the first step, with stiff
+            # bearings) leaves the disc's and the carrier's rotation free: the next Newton matrix is
+            # singular and the iteration cycles. Open springs that keep a weak stiffness never
+            # leave a mechanism; their small tensile forces are only a start, which the solve
+            # below removes
+            start = _newton(linearised(OPEN_SPRING_FRACTION), torque, coupling, None, max_iterations, label,
+                            tol_gap, names, rigid_dofs, engage_all=True)
     return _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, names, rigid_dofs)
+
+
+OPEN_SPRING_FRACTION = 1e-3
+"""Stiffness of an open compression-only spring in the fallback linearised start, relative to its
+secant stiffness (:func:`solve_bodies`)."""
 
 
 def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, names,
@@ -987,8 +1018,9 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
     return out
 
 
-def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, float]]:
-    """A secant stiffness (N/mm) per spring group for the first, linearised solve of a cycle.
+def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, float, bool]]:
+    """A secant stiffness (N/mm) per spring group for the first, linearised solve of a cycle, and
+    whether the group's law also carries tension (bilateral springs stay bilateral).
 
     Each group gets the secant of its own law at a force of the order it will carry: a bearing
     contact (with a carrier lever) about a quarter of T/r (r its lever arm); a pin about the mean
@@ -1007,8 +1039,15 @@ def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, flo
             q_ref = abs(torque) / lever / 4.0
         else:
             q_ref = abs(torque) / max(0.5 * float(moments[idx].sum()), 1e-30)
-        out.append((idx, _secant(law, q_ref)))
+        ks = _secant(law, q_ref)
+        out.append((idx, ks, _carries_tension(law, q_ref / ks)))
     return out
+
+
+def _carries_tension(law, delta: float) -> bool:
+    """True if a force law gives a tensile (negative) force at the negative approach −δ (a
+    bilateral spring), False for a compression-only law (zero force there)."""
+    return bool(np.all(law(np.array([-delta]))[0] < 0))
 
 
 def _secant(law, q_ref: float) -> float:

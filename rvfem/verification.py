@@ -466,13 +466,16 @@ class _Discs:
 
 
 def rigid_limit_section(discs: _Discs) -> Section:
-    from . import compare, cycle, reducer, rigid
+    import dataclasses
+
+    from . import compare, cycle, reducer, registry, rigid
 
     theta = _thetas()
     stiff = dict(stiffness_scale=1e6, bearing_model="rigid_bore", bearing_stiffness_scale=1e3,
                  pin_model="linear", pin_stiffness_N_per_mm=3e5)
-    system = discs.system("rv40e_solid", **stiff)
-    case = system.case
+    # the handbook and the classical distribution have no friction
+    case = _case("rv40e_solid", "analysis.friction=0")
+    system = dataclasses.replace(discs.system("rv40e_solid", **stiff), case=case)
     one = cycle.load_cycle(system, theta, saved_angles_deg=(), stage=None)
     hb = rigid.handbook_bearing_loads(case, theta)
     f_max = hb.magnitude.max()
@@ -488,11 +491,7 @@ def rigid_limit_section(discs: _Discs) -> Section:
     e_pair = np.abs(pair.bearing_loads.T - hb.magnitude).max() / f_max
     linear = discs.system("rv40e_solid", stiffness_scale=1e3)
     lin_case = _case("rv40e_solid", 'crank_bearing.stiffness_law="linear"',
-                     "crank_bearing.linear_stiffness_N_per_mm=2e5")
-    import dataclasses
-
-    from . import registry
-
+                     "crank_bearing.linear_stiffness_N_per_mm=2e5", "analysis.friction=0")
     lin_system = dataclasses.replace(linear, case=lin_case,
                                      bearings=registry.bearing_model("rollers")(lin_case, 1.0))
     lin = cycle.load_cycle(lin_system, theta, saved_angles_deg=(), stage=None)
@@ -518,8 +517,8 @@ def rigid_limit_section(discs: _Discs) -> Section:
     )
     return Section("4. Rigid limits and the torque split of stiff discs",
                    f"Coarse RV-40E solid disc, {STEP_DEG:g}° steps; 'stiff' is the disc 10⁶× stiffer, "
-                   "rigid-bore bearings 1000× stiffer and linear pin springs of 3e5 N/mm (the handbook's "
-                   "assumptions).", checks)
+                   "rigid-bore bearings 1000× stiffer and linear pin springs of 3e5 N/mm, no pin friction (the "
+                   "handbook's assumptions).", checks)
 
 
 def invariants_section(discs: _Discs) -> tuple[Section, Section]:

@@ -98,6 +98,33 @@ def test_unsettled_active_set_names_the_label(squeezed_cylinder):
                               label="at crank angle 12.00° ")
 
 
+def test_secant_start_keeps_bilateral_springs_bilateral():
+    """The first, linearised solve of a cycle replaces every law by a secant spring; a spring that
+    carries tension (the rigid_bore bearings' x and y springs) must stay bilateral there, a
+    compression-only law (rollers, pins) compression-only."""
+    hertz = contact.hertz_pin_law(length=9.0, pin_radius=3.0, flank_curvature=np.array([0.02, -0.05]),
+                                  pin_modulus=2.06e5, pin_poisson=0.3, disc_modulus=2.06e5,
+                                  disc_poisson=0.3, footprint_half_width=0.5)
+    laws = [(np.arange(2), hertz), (np.array([2, 3]), contact.palmgren_law(9.0)),
+            (np.array([4, 5]), contact.linear_law(7e5, bilateral=True)), (np.array([6]), contact.linear_law(7e5))]
+    lever = np.r_[0.0, 0.0, 36.0, 36.0, 36.0, 36.0, 0.0]
+    cset = contact.ContactSet(sp.csc_matrix(np.ones((1, 7))), np.zeros(7, bool), np.zeros(7), np.zeros(7),
+                              lever, laws)
+    # one interface column whose unit load has a moment of 60 N·mm about the disc centre
+    body = contact.Body(cset, contact.Interface(None, None, None, np.array([[0.0, 0.0, 60.0]]), {}, {}), None)
+    secants = contact._secant_stiffnesses(body, 2.0e5)
+    assert [bilateral for _, _, bilateral in secants] == [False, False, True, False]
+    assert all(1e4 < ks < 1e7 for _, ks, _ in secants)     # N/mm
+
+
+def test_linear_law_open_fraction_keeps_a_weak_tension_spring():
+    delta = np.array([-0.2, 0.0, 0.1])
+    q, dq = contact.linear_law(1e5)(delta)
+    assert np.array_equal(q, [0.0, 0.0, 1e4]) and np.array_equal(dq, [0.0, 0.0, 1e5])
+    q, dq = contact.linear_law(1e5, open_fraction=1e-3)(delta)
+    assert np.allclose(q, [-20.0, 0.0, 1e4], rtol=1e-15) and np.allclose(dq, [100.0, 100.0, 1e5], rtol=1e-15)
+
+
 def test_footprint_columns_carry_unit_force_and_exact_moment(squeezed_cylinder):
     _, _, iface, _, _ = squeezed_cylinder
     res = iface.resultants

@@ -47,8 +47,10 @@ def fanholes(mesh_dir):
 def test_rigid_limit_reproduces_handbook_and_classical_pin_forces(solid):
     """Disc 10⁶× stiffer, bearings 1000× stiffer, linear pin springs: the handbook's assumptions
     (rigid disc held at its centre, pin deflections ∝ the disc rotation's lever arms). Then the
-    FE must give the classical pin forces and the handbook bearing loads."""
-    case, mesh = solid
+    FE must give the classical pin forces and the handbook bearing loads. No friction: the
+    handbook has none."""
+    _, mesh = solid
+    case = coarse("rv40e_solid", analysis={"friction": 0.0})
     system = cycle.build_system(case, mesh, stiffness_scale=1e6, bearing_model="rigid_bore",
                                 bearing_stiffness_scale=1e3, pin_model="linear",
                                 pin_stiffness_N_per_mm=3e5)
@@ -192,7 +194,7 @@ def test_comparison_reports_life_ratio_consistent_with_loads(solid_cycle):
 def test_pin_friction_tilts_the_pin_forces_by_atan_mu_and_keeps_equilibrium(solid):
     """Coulomb friction μ along the sliding direction: every loaded pin's force on the disc has
     the tangential part μ·λ (|F| = λ·√(1 + μ²)), and the disc and carrier stay in equilibrium."""
-    case, mesh = solid
+    _, mesh = solid
     mu = 0.05
     rough = coarse("rv40e_solid", analysis={"friction": mu})
     system = cycle.build_system(rough, mesh)
@@ -203,7 +205,7 @@ def test_pin_friction_tilts_the_pin_forces_by_atan_mu_and_keeps_equilibrium(soli
     assert one.solution.residual["relative"] < 1e-9
     total = one.pin_vectors.sum(axis=0) + one.bearing_forces.sum(axis=0)
     assert np.abs(total).max() <= 1e-9 * one.bearing_loads.max()
-    smooth = cycle.solve_angle(cycle.build_system(case, mesh), 0.3)
+    smooth = cycle.solve_angle(cycle.build_system(coarse("rv40e_solid", analysis={"friction": 0.0}), mesh), 0.3)
     # friction changes the loads by a few percent at μ = 0.05, not by tens of percent
     assert 0.0 < np.abs(one.bearing_loads - smooth.bearing_loads).max() < 0.1 * smooth.bearing_loads.max()
 

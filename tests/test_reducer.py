@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rvfem import cycle, reducer, rigid
-from rvfem.case import load_case
+from rvfem.case import case_from_dict, case_to_dict, load_case
 from rvfem.mesh import mesh_case
 
 from conftest import CASES_DIR, coarse_case as coarse
@@ -196,8 +196,9 @@ def test_two_discs_lower_the_fan_hole_peak_against_one_disc_with_half_the_torque
 
 @pytest.mark.slow
 def test_stiff_discs_share_the_torque_equally_and_give_the_handbook_loads(tmp_path_factory):
-    """The rigid limit of the pair: discs 10⁶× stiffer, bearings 1000× stiffer, linear pins."""
-    case = coarse("rv40e_solid")
+    """The rigid limit of the pair: discs 10⁶× stiffer, bearings 1000× stiffer, linear pins, no
+    friction (the handbook has none)."""
+    case = coarse("rv40e_solid", analysis={"friction": 0.0})
     system = cycle.build_system(case, mesh_case(case, tmp_path_factory.mktemp("meshes")),
                                 stiffness_scale=1e6, bearing_model="rigid_bore",
                                 bearing_stiffness_scale=1e3, pin_model="linear", pin_stiffness_N_per_mm=3e5)
@@ -232,3 +233,52 @@ def test_crankshaft_deflection_follows_the_influence_matrix(fan_system):
     softer = reducer.solve_pair(reducer.build_stage(fan_system, discs=2, influence=2 * f), 0.3)
     assert np.abs(softer.eccentric_displacement).max() > 1.5 * np.abs(pair.eccentric_displacement).max()
     assert softer.torque_Nmm.sum() == pytest.approx(fan_system.case.loads.torque_Nm * 1000.0, rel=1e-12)
+
+
+def test_pin_friction_converges_on_two_discs_with_rigid_bores_and_keeps_each_disc_in_equilibrium(tmp_path_factory):
+    """Hertz pins with Coulomb friction μ = 0.05, two discs on one carrier, crankshafts from the
+    case, bores on rigid rings (two bilateral springs per bearing), each angle solved from a cold
+    start. The first, linearised solve once made the bearings' x and y springs compression-only;
+    with friction the active set then cycled without end at these angles. Each disc stays in
+    equilibrium with the friction forces to round-off, and the two discs' torques add up to T."""
+    mu = 0.05
+    case = coarse("rv40e_solid", analysis={"friction": mu}, crank_bearing={"model": "rigid_bore"})
+    system = cycle.build_system(case, mesh_case(case, tmp_path_factory.mktemp("meshes")))
+    stage = reducer.build_stage(system)
+    assert stage.discs == 2 and stage.influence is not None
+    T = case.loads.torque_Nm * 1000.0
+    for theta in (-0.02, 0.0, 0.02):
+        pair = reducer.solve_pair(stage, theta)
+        assert pair.torque_Nmm.sum() == pytest.approx(T, rel=1e-12)
+        for r in pair.results:
+            res = r.solution.residual
+            assert r.solution.iterations <= 8                # measured 3
+            loaded = r.pin_forces > 0
+            # the friction is there: every loaded pin pushes at atan(μ) to the flank normal
+            assert np.allclose(np.linalg.norm(r.pin_vectors[loaded], axis=1),
+                               r.pin_forces[loaded] * math.sqrt(1 + mu * mu), rtol=1e-9)
+            scale = r.bearing_loads.max()
+            total = r.pin_vectors.sum(axis=0) + r.bearing_forces.sum(axis=0)
+            assert np.abs(total).max() <= 1e-12 * scale
+            assert res["force_N"] <= 1e-12 * scale and res["relative"] < 1e-14
+            assert res["moment_Nmm"] <= 1e-12 * scale * case.cranks.circle_radius
+
+
+def test_pin_friction_converges_with_clearance_all_round_and_stiff_bores(tmp_path_factory):
+    """An equidistant modification (5 µm clearance at every pin) with bores on 1000× stiffer rings:
+    the first, linearised solve opens every pin spring of a disc, which leaves its rotation and the
+    carrier's free (a singular Newton matrix; with friction the iteration cycled). The start falls
+    back to open springs with a weak stiffness, and the pair settles."""
+    case = coarse("rv40e_solid", analysis={"friction": 0.05},
+                  crank_bearing={"model": "rigid_bore", "rigid_bore_stiffness_N_per_mm": 7e8})
+    data = case_to_dict(case)
+    data["cycloid"]["modification"]["equidistant"] = 0.005
+    case = case_from_dict(data, source="clearance all round")
+    system = cycle.build_system(case, mesh_case(case, tmp_path_factory.mktemp("meshes")))
+    stage = reducer.build_stage(system, discs=2, influence=None)
+    pair = reducer.solve_pair(stage, 0.0)
+    assert pair.torque_Nmm.sum() == pytest.approx(case.loads.torque_Nm * 1000.0, rel=1e-12)
+    for r in pair.results:
+        assert r.solution.iterations <= 8                    # measured 3
+        assert r.solution.residual["relative"] < 1e-14
+        assert 0 < r.pins_in_contact < case.pins.count
