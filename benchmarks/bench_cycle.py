@@ -117,7 +117,7 @@ def run_stages(case_path: str) -> tuple[float, dict, float]:
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [sys.executable, "-m", "rvfem.cli", "run", case_path, "-o", str(Path(tmp) / "out")]
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         wall = time.perf_counter() - t0
         timings = json.loads((Path(tmp) / "out" / "summary.json").read_text())["timings_s"]
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
