@@ -77,7 +77,7 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-MESHER_VERSION = 2
+MESHER_VERSION = 3
 """Bumped whenever a change here changes the mesh for the same inputs (invalidates caches)."""
 
 QUALITY_MEASURE = "minSICN"
@@ -93,10 +93,11 @@ HOLE_SIZE_FACTOR = 2.0
 BAND_FACTOR = 2.0
 """Width of the band held at the fine size next to a refined curve, in elements."""
 
-CUT_CLEARANCE = 2.0
+CUT_CLEARANCE = 1.5
 """Smallest clearance between a sector cut and a feature, in element sizes on that feature
 (``size_bore`` for a bore, the hole size for a hole); a disc whose best cut is closer is meshed
-whole."""
+whole. Measured on the coarse fan-hole disc (holes at 0.8 mm, the cut 1.67 sizes from a fillet):
+worst triangle 0.722 (minSICN) against 0.718 for the whole disc."""
 
 SYMMETRY_TOLERANCE = 1e-9
 """Tolerance of the symmetry checks and of the merging of copied nodes, relative to the largest
