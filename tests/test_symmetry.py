@@ -168,3 +168,14 @@ def test_stress_envelope_from_turned_fields_equals_the_one_from_every_field(fan_
         vm.append(np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy))
     direct = np.max(vm, axis=0)
     assert np.abs(result.von_mises_envelope - direct).max() <= 1e-8 * direct.max()
+
+
+def test_turning_onto_contacts_that_are_not_the_turned_ones_is_refused(fan_system):
+    """The contact map is checked: contacts of another angle are not a turned copy."""
+    s = fan_system
+    solved = cycle.solve_angle(s, 0.3)
+    wrong, _ = cycle.contact_set(s, 0.3 + 2 * math.pi / 3 + 0.01)
+    with pytest.raises(ValueError, match="turned contacts"):
+        cycle.turn_result(s, solved, 1, wrong)
+    right, _ = cycle.contact_set(s, 0.3 + 2 * math.pi / 3)
+    assert cycle.turn_result(s, solved, 1, right).origin == (solved, 1)
