@@ -385,7 +385,7 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     k = int(k)
     if k == 0:
         return result
-    beta = 2.0 * math.pi * k / system.symmetry      # signed: the roller cages are not 2π-periodic
+    beta = 2.0 * math.pi * k / system.symmetry      # signed: the result is labelled θ + β
     theta = result.theta + beta
     cset = contacts if contacts is not None else contact_set(system, theta)[0]
     old = result.contacts
@@ -477,8 +477,8 @@ def symmetry_plan(thetas: np.ndarray, order: int = 1, mirror: bool = False):
         g = math.gcd(g, sh)
     turn = n // order if (uniform and order > 1 and n % order == 0) else 0
     half = n // 2 if (uniform and mirror and n % 2 == 0) else 0
-    # every offset d = j − i is reached exactly (no wrap past 2π: the roller cages advance by
-    # (1 − γ)·π per revolution, so θ and θ + 2π are different states) with turns of either sign
+    # every offset d = j − i is reached exactly, with turns of either sign and no wrap past 2π,
+    # so that each result obtained carries the angle θ_j itself
     options = sorted(((swap * half + k * turn, swap, k) for swap in ((0, 1) if half else (0,))
                       for k in (range(-order + 1, order) if turn else (0,))), key=lambda o: abs(o[2]))
     source = []

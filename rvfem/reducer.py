@@ -444,7 +444,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
 
     offsets = [0.0] if stage.second is None else [0.0, math.pi - stage.second_phase]
     distinct = {id(s): s for s in systems}
-    for sid, s in distinct.items():
+    for s in distinct.values():
         ks = [k for k, t in enumerate(systems) if t is s]
         s.compliance.ensure(likely_columns(s, [cset(k, float(thetas[i]) + offsets[k])
                                                for i in solve_at for k in ks]))
@@ -465,8 +465,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
             p = pairs[i]
         else:
             # each disc's solution turned by k steps; disc B may land at θ_j + π − 2π when the
-            # discs are swapped, a state that differs from θ_j + π by the roller cages' phase
-            # only (as the mirrored pairs always did)
+            # discs are swapped: the same state, the cycle being 2π-periodic (roller_angles)
             try:
                 p = _pair(stage, tuple(turn_result(systems[d], r, k, cset(d, r.theta + k * step))
                                        for d, r in enumerate(src)))

@@ -57,7 +57,7 @@ def test_plan_solves_one_period_and_reaches_every_angle_exactly(order, mirror, s
     turn = 2 * math.pi / order
     for j, (i, swap, k) in enumerate(source):
         assert i in solve
-        # no wrap past 2π: the roller cages make θ and θ + 2π different states
+        # no wrap past 2π: every result carries the angle θ_j itself
         assert THETA[i] + swap * math.pi + k * turn == pytest.approx(THETA[j], abs=1e-12)
 
 
