@@ -1,4 +1,5 @@
-"""Small array utilities shared by the modules: read-only arrays and the ordering of mesh edges."""
+"""Small array utilities shared by the modules: read-only arrays, the first of equal maxima and the
+ordering of mesh edges."""
 
 from __future__ import annotations
 
@@ -12,6 +13,17 @@ def readonly(a, dtype=None) -> np.ndarray:
     a = np.ascontiguousarray(a, dtype=dtype)
     a.setflags(write=False)
     return a
+
+
+def first_max(a, rtol: float = 1e-9) -> tuple[int, ...]:
+    """Index of the first largest entry of ``a`` (C order) among those within ``rtol`` of the
+    largest: on a symmetric disc the maxima of a load cycle come in equal copies (bearing i at θ,
+    bearing i + 1 at θ + 360°/N) that differ by round-off only, and the choice among them must
+    not depend on it."""
+    a = np.asarray(a, dtype=float)
+    top = float(np.max(a))
+    flat = int(np.flatnonzero(a.ravel() >= top - rtol * abs(top))[0])
+    return tuple(int(i) for i in np.unravel_index(flat, a.shape))
 
 
 def chain_edges(edges) -> tuple[tuple[np.ndarray, bool], ...]:

@@ -303,6 +303,7 @@ class Compliance:
             raise ValueError("a rotation map needs the floating compliance (give rigid_modes)")
         self.order = int(order) if rotation is not None else 1
         self._orbits = None if rotation is None else _column_orbits(sp.csr_matrix(rotation), self.order)
+        self._images = {}
 
     @property
     def symmetric(self) -> bool:
@@ -314,6 +315,26 @@ class Compliance:
         if self._orbits is None:
             raise ValueError("this compliance has no rotation map")
         return self._orbits[2][int(k) % self.order]
+
+    def rotation_image(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Qᵏ column by column: the (at most two) columns each column turns into and their
+        weights, (n_cols, 2) each (weight 0 pads a single image), so that
+        ``(Qᵏ·W)[images[c, m], j] += weights[c, m]·W[c, j]``."""
+        k = int(k) % self.order
+        if k not in self._images:
+            Q = self.rotation_power(k).tocsc()
+            counts = np.diff(Q.indptr)
+            if counts.max() > 2 or counts.min() < 1:
+                raise ValueError("a column turns into more than two columns")
+            n = Q.shape[1]
+            images = np.repeat(np.arange(n)[:, None], 2, axis=1)
+            weights = np.zeros((n, 2))
+            slot = np.arange(Q.nnz) - np.repeat(Q.indptr[:-1], counts)
+            cols = np.repeat(np.arange(n), counts)
+            images[cols, slot] = Q.indices
+            weights[cols, slot] = Q.data
+            self._images[k] = (images, weights)
+        return self._images[k]
 
     def field(self, load: np.ndarray) -> np.ndarray:
         """Displacement (n_dofs,) or (n_dofs, m) of the disc under nodal loads, mm, in the frame
@@ -353,12 +374,20 @@ class Compliance:
             masters = np.unique(np.concatenate([root[c] for c in need]))
             self._back_substitute(masters[~self.known[masters]])
             mapped = need[~self.known[need]]
-            ks = np.array([power[c] for c in mapped], dtype=int)
+            ks = power[mapped]
+            slot = np.full(self.C.shape[1], -1)
             for k in np.unique(ks):
                 cs = mapped[ks == k]
                 J = np.unique(np.concatenate([root[c] for c in cs]))
-                Qk = powers[k]
-                self.C[:, cs] = Qk @ (self.C[:, J] @ Qk[cs][:, J].toarray().T)
+                # S = Qᵏ[cs, J]ᵀ from the images of J, then C[:, cs] = Qᵏ·C[:, J]·S
+                images, weights = self.rotation_image(k)
+                slot[cs] = np.arange(cs.size)
+                hit = slot[images[J]]
+                S = np.zeros((J.size, cs.size))
+                rows_j, m = np.nonzero(hit >= 0)
+                np.add.at(S, (rows_j, hit[rows_j, m]), weights[J][rows_j, m])
+                slot[cs] = -1
+                self.C[:, cs] = powers[k] @ (self.C[:, J] @ S)
             self.known[mapped] = True
             self.columns_mapped += mapped.size
         self.version += 1
@@ -464,7 +493,7 @@ def _column_orbits(Q: sp.csr_matrix, order: int):
         if t != s:
             raise ValueError("the column map is not of the given order")
     root = [members[root_site[s]] for s in site]
-    return root, power_site[site], powers
+    return root, np.asarray(power_site[site], dtype=int), powers
 
 
 # ------------------------------------------------------------------------------------------------
@@ -595,45 +624,61 @@ def hertz_pin_law(**params):
     """Force–approach law of the pin–flank Hertz line contact (:func:`hertz_pin_approach`),
     inverted: ``law(delta) -> (Q, dQ/dδ)`` per pin (arrays broadcast against the pins' curvatures).
 
-    The inversion is Newton's method on ln Q (δ(Q) ∝ Q up to logarithms, so that ln δ is nearly
-    linear in ln Q), safeguarded by bisection, to a relative 1e-13. δ ≤ 0 gives Q = 0 and
-    dQ/dδ = 0 (compression only, as Palmgren's law).
+    The inversion is closed-form. Below the tangent continuation the approach of
+    :func:`hertz_pin_approach` is δ = P·(α − β ln P) with P = Q/L, β = c_p + c_d and
+    α = c_p(2 ln 4R_p − 1) + 2c_d ln w − β ln(4R/(πE*)) (ln a = ½ ln(4PR/(πE*)) substituted).
+    With P = e^(α/β − t) this is t·e^(−t) = δ·e^(−α/β)/β, whose root on the rising branch
+    (dδ/dP = β(t − 1) > 0, t ≥ 2 below the continuation point) is t = −W₋₁(−δ·e^(−α/β)/β), W₋₁
+    the lower real branch of Lambert's W function (Corless et al., "On the Lambert W function",
+    Adv. Comput. Math. 5, 1996). Beyond the continuation point the law is linear. One Newton step
+    on ln P polishes the result to round-off. δ ≤ 0 gives Q = 0 and dQ/dδ = 0 (compression
+    only, as Palmgren's law).
     """
+    from scipy.special import lambertw
+
     curvature = np.asarray(params["flank_curvature"], dtype=float)
-    params = dict(params)
+    length = float(params["length"])
+    pin_radius, w = float(params["pin_radius"]), float(params["footprint_half_width"])
+    cp = (1.0 - params["pin_poisson"] ** 2) / (np.pi * params["pin_modulus"])
+    cd = (1.0 - params["disc_poisson"] ** 2) / (np.pi * params["disc_modulus"])
+    beta = cp + cd
+    e_star = 1.0 / (np.pi * beta)
+    inv_r = np.maximum(1.0 / pin_radius + curvature, 1e-3 / pin_radius)   # as hertz_pin_approach
+    alpha = (cp * (2.0 * np.log(4.0 * pin_radius) - 1.0) + 2.0 * cd * np.log(w)
+             - beta * np.log(4.0 / (inv_r * np.pi * e_star)))
+    # the continuation point of hertz_pin_approach: dδ/dP = β there, i.e. t = 2
+    P_lim = np.exp(alpha / beta - 2.0)
+    d_lim = 2.0 * beta * P_lim
 
     def law(delta):
         delta = np.asarray(delta, dtype=float)
-        kappa = np.broadcast_to(curvature, np.broadcast(delta, curvature).shape)
-        d = np.broadcast_to(delta, kappa.shape)
+        shape = np.broadcast(delta, curvature).shape
+        d = np.broadcast_to(delta, shape)
+        a_, b_ = np.broadcast_to(alpha, shape), np.broadcast_to(P_lim, shape)
+        dl = np.broadcast_to(d_lim, shape)
+        q = np.zeros(shape)
+        dq = np.zeros(shape)
         pos = d > 0
-        q = np.zeros(kappa.shape)
-        dq = np.zeros(kappa.shape)
-        params["flank_curvature"] = kappa
-        if np.any(pos):
-            dpos = np.where(pos, d, 1.0)
-            # start: the secant at 1 kN
-            d_ref, _ = hertz_pin_approach(np.full(kappa.shape, 1000.0), **params)
-            x = np.log(1000.0 * dpos / d_ref)
-            lo = np.full(kappa.shape, -60.0)
-            hi = np.full(kappa.shape, 40.0)
-            for _ in range(100):
-                dd, dp = hertz_pin_approach(np.exp(x), **params)
-                f = np.log(dd) - np.log(dpos)
-                lo = np.where(f < 0, x, lo)
-                hi = np.where(f >= 0, x, hi)
-                step = -f / (np.exp(x) * dp / dd)
-                x_new = x + step
-                bad = ~np.isfinite(x_new) | (x_new <= lo) | (x_new >= hi) | (dp <= 0)
-                x_new = np.where(bad, 0.5 * (lo + hi), x_new)
-                done = np.abs(x_new - x) < 1e-13
-                x = x_new
-                if np.all(done | ~pos):
-                    break
-            Q = np.exp(x)
-            _, dp = hertz_pin_approach(Q, **params)
-            q = np.where(pos, Q, 0.0)
-            dq = np.where(pos, 1.0 / dp, 0.0)
+        if not np.any(pos):
+            return q, dq
+        dp, ap, Pl, dlp = d[pos], a_[pos], b_[pos], dl[pos]
+        linear = dp > dlp
+        P = Pl + (dp - dlp) / beta                                   # tangent continuation
+        rising = ~linear
+        if np.any(rising):
+            z = dp[rising] / beta * np.exp(-ap[rising] / beta)
+            t = -np.real(lambertw(-z, k=-1))
+            lnP = ap[rising] / beta - t
+            # one Newton step on ln P: f = ln δ(P) − ln δ, f' = 1 − 1/t (δ = βtP)
+            t1 = ap[rising] / beta - lnP
+            f = np.log(beta * t1) + lnP - np.log(dp[rising])
+            lnP = lnP - f / (1.0 - 1.0 / t1)
+            P = P.copy()
+            P[rising] = np.exp(lnP)
+        # dδ/dP = β(t − 1) on the rising branch (t ≥ 2), β on the continuation
+        slope = beta * (np.maximum(ap / beta - np.log(P), 2.0) - 1.0)
+        q[pos] = P * length
+        dq[pos] = length / slope                                     # dQ/dδ = L·dP/dδ
         return q, dq
 
     return law
@@ -869,13 +914,17 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
     r_typ = max(float(np.abs(lever).max()), 1.0)
     cache = {"versions": None, "G": None}
 
+    ensured = np.zeros(nc, dtype=bool)              # contacts whose load columns are known
+
     def G_cols(idx):
         if idx.size == 0:
             return np.zeros((nc, 0))
+        new = idx[~ensured[idx]]
         for k, (b, (touched, _, _, nonzero)) in enumerate(zip(bodies, subs)):
-            local = idx[(idx >= offs[k]) & (idx < offs[k + 1])] - offs[k]
+            local = new[(new >= offs[k]) & (new < offs[k + 1])] - offs[k]
             if local.size:
                 b.compliance.ensure(touched[nonzero[:, local].any(axis=1)])
+        ensured[new] = True
         versions = tuple(b.compliance.version for b in bodies)
         if cache["versions"] != versions:
             if nb == 1:

@@ -28,6 +28,7 @@ import scipy.sparse as sp
 from threadpoolctl import threadpool_limits
 
 from . import contact, registry
+from ._arrays import first_max
 from .case import Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
 from .errors import CaseError
@@ -389,15 +390,13 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     theta = result.theta + beta
     cset = contacts if contacts is not None else contact_set(system, theta)[0]
     old = result.contacts
-    Qk = system.compliance.rotation_power(k)
-    M = _contact_map(Qk, old.W, cset.W)
-    checks = [(M @ old.gap0, cset.gap0), (M @ old.offset, cset.offset), (M @ old.lever, cset.lever)]
+    Qk = system.compliance.rotation_image(k)
+    pairs = [(old.W, cset.W)]
     if old.W_load is not None or cset.W_load is not None:      # friction: the load weights map too
-        WL0 = old.W if old.W_load is None else old.W_load
-        WL1 = cset.W if cset.W_load is None else cset.W_load
-        err = abs(WL1 @ sp.csc_matrix(M) - Qk @ WL0)
-        checks.append((np.array([err.max() if err.nnz else 0.0]), np.zeros(1)))
-    for mapped, direct in checks:     # gaps, offsets and levers (mm; 1e-9 mm absolute), weights
+        pairs.append((old.W if old.W_load is None else old.W_load, cset.W if cset.W_load is None else cset.W_load))
+    M = _contact_map(Qk, *pairs)
+    checks = [(M @ old.gap0, cset.gap0), (M @ old.offset, cset.offset), (M @ old.lever, cset.lever)]
+    for mapped, direct in checks:     # gaps, offsets and levers (mm; 1e-9 mm absolute)
         if np.size(direct) and not np.allclose(mapped, direct, rtol=1e-8, atol=1e-9):
             raise ValueError(f"the contacts at {math.degrees(theta):.3f}° are not the turned contacts of "
                              f"{math.degrees(result.theta):.3f}°")
@@ -430,18 +429,44 @@ def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
     return out
 
 
-def _contact_map(Qk: sp.spmatrix, W0: sp.spmatrix, W1: sp.spmatrix) -> np.ndarray:
-    """M (n_contacts × n_contacts) with W1·M = Qk·W0; ValueError if there is none."""
-    target = sp.csc_matrix(Qk @ W0)
-    W1 = sp.csc_matrix(W1)
-    if W1.shape != target.shape:
-        raise ValueError("the turned angle has a different number of contacts")
-    A = (W1.T @ W1).toarray()
-    M = np.linalg.solve(A, (W1.T @ target).toarray())
+def _contact_map(Qk: tuple[np.ndarray, np.ndarray], *pairs: tuple[sp.spmatrix, sp.spmatrix]) -> np.ndarray:
+    """M (n_contacts × n_contacts) with W1·M = Qk·W0 for the first pair (W0, W1) of contact
+    weights, checked on every pair (the gap weights and, with friction, the load weights);
+    ValueError if there is none.
+
+    ``Qk`` is the column map as images and weights (:meth:`rvfem.contact.Compliance.rotation_image`).
+    The weights touch a few hundred of the interface columns: M is found on the dense rows of
+    those columns only, (W1ᵀW1)·M = W1ᵀ(Qk·W0) in the least-squares sense, and each pair is
+    checked to 1e-8 of its largest weight.
+    """
+    images, weights = Qk
+    blocks = []
+    for W0, W1 in pairs:
+        W0, W1 = sp.csc_matrix(W0), sp.csc_matrix(W1)
+        if W1.shape != W0.shape:
+            raise ValueError("the turned angle has a different number of contacts")
+        j0 = np.repeat(np.arange(W0.shape[1]), np.diff(W0.indptr))
+        turned = (images[W0.indices].ravel(), np.repeat(j0, 2), (weights[W0.indices] * W0.data[:, None]).ravel())
+        j1 = np.repeat(np.arange(W1.shape[1]), np.diff(W1.indptr))
+        blocks.append((W0, turned, (W1.indices, j1, W1.data)))
+    rows = np.unique(np.concatenate([t[0] for _, t, w in blocks] + [w[0] for _, t, w in blocks]))
+
+    def dense(entries, m):
+        r, j, v = entries
+        flat = np.searchsorted(rows, r) * m + j
+        return np.bincount(flat, weights=v, minlength=len(rows) * m).reshape(len(rows), m)
+
+    dense_blocks = [(W0, dense(t, W0.shape[1]), dense(w, W0.shape[1])) for W0, t, w in blocks]
+    _, T, A = dense_blocks[0]
+    try:
+        M = np.linalg.solve(A.T @ A, A.T @ T)
+    except np.linalg.LinAlgError:
+        raise ValueError("the turned contacts are not the solved ones (a contact without weights)") from None
     M[np.abs(M) < 1e-12] = 0.0
-    err = abs(W1 @ sp.csc_matrix(M) - target)
-    if err.nnz and err.max() > 1e-8 * max(float(np.abs(W0.data).max()), 1e-30):
-        raise ValueError("the turned contacts are not the solved ones")
+    for W0, T, A in dense_blocks:
+        scale = max(float(np.abs(W0.data).max()) if W0.nnz else 0.0, 1e-30)
+        if T.size and np.abs(A @ M - T).max() > 1e-8 * scale:
+            raise ValueError("the turned contacts are not the solved ones")
     return M
 
 
@@ -704,7 +729,7 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
     loads = np.linalg.norm(bf, axis=2)
     saved = case.analysis.saved_angles_deg if saved_angles_deg is None else saved_angles_deg
     keep = {int(np.argmin(np.abs(np.angle(np.exp(1j * (thetas - math.radians(a))))))) for a in saved}
-    keep.add(int(np.unravel_index(np.argmax(loads), loads.shape)[0]))
+    keep.add(first_max(loads)[0])
     t1 = time.perf_counter()
     fields = {float(thetas[k]): displacement(system, results[k]) for k in sorted(keep)}
     t_fields = time.perf_counter() - t1

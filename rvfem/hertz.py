@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arrays import first_max
 from .case import Case, CrankBearing
 
 __all__ = [
@@ -342,7 +343,7 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
     z = case.crank_bearing.rollers
     out = {}
     if roller_loads is not None:
-        k, i, j = np.unravel_index(int(np.argmax(roller_loads)), roller_loads.shape)
+        k, i, j = first_max(roller_loads)
         q = float(roller_loads[k, i, j])
         out["fe_rollers"] = RollerHertz("fe_rollers", q, *_case_contacts(case, q), bearing=int(i), roller=int(j),
                                         theta_deg=math.degrees(float(theta[k])))
@@ -351,7 +352,7 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
         out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_case_contacts(case, q),
                                             bearing=rigid_max_bearing, theta_deg=rigid_max_at_deg)
     loads = np.linalg.norm(bearing_forces, axis=2)
-    k, i = np.unravel_index(int(np.argmax(loads)), loads.shape)
+    k, i = first_max(loads)
     q = stribeck_max_roller_load(float(np.linalg.norm(bearing_forces[k, i])), z)
     out["stribeck_flexible"] = RollerHertz("stribeck_flexible", q, *_case_contacts(case, q), bearing=int(i),
                                            theta_deg=math.degrees(float(theta[k])))

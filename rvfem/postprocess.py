@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fem
+from ._arrays import first_max
 
 __all__ = [
     "FieldSnapshot",
@@ -147,7 +148,7 @@ def max_load_index(bearing_forces: np.ndarray) -> tuple[int, int]:
     (int, int)
     """
     loads = np.linalg.norm(bearing_forces, axis=2)
-    k, i = np.unravel_index(int(np.argmax(loads)), loads.shape)
+    k, i = first_max(loads)
     return int(k), int(i)
 
 

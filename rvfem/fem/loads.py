@@ -117,6 +117,12 @@ class BoundaryChain:
 
         return cKDTree(self.points[:-1])
 
+    @functools.cached_property
+    def _edges(self):
+        """Edge start points, edge vectors and their squared lengths."""
+        d = np.diff(self.points, axis=0)
+        return self.points[:-1], d, np.einsum("ij,ij->i", d, d)
+
     def locate(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Arc length of the closest point of the chain to each of ``points``.
 
@@ -133,8 +139,7 @@ class BoundaryChain:
             ``(m,)`` distance to it, mm.
         """
         q = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-        a, d = self.points[:-1], np.diff(self.points, axis=0)
-        ll = np.einsum("ij,ij->i", d, d)
+        a, d, ll = self._edges
         # points near the chain (contact points): the closest point lies on an edge next to one of
         # the nearest vertices; the others get the exhaustive search below
         k = len(a)
