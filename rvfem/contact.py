@@ -346,6 +346,28 @@ class Compliance:
         u = self._solve(load - Rv @ (H.T @ (R.T @ load)))      # Πᵀ·load: balanced on the vertices
         return u - R @ (H @ (Rv.T @ u))                        # Π·u: no rigid fit on the vertices
 
+    def fields(self, loads: np.ndarray) -> np.ndarray:
+        """:meth:`field` of many load cases, (n_dofs, m) → (n_dofs, m): back-substituted in
+        batches of :attr:`batch` on :attr:`workers` threads, as the compliance columns are."""
+        loads = np.asarray(loads, dtype=float)
+        out = np.empty_like(loads)
+        parts = [slice(i, min(i + self.batch, loads.shape[1])) for i in range(0, loads.shape[1], self.batch)]
+
+        def fill(part):
+            out[:, part] = self.field(loads[:, part])
+
+        self._map(fill, parts)
+        return out
+
+    def _map(self, fill, parts) -> None:
+        """``fill(part)`` for every part, on :attr:`workers` threads when there are several."""
+        if len(parts) > 1 and self.workers > 1:
+            with ThreadPoolExecutor(self.workers) as pool:
+                list(pool.map(fill, parts))
+        else:
+            for part in parts:
+                fill(part)
+
     def _direct(self, part: np.ndarray) -> np.ndarray:
         """C[:, part] by back-substitution."""
         Bp = self.B[:, part]
@@ -401,12 +423,7 @@ class Compliance:
         def fill(part):
             self.C[:, part] = self._direct(part)
 
-        if len(parts) > 1 and self.workers > 1:
-            with ThreadPoolExecutor(self.workers) as pool:
-                list(pool.map(fill, parts))
-        else:
-            for part in parts:
-                fill(part)
+        self._map(fill, parts)
         self.known[need] = True
         self.columns_solved += need.size
 

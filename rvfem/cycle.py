@@ -546,13 +546,24 @@ def turn_field(system: DiscSystem, u: np.ndarray, k: int) -> np.ndarray:
 
 def displacements(system: DiscSystem, results):
     """The displacement field of each result in turn (:func:`displacement`), solving each
-    distinct solved angle once: a result obtained by symmetry is its origin's field, turned."""
-    cache = {}
-    for r in results:
-        root, k = r.origin if r.origin is not None else (r, 0)
-        if id(root) not in cache:
-            cache[id(root)] = (root, displacement(system, root))
-        yield turn_field(system, cache[id(root)][1], k)
+    distinct solved angle once (all of them in one batched back-substitution): a result obtained
+    by symmetry is its origin's field, turned."""
+    origins = [r.origin if r.origin is not None and system.node_rotation is not None else (r, 0)
+               for r in results]
+    roots = list({id(root): root for root, _ in origins}.values())
+    cache, done = {}, 0
+    for root, k in origins:
+        if id(root) not in cache:                # the next FIELD_BATCH solved angles at once
+            batch = roots[done:done + FIELD_BATCH]
+            cache.update({id(r): u for r, u in zip(batch, _solved_fields(system, batch).T)})
+            done += len(batch)
+        yield turn_field(system, cache[id(root)], k)
+
+
+FIELD_BATCH = 32
+"""Solved angles whose displacement fields are back-substituted together (batched and threaded
+like the compliance columns; bounded so that a cycle without symmetry does not hold hundreds of
+fields at once)."""
 
 
 def displacement(system: DiscSystem, result: AngleResult) -> np.ndarray:
@@ -560,10 +571,20 @@ def displacement(system: DiscSystem, result: AngleResult) -> np.ndarray:
     if result.origin is not None and system.node_rotation is not None:
         root, k = result.origin
         return turn_field(system, displacement(system, root), k)
-    cset = result.contacts
-    W = cset.W if cset.W_load is None else cset.W_load      # the loads (friction included)
-    f = system.interface.B @ (W @ result.solution.force)
-    return system.compliance.field(np.asarray(f)) + system.rigid_modes @ result.solution.rigid
+    return _solved_fields(system, [result])[:, 0]
+
+
+def _solved_fields(system: DiscSystem, results: list[AngleResult]) -> np.ndarray:
+    """Displacement fields (n_dofs, m) of solved angles, mm: the contact loads (friction
+    included) back-substituted together, plus each angle's rigid motion."""
+    loads, rigid = [], []
+    for r in results:
+        cset = r.contacts
+        W = cset.W if cset.W_load is None else cset.W_load      # the loads (friction included)
+        loads.append(W @ r.solution.force)
+        rigid.append(r.solution.rigid)
+    f = system.interface.B @ np.stack(loads, axis=1)
+    return system.compliance.fields(np.asarray(f)) + system.rigid_modes @ np.stack(rigid, axis=1)
 
 
 @dataclass(frozen=True)
@@ -767,16 +788,22 @@ def _von_mises_envelope(system: DiscSystem, results: list[AngleResult]) -> tuple
     nv = system.model.n_vertices
     envelope = np.full(nv, -np.inf)
     envelope_theta = np.zeros(nv)
+    origins = [r.origin if r.origin is not None else (r, 0) for r in results]
+    roots = list({id(root): root for root, _ in origins}.values())
     solved = {}
-    for r in results:
-        root, k = r.origin if r.origin is not None else (r, 0)
-        if id(root) not in solved:
-            sxx, syy, sxy = (stress_op @ displacement(system, root)).reshape(3, nv)
-            solved[id(root)] = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+    for lo in range(0, len(roots), FIELD_BATCH):          # vertex von Mises of the solved angles
+        batch = roots[lo:lo + FIELD_BATCH]
+        sxx, syy, sxy = (stress_op @ _solved_fields(system, batch)).reshape(3, nv, len(batch))
+        vm = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+        solved.update({id(r): vm[:, j].copy() for j, r in enumerate(batch)})
+    turns = {}
+    for r, (root, k) in zip(results, origins):
         vm = solved[id(root)]
         if k:                              # von Mises is invariant: the values move with the disc
+            if k not in turns:
+                turns[k] = turned_nodes(system, k)[:nv]
             turned = np.empty(nv)
-            turned[turned_nodes(system, k)[:nv]] = vm
+            turned[turns[k]] = vm
             vm = turned
         higher = vm > envelope
         envelope[higher] = vm[higher]
