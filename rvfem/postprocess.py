@@ -532,8 +532,13 @@ def vertex_of(points: np.ndarray, peak: PeakStress) -> int:
 
 def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
                      p2_factor: dict[str, float] | None = None) -> HotSpotHistory:
-    """Vertex stresses at the hot spots at every solved crank angle of a cycle: one
-    back-substitution and a few rows of :func:`rvfem.fem.nodal_stress_operator` per angle.
+    """Vertex stresses at the hot spots at every crank angle of a cycle, by influence
+    coefficients: the few rows S_h of :func:`rvfem.fem.nodal_stress_operator` at the hot spots
+    are back-substituted once, Z = A·S_hᵀ with A = Π K_s⁻¹ Πᵀ the disc's (symmetric) floating
+    compliance (:meth:`rvfem.contact.Compliance.field`), and the stresses of an angle with nodal
+    loads f = B·W·λ and rigid motion a are S_h·(A f + R a) = (ZᵀB)(Wλ) + (S_h R) a: three
+    numbers per hot spot and angle from a product with the angle's contact forces, exactly the
+    stresses of the angle's displacement field (Maxwell–Betti reciprocity).
 
     Parameters
     ----------
@@ -544,7 +549,6 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     p2_factor : dict, optional
         Name → P2/P1 ratio at the hot spot (see :class:`HotSpotHistory`).
     """
-    from .cycle import displacements
     from .fem import StressState, nodal_stress_operator
 
     points = np.asarray(system.mesh.points, dtype=float)
@@ -554,7 +558,12 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     op = nodal_stress_operator(system.model)
     rows = np.concatenate([np.asarray(vertices) + c * nv for c in range(3)])
     sub = op[rows]
-    comps = np.stack([sub @ u for u in displacements(system, cycle.solutions)])   # (n, 3·hot spots)
+    Z = system.compliance.fields(sub.T.toarray())                  # A·S_hᵀ, (n_dofs, 3·hot spots)
+    ZB = np.asarray(system.interface.B.T @ Z).T                    # (3·hot spots, n_columns)
+    SR = np.asarray(sub @ system.rigid_modes)                      # ≈ 0: rigid motions do not strain
+    comps = np.stack([ZB @ ((r.contacts.W if r.contacts.W_load is None else r.contacts.W_load)
+                            @ r.solution.force) + SR @ r.solution.rigid
+                      for r in cycle.solutions])                   # (n, 3·hot spots)
     k = len(vertices)
     state = StressState.from_components(comps[:, :k], comps[:, k:2 * k], comps[:, 2 * k:])
     factors = tuple(float((p2_factor or {}).get(n, 1.0)) for n in names)
