@@ -87,7 +87,7 @@ class DiscSystem:
     contact_sets : dict
         Cache of :func:`contact_set` by crank angle and the objects the contacts are built from
         (mutable, like the compliance): the cycles of the attribution revisit the case cycle's
-        angles.
+        angles; also the contact maps of :func:`turn_result`.
     """
 
     case: Case
@@ -390,11 +390,19 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     theta = result.theta + beta
     cset = contacts if contacts is not None else contact_set(system, theta)[0]
     old = result.contacts
-    Qk = system.compliance.rotation_image(k)
-    pairs = [(old.W, cset.W)]
-    if old.W_load is not None or cset.W_load is not None:      # friction: the load weights map too
-        pairs.append((old.W if old.W_load is None else old.W_load, cset.W if cset.W_load is None else cset.W_load))
-    M = _contact_map(Qk, *pairs)
+    # the map depends only on the two contact sets and the turn: found once per system (the
+    # attribution's cycles turn the same solved angles); the entry keeps its objects so that a
+    # reused id cannot hit
+    key = ("map", id(old), id(cset), k, id(system.compliance))
+    hit = system.contact_sets.get(key)
+    if hit is None or hit[0][0] is not old or hit[0][1] is not cset or hit[0][2] is not system.compliance:
+        Qk = system.compliance.rotation_image(k)
+        pairs = [(old.W, cset.W)]
+        if old.W_load is not None or cset.W_load is not None:      # friction: the load weights map too
+            pairs.append((old.W if old.W_load is None else old.W_load,
+                          cset.W if cset.W_load is None else cset.W_load))
+        hit = system.contact_sets[key] = ((old, cset, system.compliance), _contact_map(Qk, *pairs))
+    M = hit[1]
     checks = [(M @ old.gap0, cset.gap0), (M @ old.offset, cset.offset), (M @ old.lever, cset.lever)]
     for mapped, direct in checks:     # gaps, offsets and levers (mm; 1e-9 mm absolute)
         if np.size(direct) and not np.allclose(mapped, direct, rtol=1e-8, atol=1e-9):
