@@ -239,6 +239,10 @@ def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
 # ------------------------------------------------------------------------------------------------
 
 
+MAP_CHUNK = 256
+"""Columns rotated at a time by :meth:`Compliance.ensure` (bounds its temporaries)."""
+
+
 class Compliance:
     """C = Bᵀ K⁺ B, computed a batch of columns at a time when first needed and cached.
 
@@ -348,10 +352,13 @@ class Compliance:
 
     def fields(self, loads: np.ndarray) -> np.ndarray:
         """:meth:`field` of many load cases, (n_dofs, m) → (n_dofs, m): back-substituted in
-        batches of :attr:`batch` on :attr:`workers` threads, as the compliance columns are."""
+        batches of at most :attr:`batch` on :attr:`workers` threads, as the compliance columns
+        are."""
         loads = np.asarray(loads, dtype=float)
         out = np.empty_like(loads)
-        parts = [slice(i, min(i + self.batch, loads.shape[1])) for i in range(0, loads.shape[1], self.batch)]
+        m = loads.shape[1]
+        size = max(1, min(self.batch, -(-m // self.workers)))     # every thread gets a share
+        parts = [slice(i, min(i + size, m)) for i in range(0, m, size)]
 
         def fill(part):
             out[:, part] = self.field(loads[:, part])
@@ -398,8 +405,9 @@ class Compliance:
             mapped = need[~self.known[need]]
             ks = power[mapped]
             slot = np.full(self.C.shape[1], -1)
-            for k in np.unique(ks):
-                cs = mapped[ks == k]
+            groups = [(k, part) for k in np.unique(ks) for cs_k in [mapped[ks == k]]
+                      for part in np.array_split(cs_k, -(-cs_k.size // MAP_CHUNK))]
+            for k, cs in groups:       # in chunks: the temporaries are (n_cols, chunk) arrays
                 J = np.unique(np.concatenate([root[c] for c in cs]))
                 # S = Qᵏ[cs, J]ᵀ from the images of J, then C[:, cs] = Qᵏ·C[:, J]·S
                 images, weights = self.rotation_image(k)

@@ -568,7 +568,7 @@ def displacements(system: DiscSystem, results):
         yield turn_field(system, cache[id(root)], k)
 
 
-FIELD_BATCH = 32
+FIELD_BATCH = 16
 """Solved angles whose displacement fields are back-substituted together (batched and threaded
 like the compliance columns; bounded so that a cycle without symmetry does not hold hundreds of
 fields at once)."""
