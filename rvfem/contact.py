@@ -37,6 +37,7 @@ the rigid pins) on this small dense system.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import os
 import time
@@ -46,6 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from ._arrays import readonly as _readonly
 from .errors import ContactError
 from .hertz import PALMGREN_COEFFICIENT
 
@@ -104,12 +106,12 @@ class FootprintGrid:
         """Columns per vertex: 1 (radial, bores) or 2 (x and y, profile)."""
         return 1 if self.centre is not None else 2
 
-    @property
+    @functools.cached_property
     def arcs(self) -> np.ndarray:
         """Arc lengths of the column positions, mm, with the loop length appended."""
-        return np.append(self.chain.s[:-1][::self.stride], self.chain.s[-1])
+        return _readonly(np.append(self.chain.s[:-1][::self.stride], self.chain.s[-1]))
 
-    @property
+    @functools.cached_property
     def count(self) -> int:
         """Number of column positions."""
         return len(self.arcs) - 1

@@ -200,21 +200,23 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
                       pin_stiffness_N_per_mm, times, bearings, pins, symmetry, node_rotation)
 
 
-def pin_contacts(system: DiscSystem, theta: float):
+def pin_contacts(system: DiscSystem, theta: float, pc=None):
     """The pin contacts of crank angle θ (rad) as a :class:`rvfem.models.ContactGroup`.
 
     Each pin pushes along the inward normal of the profile at its closest point; the gap is the
     exact one of the (modified, pitch-error) profile. With friction (``analysis.friction`` = μ)
     the load on the disc is λ·(d + μ·s·t) along the known sliding direction, while the gap is
     still measured along the normal d. The pin model's law gets the angle's contacts and the
-    flank curvature at each pin's closest point (the Hertz law depends on it).
+    flank curvature at each pin's closest point (the Hertz law depends on it). ``pc`` passes the
+    angle's :class:`rvfem.geometry.PinContacts` if they are already computed.
     """
     from .geometry import pin_centres, pin_profile_contacts, profile_curvature
     from .models import ContactGroup
 
     case = system.case
     prof = system.interface.grids["profile"]
-    pc = pin_profile_contacts(system.geometry, theta)
+    if pc is None:
+        pc = pin_profile_contacts(system.geometry, theta)
     zp = case.pins.count
     s = prof.arc_of(np.asarray(pc.point))
     inward = -np.asarray(pc.normal)
@@ -252,16 +254,34 @@ def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]
     """
     # a system copied with dataclasses.replace shares the cache: an entry is valid only for the
     # very objects it was built from (kept in the entry, so that their ids cannot be reused)
+    return contact_sets(system, [theta])[0]
+
+
+def contact_sets(system: DiscSystem, thetas) -> list[tuple[ContactSet, list[str]]]:
+    """:func:`contact_set` of many crank angles; the pin contacts of the angles not built yet
+    come from one vectorised closest-point search (:func:`rvfem.geometry.pin_profile_contacts_many`)."""
+    from .geometry import pin_profile_contacts_many
+
+    # a system copied with dataclasses.replace shares the cache: an entry is valid only for the
+    # very objects it was built from (kept in the entry, so that their ids cannot be reused)
     owner = (system.case, system.interface, system.geometry, system.bearings, system.pins)
-    key = (round(float(theta), 12),) + tuple(id(o) for o in owner)
-    hit = system.contact_sets.get(key)
-    if hit is None or any(a is not b for a, b in zip(hit[0], owner)):
-        hit = system.contact_sets[key] = (owner, _contact_set(system, theta))
-    return hit[1]
+    ids = tuple(id(o) for o in owner)
+    keys = [(round(float(theta), 12),) + ids for theta in thetas]
+
+    def cached(key):
+        hit = system.contact_sets.get(key)
+        return hit is not None and all(a is b for a, b in zip(hit[0], owner))
+
+    missing = {key: float(theta) for key, theta in zip(keys, thetas) if not cached(key)}
+    if missing:
+        pcs = pin_profile_contacts_many(system.geometry, list(missing.values()))
+        for (key, theta), pc in zip(missing.items(), pcs):
+            system.contact_sets[key] = (owner, _contact_set(system, theta, pc))
+    return [system.contact_sets[key][1] for key in keys]
 
 
-def _contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
-    pins = pin_contacts(system, theta)
+def _contact_set(system: DiscSystem, theta: float, pc=None) -> tuple[ContactSet, list[str]]:
+    pins = pin_contacts(system, theta, pc)
     centres = crank_centres(system.case)
     bearings = system.bearings.contacts(system.interface, centres, theta)
     zp = pins.size
@@ -731,7 +751,7 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
     with threadpool_limits(limits=1, user_api="blas"):
         if stage is None:
             solve_at, source = symmetry_plan(thetas, system.symmetry)
-            sets = [contact_set(system, float(th)) for th in thetas]
+            sets = contact_sets(system, thetas)
             system.compliance.ensure(likely_columns(system, [sets[i][0] for i in solve_at]))
             t_prefetch = time.perf_counter() - t0
             solved: list[AngleResult] = []

@@ -329,11 +329,17 @@ class PairResult:
     eccentric_displacement: np.ndarray
 
 
+def _disc_angles(stage: ReducerStage, theta: float) -> list[float]:
+    """The crank angle of each disc's own frame at the stage's crank angle θ (rad): disc A at θ,
+    disc B at θ + π − its phase."""
+    return [theta] if stage.second is None else [theta, theta + math.pi - stage.second_phase]
+
+
 def _bodies(stage: ReducerStage, theta: float):
     from .cycle import contact_set
 
     systems = [stage.first] if stage.second is None else [stage.first, stage.second]
-    thetas = [theta] if stage.second is None else [theta, theta + math.pi - stage.second_phase]
+    thetas = _disc_angles(stage, theta)
     phases = [0.0, stage.second_phase][:len(systems)]
     sets = [contact_set(s, th) for s, th in zip(systems, thetas)]
     return systems, thetas, phases, sets
@@ -427,7 +433,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
         stage's description).
     """
-    from .cycle import contact_set, likely_columns, symmetry_plan, turn_result
+    from .cycle import contact_set, contact_sets, likely_columns, symmetry_plan, turn_result
 
     thetas = np.asarray(thetas, dtype=float)
     n = len(thetas)
@@ -442,11 +448,17 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
     def cset(k, theta):
         return contact_set(systems[k], theta)[0]
 
-    offsets = [0.0] if stage.second is None else [0.0, math.pi - stage.second_phase]
-    distinct = {id(s): s for s in systems}
-    for s in distinct.values():
+    # the contacts of every angle a disc is solved or turned to, built in one sweep per system
+    wanted = [[] for _ in systems]
+    for j, (i, swap, k) in enumerate(source):
+        own = _disc_angles(stage, float(thetas[i]))
+        for d in range(len(systems)):
+            wanted[d].append(own[d] if (swap, k) == (0, 0) else own[d ^ swap] + k * step)
+    for d, s in enumerate(systems):
+        contact_sets(s, wanted[d] + [_disc_angles(stage, float(thetas[i]))[d] for i in solve_at])
+    for s in {id(s): s for s in systems}.values():
         ks = [k for k, t in enumerate(systems) if t is s]
-        s.compliance.ensure(likely_columns(s, [cset(k, float(thetas[i]) + offsets[k])
+        s.compliance.ensure(likely_columns(s, [cset(k, _disc_angles(stage, float(thetas[i]))[k])
                                                for i in solve_at for k in ks]))
     log.info("stage compliance prefetch %.2f s", time.perf_counter() - t0)
     pairs: list[PairResult] = []

@@ -31,7 +31,8 @@ from .features import (
     Wall,
     disc_geometry,
 )
-from .kinematics import PinContacts, closest_points, crank_centres, pin_centres, pin_profile_contacts
+from .kinematics import (PinContacts, closest_points, crank_centres, pin_centres, pin_profile_contacts,
+                         pin_profile_contacts_many)
 from .profile import (
     PITCH_BLEND_FRACTION,
     SAMPLES_PER_SEGMENT,
@@ -61,6 +62,7 @@ __all__ = [
     "pin_centres",
     "crank_centres",
     "pin_profile_contacts",
+    "pin_profile_contacts_many",
     "closest_points",
     "disc_geometry",
     "check_undercut",

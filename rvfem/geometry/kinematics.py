@@ -35,6 +35,7 @@ __all__ = [
     "crank_centres",
     "PinContacts",
     "pin_profile_contacts",
+    "pin_profile_contacts_many",
     "closest_points",
 ]
 
@@ -185,6 +186,13 @@ def pin_profile_contacts(geom_or_case, theta: float) -> PinContacts:
         to round-off (≈1e-12 mm), not taken from the samples. For d > 1 a closest point beyond a
         tip corner is the corner itself.
     """
+    return pin_profile_contacts_many(geom_or_case, [theta])[0]
+
+
+def pin_profile_contacts_many(geom_or_case, thetas) -> list[PinContacts]:
+    """:func:`pin_profile_contacts` at many crank angles, with one vectorised closest-point
+    search for all of them (each point's Newton iteration is its own: the results are those of
+    the angles one by one)."""
     if isinstance(geom_or_case, Case):
         case = geom_or_case
         profile = build_profile(case)
@@ -193,27 +201,36 @@ def pin_profile_contacts(geom_or_case, theta: float) -> PinContacts:
         profile, case = geom_or_case.profile, geom_or_case.case     # a DiscGeometry
     else:
         raise TypeError("pin_profile_contacts needs a DiscGeometry or a Case")
-    cxy = pin_centres(case, theta)
-    c = cxy[:, 0] + 1j * cxy[:, 1]
-    seg, s, P, P1 = _closest_points(profile, c)
-    n = -1j * P1 / np.abs(P1)
-    diff = c - P
-    dist = np.abs(diff)
-    # signed distance: positive on the outward side. At a d > 1 corner the normal is undefined;
-    # use the direction to the pin there.
-    sd = np.real(np.conj(diff) * n)
-    if profile.tooth_difference > 1:
-        corner = np.abs(np.abs(s) - profile.half_range) < 1e-12
-        if np.any(corner):
-            inside = _MplPath(profile.points).contains_points(_c2xy(c[corner]))
-            sgn = np.where(inside, -1.0, 1.0)
-            u = diff[corner] / np.where(dist[corner] > 0, dist[corner], 1.0)
-            n = n.copy()
-            n[corner] = sgn * u
-            sd = sd.copy()
-            sd[corner] = sgn * dist[corner]
-    return PinContacts(
-        theta=float(theta), centres=_readonly(cxy), gap=_readonly(sd - case.pins.radius),
-        point=_readonly(_c2xy(P)), normal=_readonly(_c2xy(n)), segment=_readonly(seg),
-        param=_readonly(s),
-    )
+    thetas = [float(t) for t in thetas]
+    if not thetas:
+        return []
+    cxy_all = np.concatenate([pin_centres(case, t) for t in thetas])
+    c_all = cxy_all[:, 0] + 1j * cxy_all[:, 1]
+    seg_all, s_all, P_all, P1_all = _closest_points(profile, c_all)
+    zp = case.pins.count
+    out = []
+    for a, theta in enumerate(thetas):
+        rows = slice(a * zp, (a + 1) * zp)
+        cxy, c, seg, s, P, P1 = cxy_all[rows], c_all[rows], seg_all[rows], s_all[rows], P_all[rows], P1_all[rows]
+        n = -1j * P1 / np.abs(P1)
+        diff = c - P
+        dist = np.abs(diff)
+        # signed distance: positive on the outward side. At a d > 1 corner the normal is undefined;
+        # use the direction to the pin there.
+        sd = np.real(np.conj(diff) * n)
+        if profile.tooth_difference > 1:
+            corner = np.abs(np.abs(s) - profile.half_range) < 1e-12
+            if np.any(corner):
+                inside = _MplPath(profile.points).contains_points(_c2xy(c[corner]))
+                sgn = np.where(inside, -1.0, 1.0)
+                u = diff[corner] / np.where(dist[corner] > 0, dist[corner], 1.0)
+                n = n.copy()
+                n[corner] = sgn * u
+                sd = sd.copy()
+                sd[corner] = sgn * dist[corner]
+        out.append(PinContacts(
+            theta=theta, centres=_readonly(cxy), gap=_readonly(sd - case.pins.radius),
+            point=_readonly(_c2xy(P)), normal=_readonly(_c2xy(n)), segment=_readonly(seg),
+            param=_readonly(s),
+        ))
+    return out
