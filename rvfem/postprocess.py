@@ -386,6 +386,18 @@ def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *
     return tuple(angles[:count])
 
 
+def _fields(system, results) -> list[np.ndarray]:
+    """Displacement fields of solved angles (:func:`rvfem.cycle.displacement`), one
+    back-substitution per distinct solved angle: on a symmetric model an angle obtained by symmetry
+    is its origin's field turned (:func:`rvfem.cycle.displacements`), exactly as
+    :func:`~rvfem.cycle.displacement` gives it."""
+    from .cycle import displacement, displacements
+
+    if getattr(system, "node_rotation", None) is not None:
+        return list(displacements(system, results))
+    return [displacement(system, r) for r in results]
+
+
 def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
                  exclude: dict[str, float] | None = None, p1_peak: PeakStress | None = None,
                  system_p1=None, setup_seconds: float = 0.0) -> RecoveredPeak:
@@ -423,6 +435,7 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     import time
 
     from .cycle import displacement
+    from .fem.stress import displacement_gradients
 
     t0 = time.perf_counter()
     model = system_p2.model
@@ -431,18 +444,17 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     points = np.asarray(points, dtype=float)
     mask = _mask(points, boundaries, exclude)
     candidates = np.flatnonzero(mask)
+    ks = [nearest_index(cycle.theta, float(theta)) for theta in angles]
     best = None
-    for theta in angles:
-        k = nearest_index(cycle.theta, float(theta))
-        u = displacement(system_p2, cycle.solutions[k])
-        fields = fem.stress_fields(model, u)
-        vm = fields.nodal.von_mises
+    for k, u in zip(ks, _fields(system_p2, [cycle.solutions[k] for k in ks])):
+        g = displacement_gradients(model, u)
+        vm = fem.stress_fields(model, u, gradients=g).nodal.von_mises
         v = int(candidates[np.argmax(vm[candidates])])
         if best is None or vm[v] > best[0]:
-            best = (float(vm[v]), v, k, u)
-    value, vertex, k, u = best
+            best = (float(vm[v]), v, k, g)
+    value, vertex, k, g = best
     # the spread of the P2 element stresses at the peak vertex around their average
-    g = model._stress_basis.interpolate(u).grad[:, :, :, :3]      # (2, 2, n_elements, 3 vertices)
+    g = g[:, :, :, :3]                                           # (2, 2, n_elements, 3 vertices)
     lam, mu = fem.plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
     t = model.mesh.t
     local, elems = np.nonzero(t == vertex)

@@ -155,6 +155,43 @@ def test_stiffness_symmetric_psd_with_exactly_three_rigid_modes(order):
     assert ev[3] > 1.5e-4 * ev[-1]                       # ... and no more (measured 3.9e-4, P2)
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_stiffness_equals_scikit_fem_linear_elasticity(order):
+    """The stiffness assembled from scalar gradient products (plane_stress_stiffness) is
+    scikit-fem's generic vector form ``linear_elasticity(λ*, μ)`` on the same P1/P2 basis, entry
+    by entry to round-off, in the same DOF numbering. Unstructured mesh (scikit-fem's refined
+    circle) with the plane-stress constants times the thickness, as build_model uses them."""
+    from skfem import MeshTri, asm
+    from skfem.models.elasticity import linear_elasticity
+
+    mesh = MeshTri.init_circle(3)
+    m = fem.build_model(mesh.p.T, mesh.t.T, E, NU, THICK, order)
+    lam, mu = fem.plane_stress_constants(E, NU)
+    reference = asm(linear_elasticity(lam * THICK, mu * THICK), m.basis).tocsr()
+    assert m.stiffness.shape == reference.shape
+    assert abs(m.stiffness - reference).max() <= 1e-15 * abs(reference).max()    # measured 3.4e-16 (P2)
+    # no structural zeros beyond the generic form's pattern, apart from round-off-sized entries
+    extra = abs(m.stiffness) - abs(m.stiffness).multiply(reference != 0)
+    assert abs(extra).max() <= 1e-15 * abs(reference).max()                      # measured 2.2e-17
+
+
+def test_plane_stress_stiffness_follows_the_given_vector_numbering():
+    """With a scrambled global numbering of the vector DOFs, plane_stress_stiffness returns the
+    same matrix with rows and columns renumbered: K'[π(a), π(b)] = K[a, b]."""
+    from skfem import Basis, ElementTriP2, ElementVector, MeshTri
+    from skfem.assembly import Dofs
+
+    from rvfem.fem.model import plane_stress_stiffness
+
+    mesh = MeshTri.init_circle(2)
+    basis = Basis(mesh, ElementTriP2())
+    dofs = Dofs(mesh, ElementVector(ElementTriP2())).element_dofs
+    k = plane_stress_stiffness(basis, dofs, 2.0, 3.0)
+    pi = np.random.default_rng(3).permutation(k.shape[0])
+    k_scrambled = plane_stress_stiffness(basis, pi[dofs], 2.0, 3.0)
+    assert abs(k_scrambled[pi][:, pi] - k).max() == 0.0
+
+
 def test_stiffness_scales_with_thickness_and_modulus():
     pts, tris, _, _ = annulus(5.0, 9.0, 2, 12)
     k1 = fem.build_model(pts, tris, E, NU, 1.0, 1).stiffness
@@ -589,10 +626,15 @@ def test_nodal_stress_operator_equals_stress_fields(order):
     """The linear operator behind the load cycle's stress envelope reproduces stress_fields."""
     from skfem import MeshTri
 
+    from rvfem.fem.stress import displacement_gradients
+
     mesh = MeshTri.init_circle(3)
     model = fem.build_model(mesh.p.T, mesh.t.T, 2.0e5, 0.3, 2.0, order=order)
     u = np.random.default_rng(1).normal(size=model.n_dofs)
     nodal = fem.stress_fields(model, u).nodal
+    # the same fields from gradients evaluated beforehand
+    again = fem.stress_fields(model, u, gradients=displacement_gradients(model, u))
+    assert np.array_equal(again.nodal.von_mises, nodal.von_mises)
     nv = model.n_vertices
     s = fem.nodal_stress_operator(model) @ u
     for k, comp in enumerate((nodal.sxx, nodal.syy, nodal.sxy)):
