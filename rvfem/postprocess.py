@@ -348,10 +348,16 @@ class RecoveredPeak:
 
 
 def _mask(points: np.ndarray, boundaries: dict[str, np.ndarray], exclude: dict[str, float] | None) -> np.ndarray:
+    """Vertices at least ``exclude[name]`` (mm) from every named boundary's vertices (the mask of
+    :func:`peak_von_mises`); the k-d tree search stops at the band (farther vertices are kept
+    whatever their distance)."""
+    from scipy.spatial import cKDTree
+
     mask = np.ones(len(points), dtype=bool)
     for name, band in (exclude or {}).items():
         if name in boundaries and band > 0:
-            mask &= _distances(points, points[np.asarray(boundaries[name])[:, 0]]) >= band
+            tree = cKDTree(points[np.asarray(boundaries[name])[:, 0]])
+            mask &= tree.query(points, distance_upper_bound=band)[0] >= band
     return mask
 
 
