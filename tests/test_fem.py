@@ -456,6 +456,26 @@ def test_minimal_support_gives_the_floating_body_solution(order):
         assert np.abs(s.von_mises - s_ref.von_mises).max() <= 1e-12 * s_ref.von_mises.max()  # measured 3.3e-13
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_superlu_with_its_supernode_settings_solves_to_round_off(order):
+    """SuperLU with rvfem's supernode relaxation and panel size (fem.solve.SUPERLU_RELAX,
+    SUPERLU_PANEL_SIZE) on a mesh with thousands of DOFs (many supernodes and panels): the
+    residual of K_ff u = f is at round-off, and the solution is the one of SciPy's default
+    settings to round-off."""
+    pts, tris, _, _ = annulus(5.0, 9.0, 10, 96)
+    m = fem.build_model(pts, tris, E, NU, THICK, order)
+    fac = fem.factorize(m, solver="superlu")
+    rhs = np.random.default_rng(11).normal(size=(m.n_dofs, 5))
+    u = fac.solve(rhs)
+    kff = m.stiffness[fac.free_dofs][:, fac.free_dofs].tocsc()
+    f = rhs[fac.free_dofs]
+    residual = kff @ u[fac.free_dofs] - f
+    assert np.abs(residual).max() <= 1e-11 * np.abs(f).max()       # measured 7.8e-13 (P2)
+    default = spla.splu(kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                        options={"SymmetricMode": True}).solve(f)
+    assert np.abs(u[fac.free_dofs] - default).max() <= 1e-12 * np.abs(default).max()  # measured 6.9e-14 (P2)
+
+
 @pytest.mark.parametrize("solver", fem.available_solvers())
 def test_every_available_solver_agrees_with_spsolve(solver):
     pts, tris, _, _ = annulus(5.0, 9.0, 4, 32)
