@@ -437,6 +437,9 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     contact problem spread by the P2 consistent footprint weights, so each body is in equilibrium
     exactly as in the P1 solve. The P2 response is the stress under these forces; the contact
     forces themselves would change by less than 0.1 % on P2 (the bearing loads do, docs/theory.md).
+    Each distinct solved angle is back-substituted once: on a symmetric disc an angle the cycle
+    obtained by symmetry gets its origin's P2 field turned (:func:`rvfem.cycle.displacements`),
+    the field :func:`rvfem.cycle.displacement` gives.
     """
     import time
 
