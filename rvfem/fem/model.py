@@ -168,14 +168,15 @@ def plane_stress_stiffness(scalar_basis: Any, vector_element_dofs: np.ndarray, l
 
     For u = φ_j e_a and v = φ_i e_b (φ the scalar shape functions, e_x, e_y the unit vectors) the
     bilinear form splits into the scalar gradient products D_xx, D_yy, D_xy (:data:`_D_XX`…)
-    ([1]_ § 6.2, the element matrix B_iᵀ D B_j written out)::
+    ([1]_ ch. 6, the element matrix B_iᵀ D B_j written out)::
 
         K_xx = (λ + 2μ) D_xx + μ D_yy        K_xy = λ D_xy + μ D_xyᵀ
         K_yx = λ D_xyᵀ + μ D_xy              K_yy = (λ + 2μ) D_yy + μ D_xx
 
-    This is scikit-fem's ``linear_elasticity(λ, μ)`` on the vector basis term by term, with six
-    (P1: three) instead of twelve (P1: six) local functions per triangle and no zero components;
-    the two agree to round-off (tests/test_fem.py).
+    This is scikit-fem's ``linear_elasticity(λ, μ)`` on the vector basis term by term: three
+    scalar forms of 6×6 (P1: 3×3) cheap local products per triangle instead of one vector form of
+    12×12 (P1: 6×6) tensor products, half of whose components are zero; the two agree to
+    round-off (tests/test_fem.py).
 
     Parameters
     ----------
@@ -186,7 +187,7 @@ def plane_stress_stiffness(scalar_basis: Any, vector_element_dofs: np.ndarray, l
         (``skfem.assembly.Dofs(mesh, ElementVector(element)).element_dofs``): local DOF 2k + c is
         component c (x, y) of scalar local function k. Gives the global numbering of the result.
     lam, mu : float
-        Lamé constants times the thickness, N/mm² · mm (the plane-stress λ* for plane stress).
+        Lamé constants times the thickness, MPa·mm = N/mm (the plane-stress λ* for plane stress).
 
     Returns
     -------
