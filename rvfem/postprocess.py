@@ -349,10 +349,16 @@ class RecoveredPeak:
 
 
 def _mask(points: np.ndarray, boundaries: dict[str, np.ndarray], exclude: dict[str, float] | None) -> np.ndarray:
+    """Vertices at least ``exclude[name]`` (mm) from every named boundary's vertices (the mask of
+    :func:`peak_von_mises`); the k-d tree search stops at the band (farther vertices are kept
+    whatever their distance)."""
+    from scipy.spatial import cKDTree
+
     mask = np.ones(len(points), dtype=bool)
     for name, band in (exclude or {}).items():
         if name in boundaries and band > 0:
-            mask &= _distances(points, points[np.asarray(boundaries[name])[:, 0]]) >= band
+            tree = cKDTree(points[np.asarray(boundaries[name])[:, 0]])
+            mask &= tree.query(points, distance_upper_bound=band)[0] >= band
     return mask
 
 
@@ -385,6 +391,18 @@ def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *
         if not any(math.isclose(th, a, abs_tol=1e-12) for a in angles):
             angles.append(th)
     return tuple(angles[:count])
+
+
+def _fields(system, results) -> list[np.ndarray]:
+    """Displacement fields of solved angles (:func:`rvfem.cycle.displacement`), one
+    back-substitution per distinct solved angle: on a symmetric model an angle obtained by symmetry
+    is its origin's field turned (:func:`rvfem.cycle.displacements`), exactly as
+    :func:`~rvfem.cycle.displacement` gives it."""
+    from .cycle import displacement, displacements
+
+    if getattr(system, "node_rotation", None) is not None:
+        return list(displacements(system, results))
+    return [displacement(system, r) for r in results]
 
 
 def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
@@ -420,10 +438,14 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     contact problem spread by the P2 consistent footprint weights, so each body is in equilibrium
     exactly as in the P1 solve. The P2 response is the stress under these forces; the contact
     forces themselves would change by less than 0.1 % on P2 (the bearing loads do, docs/theory.md).
+    Each distinct solved angle is back-substituted once: on a symmetric disc an angle the cycle
+    obtained by symmetry gets its origin's P2 field turned (:func:`rvfem.cycle.displacements`),
+    the field :func:`rvfem.cycle.displacement` gives.
     """
     import time
 
     from .cycle import displacement
+    from .fem.stress import displacement_gradients
 
     t0 = time.perf_counter()
     model = system_p2.model
@@ -432,18 +454,17 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     points = np.asarray(points, dtype=float)
     mask = _mask(points, boundaries, exclude)
     candidates = np.flatnonzero(mask)
+    ks = [nearest_index(cycle.theta, float(theta)) for theta in angles]
     best = None
-    for theta in angles:
-        k = nearest_index(cycle.theta, float(theta))
-        u = displacement(system_p2, cycle.solutions[k])
-        fields = fem.stress_fields(model, u)
-        vm = fields.nodal.von_mises
+    for k, u in zip(ks, _fields(system_p2, [cycle.solutions[k] for k in ks])):
+        g = displacement_gradients(model, u)
+        vm = fem.stress_fields(model, u, gradients=g).nodal.von_mises
         v = int(candidates[np.argmax(vm[candidates])])
         if best is None or vm[v] > best[0]:
-            best = (float(vm[v]), v, k, u)
-    value, vertex, k, u = best
+            best = (float(vm[v]), v, k, g)
+    value, vertex, k, g = best
     # the spread of the P2 element stresses at the peak vertex around their average
-    g = model._stress_basis.interpolate(u).grad[:, :, :, :3]      # (2, 2, n_elements, 3 vertices)
+    g = g[:, :, :, :3]                                           # (2, 2, n_elements, 3 vertices)
     lam, mu = fem.plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
     t = model.mesh.t
     local, elems = np.nonzero(t == vertex)

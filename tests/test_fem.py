@@ -155,6 +155,43 @@ def test_stiffness_symmetric_psd_with_exactly_three_rigid_modes(order):
     assert ev[3] > 1.5e-4 * ev[-1]                       # ... and no more (measured 3.9e-4, P2)
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_stiffness_equals_scikit_fem_linear_elasticity(order):
+    """The stiffness assembled from scalar gradient products (plane_stress_stiffness) is
+    scikit-fem's generic vector form ``linear_elasticity(λ*, μ)`` on the same P1/P2 basis, entry
+    by entry to round-off, in the same DOF numbering. Unstructured mesh (scikit-fem's refined
+    circle) with the plane-stress constants times the thickness, as build_model uses them."""
+    from skfem import MeshTri, asm
+    from skfem.models.elasticity import linear_elasticity
+
+    mesh = MeshTri.init_circle(3)
+    m = fem.build_model(mesh.p.T, mesh.t.T, E, NU, THICK, order)
+    lam, mu = fem.plane_stress_constants(E, NU)
+    reference = asm(linear_elasticity(lam * THICK, mu * THICK), m.basis).tocsr()
+    assert m.stiffness.shape == reference.shape
+    assert abs(m.stiffness - reference).max() <= 1e-15 * abs(reference).max()    # measured 3.4e-16 (P2)
+    # no structural zeros beyond the generic form's pattern, apart from round-off-sized entries
+    extra = abs(m.stiffness) - abs(m.stiffness).multiply(reference != 0)
+    assert abs(extra).max() <= 1e-15 * abs(reference).max()                      # measured 2.2e-17
+
+
+def test_plane_stress_stiffness_follows_the_given_vector_numbering():
+    """With a scrambled global numbering of the vector DOFs, plane_stress_stiffness returns the
+    same matrix with rows and columns renumbered: K'[π(a), π(b)] = K[a, b]."""
+    from skfem import Basis, ElementTriP2, ElementVector, MeshTri
+    from skfem.assembly import Dofs
+
+    from rvfem.fem.model import plane_stress_stiffness
+
+    mesh = MeshTri.init_circle(2)
+    basis = Basis(mesh, ElementTriP2())
+    dofs = Dofs(mesh, ElementVector(ElementTriP2())).element_dofs
+    k = plane_stress_stiffness(basis, dofs, 2.0, 3.0)
+    pi = np.random.default_rng(3).permutation(k.shape[0])
+    k_scrambled = plane_stress_stiffness(basis, pi[dofs], 2.0, 3.0)
+    assert abs(k_scrambled[pi][:, pi] - k).max() == 0.0
+
+
 def test_stiffness_scales_with_thickness_and_modulus():
     pts, tris, _, _ = annulus(5.0, 9.0, 2, 12)
     k1 = fem.build_model(pts, tris, E, NU, 1.0, 1).stiffness
@@ -419,6 +456,26 @@ def test_minimal_support_gives_the_floating_body_solution(order):
         assert np.abs(s.von_mises - s_ref.von_mises).max() <= 1e-12 * s_ref.von_mises.max()  # measured 3.3e-13
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_superlu_with_its_supernode_settings_solves_to_round_off(order):
+    """SuperLU with rvfem's supernode relaxation and panel size (fem.solve.SUPERLU_RELAX,
+    SUPERLU_PANEL_SIZE) on a mesh with thousands of DOFs (many supernodes and panels): the
+    residual of K_ff u = f is at round-off, and the solution is the one of SciPy's default
+    settings to round-off."""
+    pts, tris, _, _ = annulus(5.0, 9.0, 10, 96)
+    m = fem.build_model(pts, tris, E, NU, THICK, order)
+    fac = fem.factorize(m, solver="superlu")
+    rhs = np.random.default_rng(11).normal(size=(m.n_dofs, 5))
+    u = fac.solve(rhs)
+    kff = m.stiffness[fac.free_dofs][:, fac.free_dofs].tocsc()
+    f = rhs[fac.free_dofs]
+    residual = kff @ u[fac.free_dofs] - f
+    assert np.abs(residual).max() <= 1e-11 * np.abs(f).max()       # measured 7.8e-13 (P2)
+    default = spla.splu(kff, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                        options={"SymmetricMode": True}).solve(f)
+    assert np.abs(u[fac.free_dofs] - default).max() <= 1e-12 * np.abs(default).max()  # measured 6.9e-14 (P2)
+
+
 @pytest.mark.parametrize("solver", fem.available_solvers())
 def test_every_available_solver_agrees_with_spsolve(solver):
     pts, tris, _, _ = annulus(5.0, 9.0, 4, 32)
@@ -589,10 +646,15 @@ def test_nodal_stress_operator_equals_stress_fields(order):
     """The linear operator behind the load cycle's stress envelope reproduces stress_fields."""
     from skfem import MeshTri
 
+    from rvfem.fem.stress import displacement_gradients
+
     mesh = MeshTri.init_circle(3)
     model = fem.build_model(mesh.p.T, mesh.t.T, 2.0e5, 0.3, 2.0, order=order)
     u = np.random.default_rng(1).normal(size=model.n_dofs)
     nodal = fem.stress_fields(model, u).nodal
+    # the same fields from gradients evaluated beforehand
+    again = fem.stress_fields(model, u, gradients=displacement_gradients(model, u))
+    assert np.array_equal(again.nodal.von_mises, nodal.von_mises)
     nv = model.n_vertices
     s = fem.nodal_stress_operator(model) @ u
     for k, comp in enumerate((nodal.sxx, nodal.syy, nodal.sxy)):

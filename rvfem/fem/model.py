@@ -35,12 +35,14 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, ElementTriP1, ElementTriP2, ElementVector, MeshTri, asm
-from skfem.models.elasticity import lame_parameters, linear_elasticity
+from skfem import Basis, BilinearForm, ElementTriP1, ElementTriP2, ElementVector, MeshTri
+from skfem.assembly import Dofs
+from skfem.models.elasticity import lame_parameters
 
 from .._arrays import readonly as _readonly
 from ..errors import MeshError
@@ -49,6 +51,7 @@ __all__ = [
     "FEModel",
     "build_model",
     "plane_stress_constants",
+    "plane_stress_stiffness",
     "edge_indices",
     "edge_outward_normals",
 ]
@@ -65,7 +68,9 @@ class FEModel:
     mesh : skfem.MeshTri
         The triangle mesh (vertices numbered as the ``points`` given to :func:`build_model`).
     basis : skfem.CellBasis
-        Vector Lagrange basis (P1 or P2) used to assemble ``stiffness``.
+        Vector Lagrange basis (P1 or P2) whose DOF numbering ``stiffness`` uses (built on first
+        access; the stiffness itself is assembled on the scalar basis, see
+        :func:`plane_stress_stiffness`).
     order : int
         Element order, 1 or 2.
     youngs_modulus : float
@@ -88,7 +93,6 @@ class FEModel:
     """
 
     mesh: MeshTri
-    basis: Any
     order: int
     youngs_modulus: float
     poissons_ratio: float
@@ -98,6 +102,12 @@ class FEModel:
     node_dofs: np.ndarray
     edges: np.ndarray
     _stress_basis: Any = field(repr=False)
+
+    @cached_property
+    def basis(self) -> Any:
+        """Vector Lagrange basis (P1 or P2) with the DOF numbering of ``stiffness``."""
+        scalar = ElementTriP1() if self.order == 1 else ElementTriP2()
+        return Basis(self.mesh, ElementVector(scalar))
 
     @property
     def n_vertices(self) -> int:
@@ -144,6 +154,81 @@ def plane_stress_constants(youngs_modulus: float, poissons_ratio: float) -> tupl
     return 2.0 * lam * mu / (lam + 2.0 * mu), mu
 
 
+#: The three scalar gradient products the plane-stress stiffness is made of (trial ``u``, test
+#: ``v``): D_xx = ∫ ∂xφ_i ∂xφ_j, D_yy = ∫ ∂yφ_i ∂yφ_j, D_xy = ∫ ∂xφ_i ∂yφ_j (row i, column j).
+_D_XX = BilinearForm(lambda u, v, w: u.grad[0] * v.grad[0])
+_D_YY = BilinearForm(lambda u, v, w: u.grad[1] * v.grad[1])
+_D_XY = BilinearForm(lambda u, v, w: u.grad[1] * v.grad[0])
+
+
+def plane_stress_stiffness(scalar_basis: Any, vector_element_dofs: np.ndarray, lam: float,
+                           mu: float) -> sp.csr_matrix:
+    """Stiffness ``∫ ε(v) : C ε(u) dA`` of the isotropic law σ = λ tr(ε) I + 2μ ε, built from
+    scikit-fem assemblies on the scalar basis.
+
+    For u = φ_j e_a and v = φ_i e_b (φ the scalar shape functions, e_x, e_y the unit vectors) the
+    bilinear form splits into the scalar gradient products D_xx, D_yy, D_xy (:data:`_D_XX`…)
+    ([1]_ ch. 6, the element matrix B_iᵀ D B_j written out)::
+
+        K_xx = (λ + 2μ) D_xx + μ D_yy        K_xy = λ D_xy + μ D_xyᵀ
+        K_yx = λ D_xyᵀ + μ D_xy              K_yy = (λ + 2μ) D_yy + μ D_xx
+
+    This is scikit-fem's ``linear_elasticity(λ, μ)`` on the vector basis term by term: three
+    scalar forms of 6×6 (P1: 3×3) cheap local products per triangle instead of one vector form of
+    12×12 (P1: 6×6) tensor products, half of whose components are zero; the two agree to
+    round-off (tests/test_fem.py).
+
+    Parameters
+    ----------
+    scalar_basis : skfem.CellBasis
+        Scalar Lagrange basis (P1 or P2) with its default quadrature.
+    vector_element_dofs : numpy.ndarray
+        ``(2·n_local, n_elements)`` element DOFs of ``ElementVector`` of the same element
+        (``skfem.assembly.Dofs(mesh, ElementVector(element)).element_dofs``): local DOF 2k + c is
+        component c (x, y) of scalar local function k. Gives the global numbering of the result.
+    lam, mu : float
+        Lamé constants times the thickness, MPa·mm = N/mm (the plane-stress λ* for plane stress).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix
+        ``(2·N, 2·N)``, sorted indices, no stored zeros; N the scalar DOF count.
+    """
+    n = scalar_basis.N
+    nb = scalar_basis.Nbfun
+    parts = [form.elemental(scalar_basis) for form in (_D_XX, _D_YY, _D_XY)]
+    rows, cols = parts[0].indices
+    dxx, dyy, dxy = (p.data for p in parts)
+    # element data are laid out (trial j, test i, element): the local transpose swaps the first two
+    dyx = dxy.reshape(nb, nb, -1).transpose(1, 0, 2).ravel()
+    blocks = ((lam + 2.0 * mu) * dxx + mu * dyy, lam * dxy + mu * dyx,
+              lam * dyx + mu * dxy, (lam + 2.0 * mu) * dyy + mu * dxx)
+    # Duplicates summed by scipy, two blocks at a time as the real and imaginary parts of complex
+    # data (summed independently, exactly as two real matrices would be); the same (rows, cols)
+    # give the same structure for all four blocks.
+    pair = [sp.coo_matrix((re + 1j * im, (rows, cols)), shape=(n, n)).tocsr()
+            for re, im in ((blocks[0], blocks[1]), (blocks[2], blocks[3]))]
+    if not (np.array_equal(pair[0].indptr, pair[1].indptr)
+            and np.array_equal(pair[0].indices, pair[1].indices)):
+        raise AssertionError("the stiffness blocks have different structures")  # pragma: no cover
+    # scalar entry (s, t) → the 2×2 block [[K_xx, K_xy], [K_yx, K_yy]] at rows 2s, 2s + 1 and
+    # columns 2t, 2t + 1
+    block_data = np.stack([pair[0].data.real, pair[0].data.imag, pair[1].data.real, pair[1].data.imag],
+                          axis=-1).reshape(-1, 2, 2)
+    k_int = sp.bsr_matrix((block_data, pair[0].indices, pair[0].indptr), shape=(2 * n, 2 * n)).tocsr()
+    # global numbering of the vector element: component c of scalar DOF s → vdofs[c, s]
+    vdofs = np.empty((2, n), dtype=np.int64)
+    for c in range(2):
+        vdofs[c, scalar_basis.element_dofs] = vector_element_dofs[c::2]
+    if not np.array_equal(vdofs.T.ravel(), np.arange(2 * n)):
+        inverse = np.empty(2 * n, dtype=np.int64)
+        inverse[vdofs.T.ravel()] = np.arange(2 * n)
+        k_int = k_int[inverse][:, inverse].tocsr()
+    k_int.eliminate_zeros()
+    k_int.sort_indices()
+    return k_int
+
+
 def build_model(
     points: np.ndarray,
     triangles: np.ndarray,
@@ -183,8 +268,9 @@ def build_model(
     Notes
     -----
     ``K = b ∫ ε(v) : C ε(u) dA`` with the plane-stress law σ = λ* tr(ε) I + 2μ ε
-    (:func:`plane_stress_constants`). scikit-fem's default quadrature (degree 2·order) integrates
-    it exactly on straight-sided triangles.
+    (:func:`plane_stress_constants`), assembled by :func:`plane_stress_stiffness`.
+    scikit-fem's default quadrature (degree 2·order) integrates it exactly on straight-sided
+    triangles.
     """
     if order not in (1, 2):
         raise ValueError(f"element order must be 1 or 2, got {order!r}")
@@ -224,20 +310,19 @@ def build_model(
         np.ascontiguousarray(triangles.T.astype(np.int64)),
     )
     scalar = ElementTriP1() if order == 1 else ElementTriP2()
-    basis = Basis(mesh, ElementVector(scalar))
+    dofs = Dofs(mesh, ElementVector(scalar))
     lam, mu = plane_stress_constants(youngs_modulus, poissons_ratio)
-    stiffness = asm(linear_elasticity(lam * thickness, mu * thickness), basis).tocsr()
-    stiffness.sort_indices()
+    stiffness = plane_stress_stiffness(Basis(mesh, scalar), dofs.element_dofs, lam * thickness, mu * thickness)
 
     edges = np.ascontiguousarray(mesh.facets.T.astype(np.int64))
     if order == 1:
         node_coords = mesh.p.T.copy()
-        node_dofs = basis.nodal_dofs.T.astype(np.int64)
+        node_dofs = dofs.nodal_dofs.T.astype(np.int64)
     else:
         mid = 0.5 * (mesh.p[:, mesh.facets[0]] + mesh.p[:, mesh.facets[1]])
         node_coords = np.vstack([mesh.p.T, mid.T])
-        node_dofs = np.vstack([basis.nodal_dofs.T, basis.facet_dofs.T]).astype(np.int64)
-    if not np.array_equal(np.sort(node_dofs.ravel()), np.arange(basis.N)):
+        node_dofs = np.vstack([dofs.nodal_dofs.T, dofs.facet_dofs.T]).astype(np.int64)
+    if not np.array_equal(np.sort(node_dofs.ravel()), np.arange(dofs.N)):
         raise AssertionError("node/DOF map does not cover the DOFs exactly once")  # pragma: no cover
 
     # Local points (reference triangle vertices 0, 1, 2 and the centroid) for stress recovery.
@@ -246,7 +331,6 @@ def build_model(
 
     return FEModel(
         mesh=mesh,
-        basis=basis,
         order=order,
         youngs_modulus=float(youngs_modulus),
         poissons_ratio=float(poissons_ratio),

@@ -32,6 +32,7 @@ __all__ = [
     "StressState",
     "StressFields",
     "stress_fields",
+    "displacement_gradients",
     "nodal_stress_operator",
 ]
 
@@ -147,7 +148,28 @@ def nodal_stress_operator(model: FEModel) -> sp.csr_matrix:
                          shape=(3 * nv, model.n_dofs))
 
 
-def stress_fields(model: FEModel, u: np.ndarray) -> StressFields:
+def displacement_gradients(model: FEModel, u: np.ndarray) -> np.ndarray:
+    """Displacement gradients ``g[i, j] = ∂u_i/∂x_j`` at the three vertices (local points 0, 1, 2)
+    and the centroid (3) of every triangle, evaluated by scikit-fem (``interpolate(u).grad``).
+
+    Parameters
+    ----------
+    model : FEModel
+    u : numpy.ndarray
+        ``(n_dofs,)`` displacement, mm.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(2, 2, n_elements, 4)``, dimensionless.
+    """
+    u = np.asarray(u, dtype=np.float64)
+    if u.shape != (model.n_dofs,):
+        raise ValueError(f"u must have shape ({model.n_dofs},), got {u.shape}")
+    return np.asarray(model._stress_basis.interpolate(u).grad)
+
+
+def stress_fields(model: FEModel, u: np.ndarray, *, gradients: np.ndarray | None = None) -> StressFields:
     """Plane stresses of a displacement field, per element and at the vertices.
 
     Parameters
@@ -155,16 +177,15 @@ def stress_fields(model: FEModel, u: np.ndarray) -> StressFields:
     model : FEModel
     u : numpy.ndarray
         ``(n_dofs,)`` displacement, mm. Rigid-body motions produce no stress (to first order).
+    gradients : numpy.ndarray, optional
+        ``displacement_gradients(model, u)`` if already computed (then ``u`` is not read again).
 
     Returns
     -------
     StressFields
         MPa.
     """
-    u = np.asarray(u, dtype=np.float64)
-    if u.shape != (model.n_dofs,):
-        raise ValueError(f"u must have shape ({model.n_dofs},), got {u.shape}")
-    g = model._stress_basis.interpolate(u).grad           # (2, 2, n_elements, 4)
+    g = displacement_gradients(model, u) if gradients is None else gradients   # (2, 2, n_elements, 4)
     sxx, syy, sxy = _plane_stress(model, g)
 
     element = StressState.from_components(sxx[:, 3].copy(), syy[:, 3].copy(), sxy[:, 3].copy())
