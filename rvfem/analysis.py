@@ -750,6 +750,7 @@ def _recover_structural_peak(system, cycle, mesh, band, away):
         system_p2, system_p1 = system, None
     else:
         system_p2, system_p1 = build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
+                                            geometry=system.geometry,
                                             pin_model=system.pin_model), system
     setup = time.perf_counter() - t0
     angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
@@ -836,7 +837,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     stages.end("mesh", t)
 
     t = stages.start("model")
-    system = cycle_module.build_system(case, mesh)
+    system = cycle_module.build_system(case, mesh, geometry=geometry)
     stages.end("model", t)
 
     # the rigid model before the cycle: a case outside every rigid reference fails fast

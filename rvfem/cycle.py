@@ -114,7 +114,8 @@ class DiscSystem:
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,
                  stiffness_scale: float = 1.0, pin_model: str | None = None,
                  bearing_stiffness_scale: float = 1.0,
-                 pin_stiffness_N_per_mm: float | None = None, column_stride: int = 1) -> DiscSystem:
+                 pin_stiffness_N_per_mm: float | None = None, column_stride: int = 1,
+                 geometry=None) -> DiscSystem:
     """Assemble and factorise the disc and build its footprint interface.
 
     Parameters
@@ -141,6 +142,8 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
         Interface columns at every stride-th boundary vertex. 1 (default) is the accurate
         choice; 2 halves the back-substitutions (default fan-hole case: cycle 8.5 → 6.0 s) at the
         price of 0.6 % of the maximum bearing load and 5 % on single pin forces.
+    geometry : rvfem.geometry.DiscGeometry, optional
+        The case's checked geometry (:func:`rvfem.geometry.disc_geometry`) if already built.
     """
     from . import fem
     from .geometry import disc_geometry
@@ -154,7 +157,8 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     except KeyError as exc:
         raise CaseError(exc.args[0]) from None
     times = {}
-    geometry = disc_geometry(case)
+    if geometry is None or geometry.case is not case:
+        geometry = disc_geometry(case)
     t0 = time.perf_counter()
     model = fem.build_model(mesh.points, mesh.triangles,
                             youngs_modulus=case.material.youngs_modulus * stiffness_scale,

@@ -268,7 +268,7 @@ def peak_von_mises(source, points: np.ndarray,
     if not mask.any():
         return None
     candidates = np.flatnonzero(mask)
-    vertex = int(candidates[np.argmax(env.von_mises[candidates])])
+    vertex = int(candidates[_first_peak(env, candidates)])
     p = points[vertex]
     feature, dist = "", math.inf
     for name, edges in boundaries.items():
@@ -362,6 +362,17 @@ def _mask(points: np.ndarray, boundaries: dict[str, np.ndarray], exclude: dict[s
     return mask
 
 
+def _first_peak(env: StressEnvelope, candidates: np.ndarray) -> int:
+    """Position in ``candidates`` of the largest envelope value; among values within 1e-9 of it
+    (on a symmetric disc the peak has rotated copies that differ by round-off) the one reached
+    at the smallest crank angle, then the lowest vertex."""
+    vm = env.von_mises[candidates]
+    top = float(vm.max())
+    tied = np.flatnonzero(vm >= top - 1e-9 * abs(top))
+    theta = np.mod(env.theta[candidates][tied], 2.0 * np.pi)
+    return int(tied[np.lexsort((tied, np.round(theta, 9)))[0]])
+
+
 def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
                 exclude: dict[str, float] | None = None, count: int = RECOVERY_ANGLES,
                 within: float = 0.1) -> tuple[float, ...]:
@@ -383,11 +394,12 @@ def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *
         sel = candidates[nearest == j]
         if sel.size == 0:
             continue
-        v = sel[np.argmax(env.von_mises[sel])]
+        v = sel[_first_peak(env, sel)]
         if env.von_mises[v] >= (1.0 - within) * top:
             best.append((float(env.von_mises[v]), float(env.theta[v])))
     angles: list[float] = []
-    for _, th in sorted(best, reverse=True):
+    # highest first; equal peaks (the rotated copies of a symmetric disc, round-off apart) by angle
+    for _, th in sorted(best, key=lambda b: (-round(b[0] / top, 9), b[1])):
         if not any(math.isclose(th, a, abs_tol=1e-12) for a in angles):
             angles.append(th)
     return tuple(angles[:count])
@@ -459,8 +471,8 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     for k, u in zip(ks, _fields(system_p2, [cycle.solutions[k] for k in ks])):
         g = displacement_gradients(model, u)
         vm = fem.stress_fields(model, u, gradients=g).nodal.von_mises
-        v = int(candidates[np.argmax(vm[candidates])])
-        if best is None or vm[v] > best[0]:
+        v = int(candidates[first_max(vm[candidates])[0]])
+        if best is None or vm[v] > best[0] * (1.0 + 1e-9):       # the first of equal peaks
             best = (float(vm[v]), v, k, g)
     value, vertex, k, g = best
     # the spread of the P2 element stresses at the peak vertex around their average

@@ -327,7 +327,9 @@ def build_model(
 
     # Local points (reference triangle vertices 0, 1, 2 and the centroid) for stress recovery.
     xi = np.array([[0.0, 1.0, 0.0, 1.0 / 3.0], [0.0, 0.0, 1.0, 1.0 / 3.0]])
-    stress_basis = Basis(mesh, ElementVector(scalar), quadrature=(xi, np.full(4, 0.125)))
+    # A scalar basis: the gradient of a displacement component is that of its scalar field, and the
+    # vector basis (2× the functions, half of each zero) would hold 4× the data (77 MB on P2)
+    stress_basis = Basis(mesh, scalar, quadrature=(xi, np.full(4, 0.125)))
 
     return FEModel(
         mesh=mesh,

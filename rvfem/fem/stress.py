@@ -130,27 +130,32 @@ def nodal_stress_operator(model: FEModel) -> sp.csr_matrix:
     scipy.sparse.csr_matrix
         ``(3·n_vertices, n_dofs)``, MPa/mm; rows ``[0, nv)`` σxx, ``[nv, 2nv)`` σyy, ``[2nv, 3nv)`` σxy.
     """
-    basis = model._stress_basis
+    basis = model._stress_basis                              # scalar: one function per local node
     t = model.mesh.t
     nv = model.n_vertices
     w, denom = _vertex_weights(model)
     rows, cols, vals = [], [], []
-    for i, (field_i,) in enumerate(basis.basis):
-        comps = _plane_stress(model, field_i.grad[:, :, :, :3])   # each (n_elements, 3 vertices)
-        dof = basis.element_dofs[i]
-        for c, sc in enumerate(comps):
-            for k in range(3):
-                v = t[k]
-                rows.append(c * nv + v)
-                cols.append(dof)
-                vals.append(sc[:, k] * w[k] / denom[v])
+    for a, (phi_a,) in enumerate(basis.basis):
+        dphi = phi_a.grad[:, :, :3]                          # (2, n_elements, 3 vertices)
+        for i in range(2):                                   # the vector function (a, component i)
+            g = np.zeros((2,) + dphi.shape)
+            g[i] = dphi
+            comps = _plane_stress(model, g)                  # each (n_elements, 3 vertices)
+            dof = model.node_dofs[basis.element_dofs[a], i]
+            for c, sc in enumerate(comps):
+                for k in range(3):
+                    v = t[k]
+                    rows.append(c * nv + v)
+                    cols.append(dof)
+                    vals.append(sc[:, k] * w[k] / denom[v])
     return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                          shape=(3 * nv, model.n_dofs))
 
 
 def displacement_gradients(model: FEModel, u: np.ndarray) -> np.ndarray:
     """Displacement gradients ``g[i, j] = ∂u_i/∂x_j`` at the three vertices (local points 0, 1, 2)
-    and the centroid (3) of every triangle, evaluated by scikit-fem (``interpolate(u).grad``).
+    and the centroid (3) of every triangle, from the gradients of scikit-fem's scalar basis
+    functions at those points.
 
     Parameters
     ----------
@@ -166,7 +171,14 @@ def displacement_gradients(model: FEModel, u: np.ndarray) -> np.ndarray:
     u = np.asarray(u, dtype=np.float64)
     if u.shape != (model.n_dofs,):
         raise ValueError(f"u must have shape ({model.n_dofs},), got {u.shape}")
-    return np.asarray(model._stress_basis.interpolate(u).grad)
+    basis = model._stress_basis                              # scalar: ∂u_i/∂x_j = Σ_a u_i,a ∂φ_a/∂x_j
+    components = u[model.node_dofs]                          # (n_nodes, 2): u_x, u_y of each node
+    g = np.zeros((2, 2) + basis.basis[0][0].grad.shape[1:])
+    for a, (phi_a,) in enumerate(basis.basis):
+        ua = components[basis.element_dofs[a]]               # (n_elements, 2)
+        for i in range(2):
+            g[i] += ua[:, i][None, :, None] * phi_a.grad
+    return g
 
 
 def stress_fields(model: FEModel, u: np.ndarray, *, gradients: np.ndarray | None = None) -> StressFields:
