@@ -27,6 +27,7 @@ import math
 import os
 import time
 import tomllib
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
@@ -76,8 +77,8 @@ STAGES: dict[str, str] = {
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
     "stress": "structural stress peak re-solved on P2 at its crank angles",
+    "attribution": "attribution: the reducer-stage models step by step (computed beside the stress stage)",
     "duty_cycle": "flexible load cycle at the other duty-cycle torques",
-    "attribution": "attribution: the reducer-stage models step by step",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
 reports)."""
@@ -872,6 +873,52 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
     stages.end("evaluation", t)
 
+    # what the flexibility effect is made of: the modelling steps the case's own model does not
+    # already give, on the same angles and the same compliance. Mostly small dense solves, it runs
+    # on a thread beside the stress stage (P2 factorisation and back-substitutions, which release
+    # the interpreter); the two share read-only data and the P1 compliance, whose cache is locked
+    pool = ThreadPoolExecutor(1, thread_name_prefix="rvfem-attribution")
+    pending = pool.submit(_timed, reducer.attribution, system, thetas,
+                          cycles={reducer.case_step(case): cycle})
+    try:
+        stress, roller_hertz, stiffness, duty = _evaluate(
+            case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
+            recover_stress)
+        t = stages.start("attribution")
+        attribution, attribution_seconds = pending.result()
+        stages.end("attribution", t)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+    if duty is not None and duty_fe:
+        t = stages.start("duty_cycle")
+        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
+                                                                   duty.flexible.service_life_h))
+        stages.end("duty_cycle", t)
+
+    timings = dict(stages.seconds)
+    timings["attribution_compute"] = attribution_seconds
+    timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
+    timings["cycle_per_angle"] = stages.seconds["cycle"] / n
+    return Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
+                    theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
+                    comparison=comparison, stress=stress, hertz=roller_hertz,
+                    torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
+                    attribution=attribution, references=references)
+
+
+def _timed(function, *args, **kwargs):
+    """``(function(*args, **kwargs), wall time in s)``."""
+    t0 = time.perf_counter()
+    return function(*args, **kwargs), time.perf_counter() - t0
+
+
+def _evaluate(case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
+              recover_stress):
+    """The stress stage (the structural peak re-solved on P2) and the rest of the evaluation:
+    hot-spot histories, Hertz, torsional stiffness, duty-cycle lives from the rigid and flexible
+    loads. Returns (StressResult, Hertz results, stiffness, DutyCycleResult or None)."""
+    from . import postprocess
+
     recovered = None
     if recover_stress and away is not None:
         t = stages.start("stress")
@@ -905,23 +952,4 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
                    if rigid_analysis.defined else None),
             flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
     stages.seconds["evaluation"] += time.perf_counter() - t
-    if duty is not None and duty_fe:
-        t = stages.start("duty_cycle")
-        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
-                                                                   duty.flexible.service_life_h))
-        stages.end("duty_cycle", t)
-
-    # what the flexibility effect is made of: the modelling steps the case's own model does not
-    # already give, on the same angles and the same compliance
-    t = stages.start("attribution")
-    attribution = reducer.attribution(system, thetas, cycles={reducer.case_step(case): cycle})
-    stages.end("attribution", t)
-
-    timings = dict(stages.seconds)
-    timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
-    timings["cycle_per_angle"] = stages.seconds["cycle"] / n
-    return Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
-                    theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
-                    comparison=comparison, stress=stress, hertz=roller_hertz,
-                    torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
-                    attribution=attribution, references=references)
+    return stress, roller_hertz, stiffness, duty

@@ -40,6 +40,7 @@ import dataclasses
 import functools
 import logging
 import os
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -310,6 +311,7 @@ class Compliance:
         self.order = int(order) if rotation is not None else 1
         self._orbits = None if rotation is None else _column_orbits(sp.csr_matrix(rotation), self.order)
         self._images = {}
+        self._lock = threading.Lock()
 
     @property
     def symmetric(self) -> bool:
@@ -394,6 +396,12 @@ class Compliance:
         with a rotation map only those of one sector, the rest are rotated copies.
         """
         columns = np.asarray(columns, dtype=int)
+        if self.known[columns].all():
+            return
+        with self._lock:        # one filler at a time (the attribution runs on its own thread)
+            self._ensure(columns)
+
+    def _ensure(self, columns: np.ndarray) -> None:
         need = np.unique(columns[~self.known[columns]])
         if need.size == 0:
             return
