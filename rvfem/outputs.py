@@ -684,18 +684,20 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
     vtk.mkdir(exist_ok=True)
     model = analysis.system.model
     snapshots = analysis.stress.snapshots
+    points, triangles = model.mesh.p.T, model.mesh.t.T
+    mesh = vtkio.vtu_mesh(points, triangles)   # the same in every file: encoded once
     out, entries = [], []
     for done, snap in enumerate(snapshots, start=1):
         name = vtkio.vtu_name(snap.theta_deg)
-        out.append(vtkio.write_vtu(vtk / name, model.mesh.p.T, model.mesh.t.T, snap))
+        out.append(vtkio.write_vtu(vtk / name, points, triangles, snap, mesh=mesh))
         entries.append((snap.theta_deg, name))
         if tick is not None and done < len(snapshots):
             tick(done, len(snapshots))
     out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
     cy = analysis.cycle
     if cy.von_mises_envelope is not None:
-        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, model.mesh.p.T, model.mesh.t.T,
-                                            cy.von_mises_envelope, cy.von_mises_envelope_theta))
+        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, points, triangles, cy.von_mises_envelope,
+                                            cy.von_mises_envelope_theta, mesh=mesh))
     return out
 
 
