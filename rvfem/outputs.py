@@ -69,6 +69,8 @@ __all__ = [
     "write_tables",
     "write_vtk",
     "write_images",
+    "submit_images",
+    "PendingImages",
     "write_plots",
     "write_summary",
     "write_report",
@@ -716,31 +718,26 @@ def image_count(analysis) -> int:
     return len(s.snapshots) + sum(pk is not None for pk in (s.peak, s.away_from_contacts)) + 1
 
 
-def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None) -> list[Path]:
-    """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
-    stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.plots.mesh_plot`).
+@dataclass(frozen=True, eq=False)
+class _ImageSet:
+    """What :func:`write_images` draws: the stress images (PNG path, scene, keyword arguments of
+    :meth:`rvfem.render.StressRenderer.write`) and the mesh picture (keyword arguments of
+    :func:`rvfem.plots.mesh_plot`)."""
 
-    The stress images share one off-screen plotter (:class:`rvfem.render.StressRenderer`); the
-    mesh picture is drawn by a second thread meanwhile. All files are complete on return.
+    stress: list
+    mesh: dict
 
-    Raises
-    ------
-    RenderError
-        If off-screen rendering is not possible here.
-    """
+
+def _image_set(analysis, images: Path) -> _ImageSet:
     from . import render
     from .geometry import crank_centres
-    from .plots import mesh_plot
 
     a, case, cy = analysis, analysis.case, analysis.cycle
-    images = Path(folder) / "images"
-    images.mkdir(exist_ok=True)
     model, mesh, snapshots = a.system.model, a.mesh, a.stress.snapshots
     peak, away = a.stress.peak, a.stress.away_from_contacts
     vertices, triangles = model.mesh.p.T, model.mesh.t.T
     pin_xy, rigid_forces = a.pin_centres, a.rigid_forces
     k_max, _ = a.max_load_index
-    total = image_count(a)
     max_def = max(float(np.max(np.hypot(*s.deformation.T))) for s in snapshots)
     magnification = render.nice_factor(DEFORMATION_DISPLAY_FRACTION * case.pins.circle_radius / max_def)
     f_ref = max(float(cy.bearing_loads.max()), float(a.rigid.loads.magnitude.max()))
@@ -764,6 +761,129 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
                   f"×{magnification:g}   bearings '{case.crank_bearing.model}', P{model.order}",
         )
 
+    stress = []
+    for snap in snapshots:
+        label = "  (max. bearing load)" if snap.index == k_max else ""
+        stress.append((images / _stress_image_name(snap.theta_deg), scene(snap, label), {}))
+    half = max(5.0, 12.0 * case.mesh.size_bore)
+    rec = a.stress.recovered
+    for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
+                          ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
+        if pk is None:
+            continue
+        snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+        extra = ""
+        if rec is not None and key == "stress_away_from_contacts_closeup":
+            extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
+        close = dataclasses.replace(
+            scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
+            title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
+                  f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, "
+                  f"{pk.feature_label}")
+        stress.append((images / f"{key}.png", close, dict(focus=(pk.x_mm, pk.y_mm), half_height=half,
+                                                          marker=(pk.x_mm, pk.y_mm), show_edges=True)))
+    b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
+    mesh_picture = dict(path=images / "mesh.png", points=vertices, triangles=triangles, boundaries=mesh.boundaries,
+                        closeup_centre=(float(b0[0]), float(b0[1])),
+                        title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
+                              f"(min quality {mesh.min_quality:.2f})",
+                        closeup_title="close-up: the rim under the bore of bearing 1")
+    return _ImageSet(stress=stress, mesh=mesh_picture)
+
+
+class PendingImages:
+    """The images of :func:`submit_images`, being drawn by a :class:`rvfem.render.RenderWorker`;
+    :meth:`result` draws the mesh picture and waits for them."""
+
+    def __init__(self, image_set: _ImageSet, worker):
+        self._set, self._worker = image_set, worker
+
+    def result(self, *, tick: TickCallback | None = None) -> list[Path]:
+        """Draw the mesh picture (in the calling thread), wait for the stress images.
+
+        Parameters
+        ----------
+        tick : callable, optional
+            ``tick(done, total)`` after each image but the last.
+
+        Returns
+        -------
+        list of Path
+            The stress images, the close-ups and the mesh picture, all complete.
+
+        Raises
+        ------
+        RenderError, OSError
+            From the render worker.
+        """
+        from .plots import mesh_plot
+
+        total = len(self._set.stress) + 1
+        done = [0]
+
+        def one_more(_=None) -> None:
+            done[0] += 1
+            if tick is not None and done[0] < total:
+                tick(done[0], total)
+
+        mesh_png = mesh_plot(**self._set.mesh)
+        one_more()
+        stress = self._worker.wait(tick=one_more)
+        return stress + [mesh_png]
+
+
+def submit_images(analysis, folder: str | os.PathLike, worker) -> PendingImages:
+    """Start the images of :func:`write_images` in a render worker's child process, which draws
+    them while this process does other work; :meth:`PendingImages.result` waits for them (and
+    draws the mesh picture).
+
+    Parameters
+    ----------
+    analysis : rvfem.analysis.Analysis
+    folder : path-like
+    worker : rvfem.render.RenderWorker
+        Checked (:meth:`~rvfem.render.RenderWorker.check`) or not; it draws one series.
+
+    Returns
+    -------
+    PendingImages
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    image_set = _image_set(analysis, images)
+    worker.submit(image_set.stress)
+    return PendingImages(image_set, worker)
+
+
+def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None,
+                 worker=None) -> list[Path]:
+    """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
+    stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.plots.mesh_plot`).
+
+    The stress images share one off-screen plotter (:class:`rvfem.render.StressRenderer`); the
+    mesh picture is drawn by a second thread meanwhile. With a render worker
+    (:class:`rvfem.render.RenderWorker`) the stress images are drawn by its child process and the
+    mesh picture by the calling thread (see also :func:`submit_images`). All files are complete
+    on return.
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    if worker is not None:
+        return submit_images(analysis, folder, worker).result(tick=tick)
+    from . import render
+    from .plots import mesh_plot
+
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    total = image_count(analysis)
     out: list[Path] = []
 
     def done(path: Path) -> None:
@@ -771,38 +891,15 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
         if tick is not None and len(out) < total:
             tick(len(out), total)
 
-    b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
+    image_set = _image_set(analysis, images)
     # the mesh picture (matplotlib) is drawn by a second thread while VTK renders the stress images;
     # the renderer is made first, so that PyVista (which imports matplotlib) is imported by this
     # thread alone
     with render.StressRenderer(IMAGE_SIZE) as renderer, \
             ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-mesh-plot") as pool:
-        mesh_png = pool.submit(
-            mesh_plot, images / "mesh.png", vertices, triangles, mesh.boundaries,
-            closeup_centre=(float(b0[0]), float(b0[1])),
-            title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
-                  f"(min quality {mesh.min_quality:.2f})",
-            closeup_title="close-up: the rim under the bore of bearing 1")
-        for snap in snapshots:
-            label = "  (max. bearing load)" if snap.index == k_max else ""
-            done(renderer.write(images / _stress_image_name(snap.theta_deg), scene(snap, label)))
-        half = max(5.0, 12.0 * case.mesh.size_bore)
-        rec = a.stress.recovered
-        for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
-                              ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
-            if pk is None:
-                continue
-            snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
-            extra = ""
-            if rec is not None and key == "stress_away_from_contacts_closeup":
-                extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
-            close = dataclasses.replace(
-                scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
-                title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
-                      f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, "
-                      f"{pk.feature_label}")
-            done(renderer.write(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
-                                marker=(pk.x_mm, pk.y_mm), show_edges=True))
+        mesh_png = pool.submit(mesh_plot, **image_set.mesh)
+        for path, scene, options in image_set.stress:
+            done(renderer.write(path, scene, **options))
         done(mesh_png.result())
     return out
 

@@ -168,3 +168,60 @@ def test_repeated_shapes_are_the_pyvista_shapes():
         np.testing.assert_allclose(arrows.points[k * n:(k + 1) * n], one.points, atol=1e-5)
     assert arrows.n_cells == len(starts) * one.n_cells
     assert shapes.discs(np.zeros((0, 2)), 0.0, 0.0, 1.0, 8) is None
+
+
+def test_a_render_worker_draws_what_the_renderer_draws(scenes, tmp_path):
+    jobs = [(tmp_path / f"worker_{k}.png", s, kw) for k, (s, kw) in enumerate(scenes)]
+    ticks = []
+    with render.RenderWorker(SIZE) as worker:
+        assert worker.check(wait=True) == render.check_rendering()
+        paths = worker.draw(jobs, tick=ticks.append)
+        assert worker.frames == len(scenes) and worker.anti_aliasing == "fxaa"
+    assert paths == [p for p, _, _ in jobs] and ticks == list(range(1, len(scenes) + 1))
+    with render.StressRenderer(SIZE) as renderer:
+        here = [renderer.write(tmp_path / f"here_{k}.png", s, **kw) for k, (s, kw) in enumerate(scenes)]
+    for a, b in zip(paths, here):
+        assert np.array_equal(_read(a), _read(b))
+
+
+def test_a_render_worker_raises_the_errors_of_its_process(scenes, tmp_path):
+    with render.RenderWorker(SIZE) as worker:
+        with pytest.raises(OSError):   # the folder does not exist
+            worker.draw([(tmp_path / "missing" / "image.png", scenes[0][0], {})])
+        with pytest.raises(RenderError, match="one series"):
+            worker.submit([(tmp_path / "again.png", scenes[0][0], {})])
+
+
+def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
+    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render, "_probe_result", None)
+    with render.RenderWorker(SIZE) as worker:
+        with pytest.raises(RenderError, match="off-screen rendering is not available.*crashed.*--no-images"):
+            worker.check()
+    # the process knows it now: a new worker fails at once, without a child process
+    worker = render.RenderWorker(SIZE)
+    with pytest.raises(RenderError, match="crashed"):
+        worker.check(wait=False)
+
+
+def test_a_failed_check_stops_a_run_before_the_load_cycle(monkeypatch, tmp_path):
+    from rvfem import run
+
+    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render, "_probe_result", None)
+    reached = []
+
+    def analyse(case, *, progress, **kwargs):
+        for stage in ("mesh", "model", "rigid", "cycle"):
+            progress(stage, 0, 1)
+            reached.append(stage)
+            progress(stage, 1, 1)
+        raise AssertionError("the load cycle ran")
+
+    monkeypatch.setattr(run, "analyse", analyse)
+    from conftest import CASES_DIR
+
+    with pytest.raises(RenderError, match="off-screen rendering is not available.*crashed"):
+        run.run_case(CASES_DIR / "rv40e_fanholes.toml", tmp_path / "out")
+    assert reached == ["mesh", "model", "rigid"]
+    assert list(tmp_path.iterdir()) == []
