@@ -18,6 +18,7 @@ cheap).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import os
@@ -476,6 +477,21 @@ class StressRenderer:
     def _count_frame(self, *_) -> None:
         self.frames += 1
 
+    def warm_up(self) -> None:
+        """Draw two throwaway frames of a small synthetic disc, the whole disc and a close-up,
+        with every kind of actor of the images: the first real image then finds the shaders
+        compiled and the fonts loaded (a render worker does this while the analysis runs).
+
+        Nothing is written and :attr:`frames` is not counted; the next image rebuilds its disc.
+        """
+        if self._closed:
+            raise RenderError("the stress renderer is closed")
+        scene = _warm_up_scene()
+        frames = self.frames
+        self._frame(scene, None, None, None, False)
+        self._frame(dataclasses.replace(scene, magnification=0.0), (6.0, 0.0), 2.0, (6.0, 0.0), True)
+        self.frames = frames
+
     def _set_mesh(self, scene: StressScene) -> None:
         """Build the disc mesh, its colour bar and the undeformed outline (once per mesh)."""
         if self._mesh is not None:
@@ -656,6 +672,28 @@ class StressRenderer:
             log.error("writing a stress image failed: %s", exc)
         if errors and raise_errors:
             raise errors[0]
+
+
+def _warm_up_scene() -> StressScene:
+    """A small disc (an annulus) with pins, bearing forces and clipped stresses."""
+    r = np.linspace(4.0, 10.0, 3)
+    t = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    rr, tt = np.meshgrid(r, t, indexing="ij")
+    points = np.column_stack([(rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel()])
+    idx = np.arange(points.shape[0]).reshape(len(r), len(t))
+    a, b = idx[:-1, :], np.roll(idx[:-1, :], -1, axis=1)
+    c, d = idx[1:, :], np.roll(idx[1:, :], -1, axis=1)
+    triangles = np.vstack([np.column_stack([a.ravel(), b.ravel(), d.ravel()]),
+                           np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
+    loop = lambda k: np.column_stack([idx[k], np.roll(idx[k], -1)])  # noqa: E731
+    pins = 11.0 * np.column_stack([np.cos(t[::3]), np.sin(t[::3])])
+    bores = np.array([[6.5, 0.0], [-3.25, 5.63], [-3.25, -5.63]])
+    forces = np.array([[300.0, 100.0], [-200.0, 250.0], [0.0, -150.0]])
+    return StressScene(points=points, triangles=triangles, boundaries={"central_hole": loop(0), "profile": loop(-1)},
+                       von_mises=np.hypot(*points.T) * 10.0, deformation=np.zeros_like(points), magnification=1.0,
+                       clim=(0.0, 80.0), pin_centres=pins, pin_radius=1.0, pin_loaded=pins[:, 0] > 0,
+                       bore_centres=bores, bearing_forces=forces, rigid_forces=0.9 * forces, force_scale=0.005,
+                       title="warm-up")
 
 
 def _background_fraction(image: np.ndarray) -> float:
@@ -859,6 +897,7 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
     renderer = None
     try:
         renderer = StressRenderer(window_size, compress_level=compress_level, anti_aliasing=anti_aliasing)
+        renderer.warm_up()
         message = _receive(sys.stdin.buffer)
         if message is None or message[0] != "draw":
             return
