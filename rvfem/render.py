@@ -504,11 +504,17 @@ class StressRenderer:
         pts = np.asarray(scene.points, dtype=float)
         disc = pv.PolyData.from_regular_faces(_xyz(pts), np.asarray(scene.triangles, dtype=np.int64))
         disc.point_data[_FIELD] = np.zeros(len(pts))
-        actor = pl.add_mesh(disc, scalars=_FIELD, cmap=COLORMAP, clim=[0.0, 1.0], show_edges=False,
-                            edge_color="#303030", line_width=0.5, lighting=False, render=False,
-                            scalar_bar_args=dict(title=_FIELD, vertical=True, color="black", fmt="%.0f",
-                                                 n_labels=6, position_x=0.87, position_y=0.25, width=0.06,
-                                                 height=0.65, title_font_size=20, label_font_size=18))
+        # the colour bar of add_mesh renders a frame despite render=False (once the plotter has
+        # rendered before): not a frame of any image
+        pl.suppress_rendering = True
+        try:
+            actor = pl.add_mesh(disc, scalars=_FIELD, cmap=COLORMAP, clim=[0.0, 1.0], show_edges=False,
+                                edge_color="#303030", line_width=0.5, lighting=False, render=False,
+                                scalar_bar_args=dict(title=_FIELD, vertical=True, color="black", fmt="%.0f",
+                                                     n_labels=6, position_x=0.87, position_y=0.25, width=0.06,
+                                                     height=0.65, title_font_size=20, label_font_size=18))
+        finally:
+            pl.suppress_rendering = False
         actor.mapper.lookup_table.above_range_color = ABOVE_COLOUR
         actor.mapper.lookup_table.SetUseAboveRangeColor(False)
         bar = pl.scalar_bars[_FIELD]

@@ -107,8 +107,21 @@ def test_a_new_mesh_replaces_the_old_one(scenes, tmp_path):
     with render.StressRenderer(SIZE) as renderer:
         renderer.write(tmp_path / "first.png", full)
         second = renderer.write(tmp_path / "second.png", other)
+        assert renderer.frames == 2   # building the new disc renders nothing
     alone = render.stress_image(tmp_path / "alone.png", other, window_size=SIZE)
     assert np.count_nonzero(np.abs(_read(second) - _read(alone)).max(axis=2)) <= 2
+
+
+def test_a_warm_up_leaves_nothing_in_the_images(scenes, tmp_path):
+    with render.StressRenderer(SIZE) as renderer:
+        renderer.warm_up()
+        assert renderer.frames == 0
+        warm = [renderer.write(tmp_path / f"warm_{k}.png", s, **kw) for k, (s, kw) in enumerate(scenes)]
+        assert renderer.frames == len(scenes) and renderer.anti_aliasing == "fxaa"
+    with render.StressRenderer(SIZE) as renderer:
+        cold = [renderer.write(tmp_path / f"cold_{k}.png", s, **kw) for k, (s, kw) in enumerate(scenes)]
+    for a, b in zip(warm, cold):
+        assert np.count_nonzero(np.abs(_read(a) - _read(b)).max(axis=2)) <= 2
 
 
 def test_fxaa_that_does_not_render_falls_back_to_msaa(scenes, tmp_path, monkeypatch, caplog):
