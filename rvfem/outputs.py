@@ -793,13 +793,13 @@ def _image_set(analysis, images: Path) -> _ImageSet:
 
 class PendingImages:
     """The images of :func:`submit_images`, being drawn by a :class:`rvfem.render.RenderWorker`;
-    :meth:`result` draws the mesh picture and waits for them."""
+    :meth:`result` waits for them."""
 
     def __init__(self, image_set: _ImageSet, worker):
         self._set, self._worker = image_set, worker
 
     def result(self, *, tick: TickCallback | None = None) -> list[Path]:
-        """Draw the mesh picture (in the calling thread), wait for the stress images.
+        """Wait for the images.
 
         Parameters
         ----------
@@ -816,26 +816,19 @@ class PendingImages:
         RenderError, OSError
             From the render worker.
         """
-        from .plots import mesh_plot
-
         total = len(self._set.stress) + 1
-        done = [0]
 
-        def one_more(_=None) -> None:
-            done[0] += 1
-            if tick is not None and done[0] < total:
-                tick(done[0], total)
+        def one_more(done: int) -> None:
+            if tick is not None and done < total:
+                tick(done, total)
 
-        mesh_png = mesh_plot(**self._set.mesh)
-        one_more()
-        stress = self._worker.wait(tick=one_more)
-        return stress + [mesh_png]
+        return [Path(p) for p in self._worker.wait(tick=one_more)]
 
 
 def submit_images(analysis, folder: str | os.PathLike, worker) -> PendingImages:
     """Start the images of :func:`write_images` in a render worker's child process, which draws
-    them while this process does other work; :meth:`PendingImages.result` waits for them (and
-    draws the mesh picture).
+    them while this process does other work (the mesh picture in a second thread of the child);
+    :meth:`PendingImages.result` waits for them.
 
     Parameters
     ----------
@@ -855,8 +848,10 @@ def submit_images(analysis, folder: str | os.PathLike, worker) -> PendingImages:
     """
     images = Path(folder) / "images"
     images.mkdir(exist_ok=True)
+    from .plots import mesh_plot
+
     image_set = _image_set(analysis, images)
-    worker.submit(image_set.stress)
+    worker.submit(image_set.stress, calls=[(mesh_plot, image_set.mesh)])
     return PendingImages(image_set, worker)
 
 
@@ -867,9 +862,8 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
 
     The stress images share one off-screen plotter (:class:`rvfem.render.StressRenderer`); the
     mesh picture is drawn by a second thread meanwhile. With a render worker
-    (:class:`rvfem.render.RenderWorker`) the stress images are drawn by its child process and the
-    mesh picture by the calling thread (see also :func:`submit_images`). All files are complete
-    on return.
+    (:class:`rvfem.render.RenderWorker`) both are drawn by its child process (see also
+    :func:`submit_images`). All files are complete on return.
 
     Raises
     ------

@@ -843,6 +843,10 @@ ImageJob = tuple[str | os.PathLike, StressScene, dict]
 """One stress image for :meth:`RenderWorker.draw`: (PNG path, scene, keyword arguments of
 :meth:`StressRenderer.write`)."""
 
+Call = tuple[Callable, dict]
+"""Another drawing for :meth:`RenderWorker.submit`: (function, keyword arguments). The function
+must be importable by name (a module-level function, e.g. :func:`rvfem.plots.mesh_plot`)."""
+
 
 def _send(stream, message, lock: threading.Lock | None = None) -> None:
     data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
@@ -891,7 +895,8 @@ class _ForwardLog(logging.Handler):
 
 def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str) -> None:
     """The child process of :class:`RenderWorker`, after its rendering check: make the renderer,
-    draw one series of images, report each, exit."""
+    draw one series of images (and run the other calls in a second thread meanwhile), report each,
+    exit."""
     global _probe_result
     _probe_result = "checked by the parent"   # the check was this process's own first render
     out = os.fdopen(os.dup(1), "wb")           # messages to the parent; any other output to stderr
@@ -901,20 +906,27 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
     logger.addHandler(_ForwardLog(out, lock))
     logger.setLevel(logging.INFO)
     renderer = None
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-worker-calls")
     try:
         renderer = StressRenderer(window_size, compress_level=compress_level, anti_aliasing=anti_aliasing)
         renderer.warm_up()
         message = _receive(sys.stdin.buffer)
         if message is None or message[0] != "draw":
             return
-        for i, (path, scene, options) in enumerate(message[1]):
+        _, jobs, calls = message
+        futures = [pool.submit(function, **kwargs) for function, kwargs in calls]
+        for j, future in enumerate(futures):
+            future.add_done_callback(lambda f, j=j: f.exception() is None and _send(out, ("called", j), lock))
+        for i, (path, scene, options) in enumerate(jobs):
             renderer.write(path, scene, **options)
             _send(out, ("drawn", i), lock)
         renderer.close()
-        _send(out, ("done", renderer.frames, renderer.anti_aliasing), lock)
+        results = [future.result() for future in futures]
+        _send(out, ("done", renderer.frames, renderer.anti_aliasing, results), lock)
         out.close()
         os._exit(0)   # every file is complete: skip tearing VTK down, the parent need not wait for it
     except BaseException as exc:  # noqa: BLE001 - every failure goes to the parent
+        pool.shutdown(wait=True, cancel_futures=True)
         if renderer is not None:
             renderer.close(raise_errors=False)
         try:
@@ -1080,7 +1092,8 @@ class RenderWorker:
         self.close()
         raise self._checked
 
-    def draw(self, jobs: Sequence[ImageJob], *, tick: Callable[[int], None] | None = None) -> list[Path]:
+    def draw(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = (),
+             tick: Callable[[int], None] | None = None) -> list:
         """Draw a series of stress images in the child process and wait for them (:meth:`submit`
         and :meth:`wait`).
 
@@ -1088,18 +1101,21 @@ class RenderWorker:
         ----------
         jobs : sequence of (path, StressScene, dict)
             PNG file, scene and keyword arguments of :meth:`StressRenderer.write`.
+        calls : sequence of (function, dict)
+            Other drawings (see :meth:`submit`).
         tick : callable, optional
-            ``tick(done)`` after each image drawn (its PNG file may still be being written).
+            ``tick(done)`` after each image drawn or call returned (a PNG file may still be being
+            written).
 
         Returns
         -------
-        list of Path
-            The PNG files, all complete.
+        list
+            The PNG files, all complete, then what the calls returned.
         """
-        self.submit(jobs)
+        self.submit(jobs, calls=calls)
         return self.wait(tick=tick)
 
-    def submit(self, jobs: Sequence[ImageJob]) -> None:
+    def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> None:
         """Hand a series of stress images over to the child process, which starts drawing them
         (once per worker); :meth:`wait` waits for them.
 
@@ -1107,6 +1123,11 @@ class RenderWorker:
         ----------
         jobs : sequence of (path, StressScene, dict)
             PNG file, scene and keyword arguments of :meth:`StressRenderer.write`.
+        calls : sequence of (function, dict)
+            Other drawings the child process makes in a second thread while it renders the images
+            (e.g. :func:`rvfem.plots.mesh_plot`: matplotlib, no OpenGL), one after the other.
+            Each function must be importable by name; its arguments and its return value are
+            pickled.
 
         Raises
         ------
@@ -1119,7 +1140,7 @@ class RenderWorker:
         self._jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
         self._used = True
         try:
-            _send(self._proc.stdin, ("draw", self._jobs))
+            _send(self._proc.stdin, ("draw", self._jobs, [(function, dict(kwargs)) for function, kwargs in calls]))
         except OSError:
             pass   # the child is gone: wait() reports how it ended
 
@@ -1129,12 +1150,13 @@ class RenderWorker:
         Parameters
         ----------
         tick : callable, optional
-            ``tick(done)`` after each image drawn (its PNG file may still be being written).
+            ``tick(done)`` after each image drawn or call returned (a PNG file may still be being
+            written).
 
         Returns
         -------
-        list of Path
-            The PNG files, all complete.
+        list
+            The PNG files, all complete, then what the calls returned.
 
         Raises
         ------
@@ -1142,23 +1164,26 @@ class RenderWorker:
             An image is blank, or the child process ended unexpectedly.
         OSError
             A PNG file could not be written.
+        Exception
+            What a call raised.
         """
         if self._jobs is None:
             raise RenderError("no images were submitted to the render worker")
         if self._proc is None:
             raise RenderError("the render worker is closed")
-        jobs = self._jobs
+        jobs, done = self._jobs, 0
         while True:
             message = self._messages.get()
             kind = message[0]
             if kind == "log":
                 logging.getLogger(message[2]).log(message[1], "%s", message[3])
-            elif kind == "drawn":
+            elif kind in ("drawn", "called"):
+                done += 1
                 if tick is not None:
-                    tick(message[1] + 1)
+                    tick(done)
             elif kind == "done":   # the child exits by itself; close() collects it
                 self.frames, self.anti_aliasing = message[1], message[2]
-                return [path for path, _, _ in jobs]
+                return [path for path, _, _ in jobs] + list(message[3])
             elif kind == "error":
                 self.close()
                 raise message[1]

@@ -70,9 +70,9 @@ STAGES: dict[str, str] = {
 }
 """Stages of a run in order, with a one-line description (what the progress callback reports):
 those of :func:`rvfem.analysis.analyse`, then one per writer. The stress images are drawn by a
-child process (:class:`rvfem.render.RenderWorker`) from the start of the writers on, while this
-process writes the tables, the VTK files and the plots; the ``images`` stage is the mesh picture
-and the wait for the stress images."""
+child process (:class:`rvfem.render.RenderWorker`, with the mesh picture) from the start of the
+writers on, while this process writes the tables, the VTK files and the plots; the ``images``
+stage is the wait for them."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,9 +223,9 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
 def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> tuple[dict, tuple[str, ...]]:
     """Write every file of the result folder ``tmp``; returns the summary and the files.
 
-    The stress images are handed to ``worker`` first (its child process draws them meanwhile);
-    this process writes the tables, the VTK files, the plots and the mesh picture, then waits
-    for the images, and writes the report and the summary.
+    The images are handed to ``worker`` first (its child process draws them meanwhile); this
+    process writes the tables, the VTK files and the plots, then waits for the images, and writes
+    the report and the summary.
     """
     written: list[Path] = []
 
