@@ -72,6 +72,7 @@ __all__ = [
     "submit_images",
     "PendingImages",
     "write_plots",
+    "plot_calls",
     "write_summary",
     "write_report",
 ]
@@ -793,10 +794,21 @@ def _image_set(analysis, images: Path) -> _ImageSet:
 
 class PendingImages:
     """The images of :func:`submit_images`, being drawn by a :class:`rvfem.render.RenderWorker`;
-    :meth:`result` waits for them."""
+    :meth:`result` waits for them, :meth:`calls_result` for the other calls."""
 
-    def __init__(self, image_set: _ImageSet, worker):
-        self._set, self._worker = image_set, worker
+    def __init__(self, image_set: _ImageSet, worker, n_calls: int):
+        self._set, self._worker, self._n_calls = image_set, worker, n_calls
+
+    def calls_result(self) -> list:
+        """Wait for the calls given to :func:`submit_images` (the child makes them before the mesh
+        picture) and return what they returned.
+
+        Raises
+        ------
+        RenderError, Exception
+            From the render worker, or what a call raised.
+        """
+        return self._worker.wait_calls(self._n_calls)
 
     def result(self, *, tick: TickCallback | None = None) -> list[Path]:
         """Wait for the images.
@@ -822,10 +834,12 @@ class PendingImages:
             if tick is not None and done < total:
                 tick(done, total)
 
-        return [Path(p) for p in self._worker.wait(tick=one_more)]
+        done = self._worker.wait(tick=one_more)
+        return [Path(p) for p in done[:len(self._set.stress)]] + [Path(done[-1])]
 
 
-def submit_images(analysis, folder: str | os.PathLike, worker) -> PendingImages:
+def submit_images(analysis, folder: str | os.PathLike, worker, *,
+                  calls: Iterable[tuple[Callable, dict]] = ()) -> PendingImages:
     """Start the images of :func:`write_images` in a render worker's child process, which draws
     them while this process does other work (the mesh picture in a second thread of the child);
     :meth:`PendingImages.result` waits for them.
@@ -836,6 +850,9 @@ def submit_images(analysis, folder: str | os.PathLike, worker) -> PendingImages:
     folder : path-like
     worker : rvfem.render.RenderWorker
         Checked (:meth:`~rvfem.render.RenderWorker.check`) or not; it draws one series.
+    calls : iterable of (function, dict)
+        Other drawings for the child's second thread, made before the mesh picture (e.g.
+        :func:`plot_calls`); :meth:`PendingImages.calls_result` waits for them.
 
     Returns
     -------
@@ -851,8 +868,9 @@ def submit_images(analysis, folder: str | os.PathLike, worker) -> PendingImages:
     from .plots import mesh_plot
 
     image_set = _image_set(analysis, images)
-    worker.submit(image_set.stress, calls=[(mesh_plot, image_set.mesh)])
-    return PendingImages(image_set, worker)
+    calls = list(calls)
+    worker.submit(image_set.stress, calls=calls + [(mesh_plot, image_set.mesh)])
+    return PendingImages(image_set, worker, len(calls))
 
 
 def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None,
@@ -898,10 +916,13 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
     return out
 
 
-def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
-    """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
-    the equal share where it is not defined), roller loads and pin forces at the angle of the
-    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
+def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict]]:
+    """The plots of :func:`write_plots` as calls: (function of :mod:`rvfem.plots`, keyword
+    arguments), each drawing one PNG file and returning its path (``plots/`` is created).
+
+    :func:`write_plots` makes the calls; a render worker can make them in its child process
+    (:func:`submit_images`).
+    """
     from . import plots
 
     a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
@@ -912,20 +933,29 @@ def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
     classical = None if a.classical is None else a.classical.magnitude
     handbook = a.comparison.reference == "handbook"
     label = "rigid (handbook)" if handbook else "equal share of the FE pin resultant"
-    out = [plots.bearing_loads_plot(
-        folder / "bearing_loads.png", th, cy.bearing_loads, a.reference_loads, reference_label=label,
+    calls = [(plots.bearing_loads_plot, dict(
+        path=folder / "bearing_loads.png", theta=th, flexible=cy.bearing_loads, rigid=a.reference_loads,
+        reference_label=label,
         title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs "
-              + ("rigid handbook" if handbook else "equal share (handbook not defined for Zp − Zc ≠ 1)"))]
+              + ("rigid handbook" if handbook else "equal share (handbook not defined for Zp − Zc ≠ 1)")))]
     if cy.roller_loads is not None:
-        out.append(plots.roller_loads_plot(folder / "roller_loads.png", cy.roller_angles[k_max],
-                                           cy.roller_loads[k_max], cy.bearing_forces[k_max], theta_deg=th_max))
-    out.append(plots.pin_forces_plot(folder / "pin_forces.png", np.arange(1, case.pins.count + 1),
-                                     cy.pin_forces[k_max], None if classical is None else classical[:, k_max],
-                                     theta_deg=th_max))
-    out.append(plots.pins_in_contact_plot(folder / "pins_in_contact.png", th, cy.pins_in_contact, case.pins.count,
-                                          classical=None if classical is None
-                                          else np.count_nonzero(classical > 0, axis=0)))
-    return out
+        calls.append((plots.roller_loads_plot, dict(
+            path=folder / "roller_loads.png", roller_angles=cy.roller_angles[k_max],
+            roller_loads=cy.roller_loads[k_max], bearing_forces=cy.bearing_forces[k_max], theta_deg=th_max)))
+    calls.append((plots.pin_forces_plot, dict(
+        path=folder / "pin_forces.png", pin_index=np.arange(1, case.pins.count + 1), fe=cy.pin_forces[k_max],
+        classical=None if classical is None else classical[:, k_max], theta_deg=th_max)))
+    calls.append((plots.pins_in_contact_plot, dict(
+        path=folder / "pins_in_contact.png", theta=th, count=cy.pins_in_contact, total=case.pins.count,
+        classical=None if classical is None else np.count_nonzero(classical > 0, axis=0))))
+    return calls
+
+
+def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
+    the equal share where it is not defined), roller loads and pin forces at the angle of the
+    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
+    return [function(**kwargs) for function, kwargs in plot_calls(analysis, folder)]
 
 
 # --------------------------------------------------------------------------------------------

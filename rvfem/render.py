@@ -916,7 +916,8 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
         _, jobs, calls = message
         futures = [pool.submit(function, **kwargs) for function, kwargs in calls]
         for j, future in enumerate(futures):
-            future.add_done_callback(lambda f, j=j: f.exception() is None and _send(out, ("called", j), lock))
+            future.add_done_callback(
+                lambda f, j=j: f.exception() is None and _send(out, ("called", j, f.result()), lock))
         for i, (path, scene, options) in enumerate(jobs):
             renderer.write(path, scene, **options)
             _send(out, ("drawn", i), lock)
@@ -984,6 +985,10 @@ class RenderWorker:
         self._checked: str | RenderError | None = None
         self._used = False
         self._jobs: list | None = None
+        self._n_calls = 0
+        self._drawn = 0
+        self._results: dict[int, object] = {}
+        self._finished = False
         self._messages: queue.Queue = queue.Queue()
         self._proc = None
         if isinstance(_probe_result, RenderError):   # this process knows already: no child
@@ -1104,8 +1109,7 @@ class RenderWorker:
         calls : sequence of (function, dict)
             Other drawings (see :meth:`submit`).
         tick : callable, optional
-            ``tick(done)`` after each image drawn or call returned (a PNG file may still be being
-            written).
+            ``tick(done)`` after each image drawn (its PNG file may still be being written).
 
         Returns
         -------
@@ -1138,20 +1142,21 @@ class RenderWorker:
         if self._jobs is not None:
             raise RenderError("a render worker draws one series of images")
         self._jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
+        calls = [(function, dict(kwargs)) for function, kwargs in calls]
+        self._n_calls = len(calls)
         self._used = True
         try:
-            _send(self._proc.stdin, ("draw", self._jobs, [(function, dict(kwargs)) for function, kwargs in calls]))
+            _send(self._proc.stdin, ("draw", self._jobs, calls))
         except OSError:
             pass   # the child is gone: wait() reports how it ended
 
-    def wait(self, *, tick: Callable[[int], None] | None = None) -> list[Path]:
-        """Wait for the images of :meth:`submit`.
+    def wait(self, *, tick: Callable[[int], None] | None = None) -> list:
+        """Wait for the images and the calls of :meth:`submit`.
 
         Parameters
         ----------
         tick : callable, optional
-            ``tick(done)`` after each image drawn or call returned (a PNG file may still be being
-            written).
+            ``tick(done)`` after each image drawn (its PNG file may still be being written).
 
         Returns
         -------
@@ -1167,33 +1172,61 @@ class RenderWorker:
         Exception
             What a call raised.
         """
+        self._submitted()
+        while not self._finished:
+            if self._next() == "drawn" and tick is not None:
+                tick(self._drawn)
+        return [path for path, _, _ in self._jobs] + [self._results[j] for j in range(self._n_calls)]
+
+    def wait_calls(self, count: int | None = None) -> list:
+        """Wait for the first ``count`` calls of :meth:`submit` (all by default), which the child
+        makes one after the other, and return what they returned.
+
+        Raises
+        ------
+        RenderError
+            The child process ended unexpectedly, or an image failed.
+        Exception
+            What a call raised.
+        """
+        self._submitted()
+        count = self._n_calls if count is None else min(int(count), self._n_calls)
+        while any(j not in self._results for j in range(count)):
+            self._next()
+        return [self._results[j] for j in range(count)]
+
+    def _submitted(self) -> None:
         if self._jobs is None:
             raise RenderError("no images were submitted to the render worker")
-        if self._proc is None:
+        if self._proc is None and not self._finished:
             raise RenderError("the render worker is closed")
-        jobs, done = self._jobs, 0
-        while True:
-            message = self._messages.get()
-            kind = message[0]
-            if kind == "log":
-                logging.getLogger(message[2]).log(message[1], "%s", message[3])
-            elif kind in ("drawn", "called"):
-                done += 1
-                if tick is not None:
-                    tick(done)
-            elif kind == "done":   # the child exits by itself; close() collects it
-                self.frames, self.anti_aliasing = message[1], message[2]
-                return [path for path, _, _ in jobs] + list(message[3])
-            elif kind == "error":
-                self.close()
-                raise message[1]
-            else:   # the child ended without a word
-                rc = self._stop()
-                details = _vtk_messages(self._stderr_text())
-                how = f"crashed (signal {-rc})" if rc is not None and rc < 0 else f"ended (exit code {rc})"
-                self.close()
-                raise RenderError(f"the process drawing the stress images {how}"
-                                  f"{': ' + details if details else ''}")
+
+    def _next(self) -> str:
+        """Process the next message of the child process; returns its kind. An error of the child
+        (or its unexpected end) is raised."""
+        message = self._messages.get()
+        kind = message[0]
+        if kind == "log":
+            logging.getLogger(message[2]).log(message[1], "%s", message[3])
+        elif kind == "drawn":
+            self._drawn += 1
+        elif kind == "called":
+            self._results[message[1]] = message[2]
+        elif kind == "done":   # the child exits by itself; close() collects it
+            self.frames, self.anti_aliasing = message[1], message[2]
+            self._results.update(enumerate(message[3]))
+            self._finished = True
+        elif kind == "error":
+            self.close()
+            raise message[1]
+        else:   # the child ended without a word
+            rc = self._stop()
+            details = _vtk_messages(self._stderr_text())
+            how = f"crashed (signal {-rc})" if rc is not None and rc < 0 else f"ended (exit code {rc})"
+            self.close()
+            raise RenderError(f"the process drawing the stress images {how}"
+                              f"{': ' + details if details else ''}")
+        return kind
 
     def close(self) -> None:
         """End the child process (at once if it is still drawing) and release its pipes."""

@@ -69,10 +69,10 @@ STAGES: dict[str, str] = {
     "report": "writing the report",
 }
 """Stages of a run in order, with a one-line description (what the progress callback reports):
-those of :func:`rvfem.analysis.analyse`, then one per writer. The stress images are drawn by a
-child process (:class:`rvfem.render.RenderWorker`, with the mesh picture) from the start of the
-writers on, while this process writes the tables, the VTK files and the plots; the ``images``
-stage is the wait for them."""
+those of :func:`rvfem.analysis.analyse`, then one per writer. With images, the stress images, the
+mesh picture and the plots are drawn by a child process (:class:`rvfem.render.RenderWorker`) from
+the start of the writers on, while this process writes the tables and the VTK files; the ``plots``
+and ``images`` stages are the waits for them."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -223,9 +223,9 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
 def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> tuple[dict, tuple[str, ...]]:
     """Write every file of the result folder ``tmp``; returns the summary and the files.
 
-    The images are handed to ``worker`` first (its child process draws them meanwhile); this
-    process writes the tables, the VTK files and the plots, then waits for the images, and writes
-    the report and the summary.
+    The images and the plots are handed to ``worker`` first (its child process draws them
+    meanwhile); this process writes the tables and the VTK files, then waits for the plots and the
+    images, and writes the report and the summary. Without a worker the plots are drawn here.
     """
     written: list[Path] = []
 
@@ -235,7 +235,9 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> t
     stages.end("tables", t)
 
     t_submit = time.perf_counter()
-    pending = outputs.submit_images(result, tmp, worker) if worker is not None else None
+    pending = None
+    if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
+        pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp))
     submitted = time.perf_counter() - t_submit
 
     n_fields = len(result.stress.snapshots)
@@ -244,7 +246,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> t
     stages.end("vtk", t, n_fields)
 
     t = stages.start("plots")
-    written += outputs.write_plots(result, tmp)
+    written += pending.calls_result() if pending is not None else outputs.write_plots(result, tmp)
     stages.end("plots", t)
 
     if pending is not None:

@@ -205,6 +205,24 @@ def test_a_render_worker_raises_the_errors_of_its_process(scenes, tmp_path):
             worker.submit([(tmp_path / "again.png", scenes[0][0], {})])
 
 
+def test_a_render_worker_makes_other_calls_meanwhile(scenes, tmp_path):
+    import shutil
+
+    source = tmp_path / "source.txt"
+    source.write_text("x")
+    calls = [(shutil.copyfile, dict(src=source, dst=tmp_path / f"copy_{k}.txt")) for k in range(2)]
+    with render.RenderWorker(SIZE) as worker:
+        worker.submit([(tmp_path / "image.png", scenes[0][0], {})], calls=calls)
+        assert worker.wait_calls() == [tmp_path / "copy_0.txt", tmp_path / "copy_1.txt"]
+        assert worker.wait() == [tmp_path / "image.png", tmp_path / "copy_0.txt", tmp_path / "copy_1.txt"]
+    assert (tmp_path / "copy_1.txt").read_text() == "x" and (tmp_path / "image.png").is_file()
+    with render.RenderWorker(SIZE) as worker:
+        worker.submit([(tmp_path / "image2.png", scenes[0][0], {})],
+                      calls=[(shutil.copyfile, dict(src=tmp_path / "missing.txt", dst=tmp_path / "c.txt"))])
+        with pytest.raises(FileNotFoundError):
+            worker.wait_calls()
+
+
 def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
     monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
     monkeypatch.setattr(render, "_probe_result", None)
