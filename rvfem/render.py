@@ -1141,12 +1141,17 @@ class RenderWorker:
         self.check()
         if self._jobs is not None:
             raise RenderError("a render worker draws one series of images")
-        self._jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
+        jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
         calls = [(function, dict(kwargs)) for function, kwargs in calls]
-        self._n_calls = len(calls)
-        self._used = True
         try:
-            _send(self._proc.stdin, ("draw", self._jobs, calls))
+            data = pickle.dumps(("draw", jobs, calls), protocol=pickle.HIGHEST_PROTOCOL)
+        except (pickle.PicklingError, AttributeError, TypeError) as exc:
+            raise TypeError(f"the images and calls cannot be handed to the render process "
+                            f"(functions must be importable by name): {exc}") from exc
+        self._jobs, self._n_calls, self._used = jobs, len(calls), True
+        try:
+            self._proc.stdin.write(_HEADER.pack(len(data)) + data)
+            self._proc.stdin.flush()
         except OSError:
             pass   # the child is gone: wait() reports how it ended
 
