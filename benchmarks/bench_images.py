@@ -18,11 +18,18 @@ and reports
 The first repeat pays the imports (PyVista, VTK, matplotlib) and the first OpenGL context, as a
 real run does; ``--warm`` renders the set once untimed beforehand to see the steady state.
 
+``--worker`` times the set as ``rvfem run`` draws it: by a :class:`rvfem.render.RenderWorker`
+(a child process, started, checked and warmed up before the clock, as during a run's analysis),
+the stress images, the mesh picture and the plots; the CPU time then includes the child's whole
+life (its start and warm-up too), and the own times of the calls (made in the child) are not
+recorded.
+
 Run from the repository root::
 
     python benchmarks/bench_images.py
     python benchmarks/bench_images.py --repeat 5 --json results/bench_images.json
     python benchmarks/bench_images.py --keep images_bench   # keep the PNGs of the best repeat
+    python benchmarks/bench_images.py --worker              # as rvfem run: in a child process
 
 The machine should be otherwise idle: the load average before and after is printed.
 """
@@ -45,9 +52,10 @@ sys.path.insert(0, str(ROOT))
 
 
 def _cpu_s() -> float:
-    """CPU time of this process so far, all threads (user + system), s."""
-    usage = resource.getrusage(resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime
+    """CPU time of this process and its ended child processes so far, all threads (user +
+    system), s."""
+    return sum(u.ru_utime + u.ru_stime for u in (resource.getrusage(resource.RUSAGE_SELF),
+                                                  resource.getrusage(resource.RUSAGE_CHILDREN)))
 
 
 @contextlib.contextmanager
@@ -89,18 +97,32 @@ def _timed_calls():
             setattr(owner, name, original)
 
 
-def _one_set(analysis, folder: Path) -> dict:
-    from rvfem import outputs
+def _one_set(analysis, folder: Path, worker: bool = False, lead_s: float = 3.0) -> dict:
+    from rvfem import outputs, render
 
     if folder.exists():
         shutil.rmtree(folder)
     folder.mkdir(parents=True)
     marks: list[float] = []
-    with _timed_calls() as own:
+    if worker:   # started, checked and warmed up before the clock, as during a run's analysis
+        started = render.RenderWorker(outputs.IMAGE_SIZE)
+        started.check()
+        time.sleep(lead_s)
+    # the calls made in the child are pickled by name: not timed (wrapped) in worker mode
+    with (contextlib.nullcontext({"draw": {}, "png": {}}) if worker else _timed_calls()) as own:
         c0, t0 = _cpu_s(), time.perf_counter()
-        written = outputs.write_images(analysis, folder,
-                                       tick=lambda done, total: marks.append(time.perf_counter()))
-        t_end, c_end = time.perf_counter(), _cpu_s()
+        if worker:
+            pending = outputs.submit_images(analysis, folder, started, calls=outputs.plot_calls(analysis, folder))
+            plotted = pending.calls_result()
+            written = pending.result(tick=lambda done, total: marks.append(time.perf_counter()))
+            t_end = time.perf_counter()
+            started.close()   # the child's CPU time counts once it has ended (its whole life)
+            written += plotted
+        else:
+            written = outputs.write_images(analysis, folder,
+                                           tick=lambda done, total: marks.append(time.perf_counter()))
+            t_end = time.perf_counter()
+        c_end = _cpu_s()
     ends = marks + [t_end]
     starts = [t0] + marks
     names = [p.name for p in written]
@@ -119,6 +141,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--warm", action="store_true", help="write one untimed image set first")
     parser.add_argument("--keep", type=Path, help="copy the images of the best repeat into this folder")
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
+    parser.add_argument("--worker", action="store_true",
+                        help="draw the images (and the plots) in a render worker, as rvfem run does")
+    parser.add_argument("--lead", type=float, default=3.0,
+                        help="with --worker: seconds between starting the worker and the images (default 3)")
     args = parser.parse_args(argv)
 
     from rvfem.analysis import analyse
@@ -136,9 +162,9 @@ def main(argv: list[str] | None = None) -> int:
     runs = []
     with tempfile.TemporaryDirectory(prefix="bench_images_") as tmp:
         if args.warm:
-            _one_set(analysis, Path(tmp) / "warm")
+            _one_set(analysis, Path(tmp) / "warm", args.worker, args.lead)
         for i in range(args.repeat):
-            run = _one_set(analysis, Path(tmp) / f"run{i}")
+            run = _one_set(analysis, Path(tmp) / f"run{i}", args.worker, args.lead)
             runs.append(run)
             first = " (first in the process: imports, OpenGL context)" if i == 0 and not args.warm else ""
             print(f"  repeat {i + 1}: {run['wall_s']:.2f} s wall, {run['cpu_s']:.2f} s CPU{first}")

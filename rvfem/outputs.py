@@ -69,7 +69,10 @@ __all__ = [
     "write_tables",
     "write_vtk",
     "write_images",
+    "submit_images",
+    "PendingImages",
     "write_plots",
+    "plot_calls",
     "write_summary",
     "write_report",
 ]
@@ -684,18 +687,20 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
     vtk.mkdir(exist_ok=True)
     model = analysis.system.model
     snapshots = analysis.stress.snapshots
+    points, triangles = model.mesh.p.T, model.mesh.t.T
+    mesh = vtkio.vtu_mesh(points, triangles)   # the same in every file: encoded once
     out, entries = [], []
     for done, snap in enumerate(snapshots, start=1):
         name = vtkio.vtu_name(snap.theta_deg)
-        out.append(vtkio.write_vtu(vtk / name, model.mesh.p.T, model.mesh.t.T, snap))
+        out.append(vtkio.write_vtu(vtk / name, points, triangles, snap, mesh=mesh))
         entries.append((snap.theta_deg, name))
         if tick is not None and done < len(snapshots):
             tick(done, len(snapshots))
     out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
     cy = analysis.cycle
     if cy.von_mises_envelope is not None:
-        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, model.mesh.p.T, model.mesh.t.T,
-                                            cy.von_mises_envelope, cy.von_mises_envelope_theta))
+        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, points, triangles, cy.von_mises_envelope,
+                                            cy.von_mises_envelope_theta, mesh=mesh))
     return out
 
 
@@ -714,31 +719,26 @@ def image_count(analysis) -> int:
     return len(s.snapshots) + sum(pk is not None for pk in (s.peak, s.away_from_contacts)) + 1
 
 
-def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None) -> list[Path]:
-    """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
-    stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.plots.mesh_plot`).
+@dataclass(frozen=True, eq=False)
+class _ImageSet:
+    """What :func:`write_images` draws: the stress images (PNG path, scene, keyword arguments of
+    :meth:`rvfem.render.StressRenderer.write`) and the mesh picture (keyword arguments of
+    :func:`rvfem.plots.mesh_plot`)."""
 
-    The stress images share one off-screen plotter (:class:`rvfem.render.StressRenderer`); the
-    mesh picture is drawn by a second thread meanwhile. All files are complete on return.
+    stress: list
+    mesh: dict
 
-    Raises
-    ------
-    RenderError
-        If off-screen rendering is not possible here.
-    """
+
+def _image_set(analysis, images: Path) -> _ImageSet:
     from . import render
     from .geometry import crank_centres
-    from .plots import mesh_plot
 
     a, case, cy = analysis, analysis.case, analysis.cycle
-    images = Path(folder) / "images"
-    images.mkdir(exist_ok=True)
     model, mesh, snapshots = a.system.model, a.mesh, a.stress.snapshots
     peak, away = a.stress.peak, a.stress.away_from_contacts
     vertices, triangles = model.mesh.p.T, model.mesh.t.T
     pin_xy, rigid_forces = a.pin_centres, a.rigid_forces
     k_max, _ = a.max_load_index
-    total = image_count(a)
     max_def = max(float(np.max(np.hypot(*s.deformation.T))) for s in snapshots)
     magnification = render.nice_factor(DEFORMATION_DISPLAY_FRACTION * case.pins.circle_radius / max_def)
     f_ref = max(float(cy.bearing_loads.max()), float(a.rigid.loads.magnitude.max()))
@@ -762,6 +762,140 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
                   f"×{magnification:g}   bearings '{case.crank_bearing.model}', P{model.order}",
         )
 
+    stress = []
+    for snap in snapshots:
+        label = "  (max. bearing load)" if snap.index == k_max else ""
+        stress.append((images / _stress_image_name(snap.theta_deg), scene(snap, label), {}))
+    half = max(5.0, 12.0 * case.mesh.size_bore)
+    rec = a.stress.recovered
+    for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
+                          ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
+        if pk is None:
+            continue
+        snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+        extra = ""
+        if rec is not None and key == "stress_away_from_contacts_closeup":
+            extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
+        close = dataclasses.replace(
+            scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
+            title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
+                  f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, "
+                  f"{pk.feature_label}")
+        stress.append((images / f"{key}.png", close, dict(focus=(pk.x_mm, pk.y_mm), half_height=half,
+                                                          marker=(pk.x_mm, pk.y_mm), show_edges=True)))
+    b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
+    mesh_picture = dict(path=images / "mesh.png", points=vertices, triangles=triangles, boundaries=mesh.boundaries,
+                        closeup_centre=(float(b0[0]), float(b0[1])),
+                        title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
+                              f"(min quality {mesh.min_quality:.2f})",
+                        closeup_title="close-up: the rim under the bore of bearing 1")
+    return _ImageSet(stress=stress, mesh=mesh_picture)
+
+
+class PendingImages:
+    """The images of :func:`submit_images`, being drawn by a :class:`rvfem.render.RenderWorker`;
+    :meth:`result` waits for them, :meth:`calls_result` for the other calls."""
+
+    def __init__(self, image_set: _ImageSet, worker, n_calls: int):
+        self._set, self._worker, self._n_calls = image_set, worker, n_calls
+
+    def calls_result(self) -> list:
+        """Wait for the calls given to :func:`submit_images` (the child makes them before the mesh
+        picture) and return what they returned.
+
+        Raises
+        ------
+        RenderError, Exception
+            From the render worker, or what a call raised.
+        """
+        return self._worker.wait_calls(self._n_calls)
+
+    def result(self, *, tick: TickCallback | None = None) -> list[Path]:
+        """Wait for the images.
+
+        Parameters
+        ----------
+        tick : callable, optional
+            ``tick(done, total)`` after each image but the last.
+
+        Returns
+        -------
+        list of Path
+            The stress images, the close-ups and the mesh picture, all complete.
+
+        Raises
+        ------
+        RenderError, OSError
+            From the render worker.
+        """
+        total = len(self._set.stress) + 1
+
+        def one_more(done: int) -> None:
+            if tick is not None and done < total:
+                tick(done, total)
+
+        done = self._worker.wait(tick=one_more)
+        return [Path(p) for p in done[:len(self._set.stress)]] + [Path(done[-1])]
+
+
+def submit_images(analysis, folder: str | os.PathLike, worker, *,
+                  calls: Iterable[tuple[Callable, dict]] = ()) -> PendingImages:
+    """Start the images of :func:`write_images` in a render worker's child process, which draws
+    them while this process does other work (the mesh picture in a second thread of the child);
+    :meth:`PendingImages.result` waits for them.
+
+    Parameters
+    ----------
+    analysis : rvfem.analysis.Analysis
+    folder : path-like
+    worker : rvfem.render.RenderWorker
+        Checked (:meth:`~rvfem.render.RenderWorker.check`) or not; it draws one series.
+    calls : iterable of (function, dict)
+        Other drawings for the child's second thread, made before the mesh picture (e.g.
+        :func:`plot_calls`); :meth:`PendingImages.calls_result` waits for them.
+
+    Returns
+    -------
+    PendingImages
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    from .plots import mesh_plot
+
+    image_set = _image_set(analysis, images)
+    calls = list(calls)
+    worker.submit(image_set.stress, calls=calls + [(mesh_plot, image_set.mesh)])
+    return PendingImages(image_set, worker, len(calls))
+
+
+def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None,
+                 worker=None) -> list[Path]:
+    """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
+    stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.plots.mesh_plot`).
+
+    The stress images share one off-screen plotter (:class:`rvfem.render.StressRenderer`); the
+    mesh picture is drawn by a second thread meanwhile. With a render worker
+    (:class:`rvfem.render.RenderWorker`) both are drawn by its child process (see also
+    :func:`submit_images`). All files are complete on return.
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    if worker is not None:
+        return submit_images(analysis, folder, worker).result(tick=tick)
+    from . import render
+    from .plots import mesh_plot
+
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    total = image_count(analysis)
     out: list[Path] = []
 
     def done(path: Path) -> None:
@@ -769,46 +903,26 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
         if tick is not None and len(out) < total:
             tick(len(out), total)
 
-    b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
+    image_set = _image_set(analysis, images)
     # the mesh picture (matplotlib) is drawn by a second thread while VTK renders the stress images;
     # the renderer is made first, so that PyVista (which imports matplotlib) is imported by this
     # thread alone
     with render.StressRenderer(IMAGE_SIZE) as renderer, \
             ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-mesh-plot") as pool:
-        mesh_png = pool.submit(
-            mesh_plot, images / "mesh.png", vertices, triangles, mesh.boundaries,
-            closeup_centre=(float(b0[0]), float(b0[1])),
-            title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
-                  f"(min quality {mesh.min_quality:.2f})",
-            closeup_title="close-up: the rim under the bore of bearing 1")
-        for snap in snapshots:
-            label = "  (max. bearing load)" if snap.index == k_max else ""
-            done(renderer.write(images / _stress_image_name(snap.theta_deg), scene(snap, label)))
-        half = max(5.0, 12.0 * case.mesh.size_bore)
-        rec = a.stress.recovered
-        for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
-                              ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
-            if pk is None:
-                continue
-            snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
-            extra = ""
-            if rec is not None and key == "stress_away_from_contacts_closeup":
-                extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
-            close = dataclasses.replace(
-                scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
-                title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
-                      f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, "
-                      f"{pk.feature_label}")
-            done(renderer.write(images / f"{key}.png", close, focus=(pk.x_mm, pk.y_mm), half_height=half,
-                                marker=(pk.x_mm, pk.y_mm), show_edges=True))
+        mesh_png = pool.submit(mesh_plot, **image_set.mesh)
+        for path, scene, options in image_set.stress:
+            done(renderer.write(path, scene, **options))
         done(mesh_png.result())
     return out
 
 
-def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
-    """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
-    the equal share where it is not defined), roller loads and pin forces at the angle of the
-    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
+def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict]]:
+    """The plots of :func:`write_plots` as calls: (function of :mod:`rvfem.plots`, keyword
+    arguments), each drawing one PNG file and returning its path (``plots/`` is created).
+
+    :func:`write_plots` makes the calls; a render worker can make them in its child process
+    (:func:`submit_images`).
+    """
     from . import plots
 
     a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
@@ -819,20 +933,29 @@ def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
     classical = None if a.classical is None else a.classical.magnitude
     handbook = a.comparison.reference == "handbook"
     label = "rigid (handbook)" if handbook else "equal share of the FE pin resultant"
-    out = [plots.bearing_loads_plot(
-        folder / "bearing_loads.png", th, cy.bearing_loads, a.reference_loads, reference_label=label,
+    calls = [(plots.bearing_loads_plot, dict(
+        path=folder / "bearing_loads.png", theta=th, flexible=cy.bearing_loads, rigid=a.reference_loads,
+        reference_label=label,
         title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs "
-              + ("rigid handbook" if handbook else "equal share (handbook not defined for Zp − Zc ≠ 1)"))]
+              + ("rigid handbook" if handbook else "equal share (handbook not defined for Zp − Zc ≠ 1)")))]
     if cy.roller_loads is not None:
-        out.append(plots.roller_loads_plot(folder / "roller_loads.png", cy.roller_angles[k_max],
-                                           cy.roller_loads[k_max], cy.bearing_forces[k_max], theta_deg=th_max))
-    out.append(plots.pin_forces_plot(folder / "pin_forces.png", np.arange(1, case.pins.count + 1),
-                                     cy.pin_forces[k_max], None if classical is None else classical[:, k_max],
-                                     theta_deg=th_max))
-    out.append(plots.pins_in_contact_plot(folder / "pins_in_contact.png", th, cy.pins_in_contact, case.pins.count,
-                                          classical=None if classical is None
-                                          else np.count_nonzero(classical > 0, axis=0)))
-    return out
+        calls.append((plots.roller_loads_plot, dict(
+            path=folder / "roller_loads.png", roller_angles=cy.roller_angles[k_max],
+            roller_loads=cy.roller_loads[k_max], bearing_forces=cy.bearing_forces[k_max], theta_deg=th_max)))
+    calls.append((plots.pin_forces_plot, dict(
+        path=folder / "pin_forces.png", pin_index=np.arange(1, case.pins.count + 1), fe=cy.pin_forces[k_max],
+        classical=None if classical is None else classical[:, k_max], theta_deg=th_max)))
+    calls.append((plots.pins_in_contact_plot, dict(
+        path=folder / "pins_in_contact.png", theta=th, count=cy.pins_in_contact, total=case.pins.count,
+        classical=None if classical is None else np.count_nonzero(classical > 0, axis=0))))
+    return calls
+
+
+def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
+    the equal share where it is not defined), roller loads and pin forces at the angle of the
+    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.plots`)."""
+    return [function(**kwargs) for function, kwargs in plot_calls(analysis, folder)]
 
 
 # --------------------------------------------------------------------------------------------

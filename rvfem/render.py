@@ -18,12 +18,20 @@ cheap).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 import os
+import pickle
+import queue
 import re
+import struct
 import subprocess
 import sys
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,6 +45,7 @@ log = logging.getLogger(__name__)
 __all__ = [
     "RENDER_WINDOW_VARIABLE",
     "DEFAULT_RENDER_WINDOW",
+    "RenderWorker",
     "StressRenderer",
     "StressScene",
     "check_rendering",
@@ -148,20 +157,26 @@ def check_rendering(timeout_s: float = 120.0) -> str:
     if rc == 0 and len(parts) == 3 and parts[1] == "1":
         _probe_result = parts[2]
         return _probe_result
+    _probe_result = _probe_error(rc, blank=rc == 0 and bool(parts), stderr=err, chosen=chosen)
+    raise _probe_result
+
+
+def _probe_error(rc: int | None, *, blank: bool, stderr: str, chosen: str) -> RenderError:
+    """The error of a failed rendering check: the probe's exit code (negative: killed by a signal;
+    None: it could not start or did not finish), whether it rendered a blank image, its stderr."""
     if rc is not None and rc < 0:
         reason = f"VTK crashed (signal {-rc})"
-    elif rc == 0 and parts:
+    elif blank:
         reason = "VTK rendered a blank image"
     else:
         reason = "VTK could not render"
-    details = _vtk_messages(err)
-    _probe_result = RenderError(
+    details = _vtk_messages(stderr)
+    return RenderError(
         f"off-screen rendering is not available ({reason} with render window {chosen}"
         f"{': ' + details if details else ''}); install the EGL runtime (e.g. Debian/Ubuntu 'libegl1') "
         f"or OSMesa, set {RENDER_WINDOW_VARIABLE} to a render window that works here, "
         "or skip the images (rvfem run --no-images)"
     )
-    raise _probe_result
 
 
 def _pyvista():
@@ -462,6 +477,21 @@ class StressRenderer:
     def _count_frame(self, *_) -> None:
         self.frames += 1
 
+    def warm_up(self) -> None:
+        """Draw two throwaway frames of a small synthetic disc, the whole disc and a close-up,
+        with every kind of actor of the images: the first real image then finds the shaders
+        compiled and the fonts loaded (a render worker does this while the analysis runs).
+
+        Nothing is written and :attr:`frames` is not counted; the next image rebuilds its disc.
+        """
+        if self._closed:
+            raise RenderError("the stress renderer is closed")
+        scene = _warm_up_scene()
+        frames = self.frames
+        self._frame(scene, None, None, None, False)
+        self._frame(dataclasses.replace(scene, magnification=0.0), (6.0, 0.0), 2.0, (6.0, 0.0), True)
+        self.frames = frames
+
     def _set_mesh(self, scene: StressScene) -> None:
         """Build the disc mesh, its colour bar and the undeformed outline (once per mesh)."""
         if self._mesh is not None:
@@ -474,11 +504,17 @@ class StressRenderer:
         pts = np.asarray(scene.points, dtype=float)
         disc = pv.PolyData.from_regular_faces(_xyz(pts), np.asarray(scene.triangles, dtype=np.int64))
         disc.point_data[_FIELD] = np.zeros(len(pts))
-        actor = pl.add_mesh(disc, scalars=_FIELD, cmap=COLORMAP, clim=[0.0, 1.0], show_edges=False,
-                            edge_color="#303030", line_width=0.5, lighting=False, render=False,
-                            scalar_bar_args=dict(title=_FIELD, vertical=True, color="black", fmt="%.0f",
-                                                 n_labels=6, position_x=0.87, position_y=0.25, width=0.06,
-                                                 height=0.65, title_font_size=20, label_font_size=18))
+        # the colour bar of add_mesh renders a frame despite render=False (once the plotter has
+        # rendered before): not a frame of any image
+        pl.suppress_rendering = True
+        try:
+            actor = pl.add_mesh(disc, scalars=_FIELD, cmap=COLORMAP, clim=[0.0, 1.0], show_edges=False,
+                                edge_color="#303030", line_width=0.5, lighting=False, render=False,
+                                scalar_bar_args=dict(title=_FIELD, vertical=True, color="black", fmt="%.0f",
+                                                     n_labels=6, position_x=0.87, position_y=0.25, width=0.06,
+                                                     height=0.65, title_font_size=20, label_font_size=18))
+        finally:
+            pl.suppress_rendering = False
         actor.mapper.lookup_table.above_range_color = ABOVE_COLOUR
         actor.mapper.lookup_table.SetUseAboveRangeColor(False)
         bar = pl.scalar_bars[_FIELD]
@@ -644,6 +680,28 @@ class StressRenderer:
             raise errors[0]
 
 
+def _warm_up_scene() -> StressScene:
+    """A small disc (an annulus) with pins, bearing forces and clipped stresses."""
+    r = np.linspace(4.0, 10.0, 3)
+    t = np.linspace(0.0, 2 * np.pi, 24, endpoint=False)
+    rr, tt = np.meshgrid(r, t, indexing="ij")
+    points = np.column_stack([(rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel()])
+    idx = np.arange(points.shape[0]).reshape(len(r), len(t))
+    a, b = idx[:-1, :], np.roll(idx[:-1, :], -1, axis=1)
+    c, d = idx[1:, :], np.roll(idx[1:, :], -1, axis=1)
+    triangles = np.vstack([np.column_stack([a.ravel(), b.ravel(), d.ravel()]),
+                           np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
+    loop = lambda k: np.column_stack([idx[k], np.roll(idx[k], -1)])  # noqa: E731
+    pins = 11.0 * np.column_stack([np.cos(t[::3]), np.sin(t[::3])])
+    bores = np.array([[6.5, 0.0], [-3.25, 5.63], [-3.25, -5.63]])
+    forces = np.array([[300.0, 100.0], [-200.0, 250.0], [0.0, -150.0]])
+    return StressScene(points=points, triangles=triangles, boundaries={"central_hole": loop(0), "profile": loop(-1)},
+                       von_mises=np.hypot(*points.T) * 10.0, deformation=np.zeros_like(points), magnification=1.0,
+                       clim=(0.0, 80.0), pin_centres=pins, pin_radius=1.0, pin_loaded=pins[:, 0] > 0,
+                       bore_centres=bores, bearing_forces=forces, rigid_forces=0.9 * forces, force_scale=0.005,
+                       title="warm-up")
+
+
 def _background_fraction(image: np.ndarray) -> float:
     """Fraction of the pixels in the background colour."""
     from pyvista import Color
@@ -765,3 +823,430 @@ def _locator_inset(pv, pl, points: np.ndarray, boundaries: dict, focus: tuple[fl
     ren.SetInteractive(False)
     win.AddRenderer(ren)
     return ren, layers
+
+
+# --------------------------------------------------------------------------------------------
+# Rendering in a child process
+# --------------------------------------------------------------------------------------------
+
+_WORKER = r"""
+import sys
+sys.stdout.flush()
+sys.path.insert(0, {root!r})
+from rvfem.render import _serve
+_serve({window_size!r}, {compress_level!r}, {anti_aliasing!r})
+"""
+
+_HEADER = struct.Struct("<Q")
+
+ImageJob = tuple[str | os.PathLike, StressScene, dict]
+"""One stress image for :meth:`RenderWorker.draw`: (PNG path, scene, keyword arguments of
+:meth:`StressRenderer.write`)."""
+
+Call = tuple[Callable, dict]
+"""Another drawing for :meth:`RenderWorker.submit`: (function, keyword arguments). The function
+must be importable by name (a module-level function, e.g. :func:`rvfem.plots.mesh_plot`)."""
+
+
+def _send(stream, message, lock: threading.Lock | None = None) -> None:
+    data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    if lock is None:
+        stream.write(_HEADER.pack(len(data)) + data)
+        stream.flush()
+        return
+    with lock:
+        stream.write(_HEADER.pack(len(data)) + data)
+        stream.flush()
+
+
+def _receive(stream):
+    """The next message of a stream of :func:`_send`, or None at its end."""
+    header = stream.read(_HEADER.size)
+    if len(header) < _HEADER.size:
+        return None
+    (n,) = _HEADER.unpack(header)
+    data = stream.read(n)
+    if len(data) < n:
+        return None
+    return pickle.loads(data)
+
+
+def _picklable(exc: BaseException) -> BaseException:
+    try:
+        pickle.loads(pickle.dumps(exc))
+        return exc
+    except Exception:
+        return RenderError(f"{type(exc).__name__}: {exc}")
+
+
+class _ForwardLog(logging.Handler):
+    """Sends the log records of the child process to its parent (which logs them again)."""
+
+    def __init__(self, stream, lock: threading.Lock):
+        super().__init__(logging.INFO)
+        self._stream, self._lock = stream, lock
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            _send(self._stream, ("log", record.levelno, record.name, record.getMessage()), self._lock)
+        except Exception:  # pragma: no cover - the parent is gone
+            pass
+
+
+def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str) -> None:
+    """The child process of :class:`RenderWorker`, after its rendering check: make the renderer,
+    draw one series of images (and run the other calls in a second thread meanwhile), report each,
+    exit."""
+    global _probe_result
+    _probe_result = "checked by the parent"   # the check was this process's own first render
+    out = os.fdopen(os.dup(1), "wb")           # messages to the parent; any other output to stderr
+    os.dup2(2, 1)
+    lock = threading.Lock()
+    logger = logging.getLogger("rvfem")
+    logger.addHandler(_ForwardLog(out, lock))
+    logger.setLevel(logging.INFO)
+    renderer = None
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-worker-calls")
+    try:
+        renderer = StressRenderer(window_size, compress_level=compress_level, anti_aliasing=anti_aliasing)
+        renderer.warm_up()
+        message = _receive(sys.stdin.buffer)
+        if message is None or message[0] != "draw":
+            return
+        _, jobs, calls = message
+        futures = [pool.submit(function, **kwargs) for function, kwargs in calls]
+        for j, future in enumerate(futures):
+            future.add_done_callback(
+                lambda f, j=j: f.exception() is None and _send(out, ("called", j, f.result()), lock))
+        for i, (path, scene, options) in enumerate(jobs):
+            renderer.write(path, scene, **options)
+            _send(out, ("drawn", i), lock)
+        renderer.close()
+        results = [future.result() for future in futures]
+        _send(out, ("done", renderer.frames, renderer.anti_aliasing, results), lock)
+        out.close()
+        os._exit(0)   # every file is complete: skip tearing VTK down, the parent need not wait for it
+    except BaseException as exc:  # noqa: BLE001 - every failure goes to the parent
+        pool.shutdown(wait=True, cancel_futures=True)
+        if renderer is not None:
+            renderer.close(raise_errors=False)
+        try:
+            _send(out, ("error", _picklable(exc)), lock)
+        except OSError:  # pragma: no cover - the parent is gone
+            pass
+
+
+class RenderWorker:
+    """Off-screen rendering in a child process: the rendering check, then one series of stress
+    images drawn while the calling process does other work.
+
+    The child process starts at once. It renders the small scene of :func:`check_rendering`
+    (the check: a VTK without a usable OpenGL context may crash its process, and here that is not
+    the caller's), then imports PyVista and opens its plotter, all while the caller computes.
+    :meth:`check` waits for the check's result; :meth:`draw` hands over the images and waits for
+    them. Log records of the child (e.g. the anti-aliasing fallback) are logged again here.
+
+    Parameters
+    ----------
+    window_size : (int, int)
+        Image size in pixels (width, height).
+    compress_level : int
+        zlib level of the PNG files.
+    anti_aliasing : {"fxaa", "msaa", "none"}
+        As for :class:`StressRenderer`.
+    timeout_s : float
+        Give up the check after this many seconds.
+
+    Attributes
+    ----------
+    frames : int
+        Frames rendered by :meth:`draw`.
+    anti_aliasing : str
+        The anti-aliasing used (``"msaa"`` after a fallback).
+
+    Examples
+    --------
+    >>> with RenderWorker((1500, 1100)) as worker:                  # doctest: +SKIP
+    ...     worker.check()                      # before a long computation
+    ...     scenes = ...
+    ...     worker.draw([(f"stress_{k}.png", scene, {}) for k, scene in enumerate(scenes)])
+    """
+
+    def __init__(self, window_size: tuple[int, int] = (1500, 1100), *, compress_level: int = PNG_COMPRESS_LEVEL,
+                 anti_aliasing: str = ANTI_ALIASING, timeout_s: float = 120.0):
+        if anti_aliasing not in _ANTI_ALIASING:
+            raise ValueError(f"anti_aliasing must be one of {', '.join(_ANTI_ALIASING)}, not {anti_aliasing!r}")
+        self.window_size = (int(window_size[0]), int(window_size[1]))
+        self.anti_aliasing = anti_aliasing
+        self.frames = 0
+        self._timeout_s = float(timeout_s)
+        env = _render_environment()
+        self._chosen = env.get(RENDER_WINDOW_VARIABLE, "VTK's default")
+        self._checked: str | RenderError | None = None
+        self._used = False
+        self._jobs: list | None = None
+        self._n_calls = 0
+        self._drawn = 0
+        self._results: dict[int, object] = {}
+        self._finished = False
+        self._messages: queue.Queue = queue.Queue()
+        self._proc = None
+        if isinstance(_probe_result, RenderError):   # this process knows already: no child
+            self._checked = _probe_result
+            return
+        self._stderr = tempfile.TemporaryFile()
+        code = _PROBE + _WORKER.format(root=str(Path(__file__).resolve().parents[1]),
+                                       window_size=self.window_size, compress_level=int(compress_level),
+                                       anti_aliasing=anti_aliasing)
+        try:
+            self._proc = subprocess.Popen([sys.executable, "-c", code], env=env, stdin=subprocess.PIPE,
+                                          stdout=subprocess.PIPE, stderr=self._stderr)
+        except OSError as exc:  # pragma: no cover - cannot start the interpreter itself
+            self._stderr.close()
+            self._checked = _probe_error(None, blank=False, stderr=str(exc), chosen=self._chosen)
+            return
+        self._started = time.monotonic()
+        self._reader = threading.Thread(target=self._read, name="rvfem-render-worker", daemon=True)
+        self._reader.start()
+
+    def __enter__(self) -> RenderWorker:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close()
+
+    def _read(self) -> None:
+        """Reader thread: the probe's line, then the child's messages, into the queue."""
+        stream = self._proc.stdout
+        try:
+            while True:
+                line = stream.readline()
+                if not line:
+                    self._messages.put(("eof",))
+                    return
+                if line.startswith(b"RVFEM-RENDER "):
+                    self._messages.put(("probe", line.decode("ascii", "replace").split()))
+                    break
+            while (message := _receive(stream)) is not None:
+                self._messages.put(message)
+        except Exception as exc:  # pragma: no cover - a broken pipe
+            log.debug("reading the render process failed: %s", exc)
+        self._messages.put(("eof",))
+
+    def _stderr_text(self) -> str:
+        try:
+            self._stderr.seek(0)
+            return self._stderr.read().decode("utf-8", "replace")
+        except (OSError, ValueError):  # pragma: no cover
+            return ""
+
+    def _stop(self) -> int | None:
+        """End the child process (if still running) and return its exit code."""
+        if self._proc is None:
+            return None
+        if self._proc.poll() is None:
+            self._proc.kill()
+        try:
+            return self._proc.wait(timeout=10.0)
+        except subprocess.TimeoutExpired:  # pragma: no cover
+            return None
+
+    def check(self, wait: bool = True) -> str | None:
+        """Wait for the rendering check of the child process.
+
+        Parameters
+        ----------
+        wait : bool
+            Wait for the check; else return None if it has not finished yet.
+
+        Returns
+        -------
+        str or None
+            The VTK render window class that worked (e.g. ``vtkEGLRenderWindow``); None if the
+            check is still running (``wait=False``).
+
+        Raises
+        ------
+        RenderError
+            As :func:`check_rendering`: off-screen rendering is not available, with VTK's reason.
+        """
+        global _probe_result
+        if isinstance(self._checked, str):
+            return self._checked
+        if isinstance(self._checked, RenderError):
+            raise self._checked
+        try:
+            if not wait:
+                message = self._messages.get_nowait()
+            else:
+                message = self._messages.get(timeout=max(0.0, self._started + self._timeout_s - time.monotonic()))
+        except queue.Empty:
+            if not wait and time.monotonic() < self._started + self._timeout_s:
+                return None
+            message = None
+        if message is not None and message[0] == "probe" and len(message[1]) == 3 and message[1][1] == "1":
+            self._checked = _probe_result = message[1][2]
+            return self._checked
+        blank = message is not None and message[0] == "probe"   # it rendered, but nothing
+        rc = self._stop()
+        if message is None:
+            rc, stderr = None, f"no image after {self._timeout_s:g} s"
+        else:
+            rc, stderr = (0 if blank else rc), self._stderr_text()
+        self._checked = _probe_result = _probe_error(rc, blank=blank, stderr=stderr, chosen=self._chosen)
+        self.close()
+        raise self._checked
+
+    def draw(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = (),
+             tick: Callable[[int], None] | None = None) -> list:
+        """Draw a series of stress images in the child process and wait for them (:meth:`submit`
+        and :meth:`wait`).
+
+        Parameters
+        ----------
+        jobs : sequence of (path, StressScene, dict)
+            PNG file, scene and keyword arguments of :meth:`StressRenderer.write`.
+        calls : sequence of (function, dict)
+            Other drawings (see :meth:`submit`).
+        tick : callable, optional
+            ``tick(done)`` after each image drawn (its PNG file may still be being written).
+
+        Returns
+        -------
+        list
+            The PNG files, all complete, then what the calls returned.
+        """
+        self.submit(jobs, calls=calls)
+        return self.wait(tick=tick)
+
+    def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> None:
+        """Hand a series of stress images over to the child process, which starts drawing them
+        (once per worker); :meth:`wait` waits for them.
+
+        Parameters
+        ----------
+        jobs : sequence of (path, StressScene, dict)
+            PNG file, scene and keyword arguments of :meth:`StressRenderer.write`.
+        calls : sequence of (function, dict)
+            Other drawings the child process makes in a second thread while it renders the images
+            (e.g. :func:`rvfem.plots.mesh_plot`: matplotlib, no OpenGL), one after the other.
+            Each function must be importable by name; its arguments and its return value are
+            pickled.
+
+        Raises
+        ------
+        RenderError
+            Off-screen rendering is not available, or the worker has drawn its series already.
+        """
+        self.check()
+        if self._jobs is not None:
+            raise RenderError("a render worker draws one series of images")
+        jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
+        calls = [(function, dict(kwargs)) for function, kwargs in calls]
+        try:
+            data = pickle.dumps(("draw", jobs, calls), protocol=pickle.HIGHEST_PROTOCOL)
+        except (pickle.PicklingError, AttributeError, TypeError) as exc:
+            raise TypeError(f"the images and calls cannot be handed to the render process "
+                            f"(functions must be importable by name): {exc}") from exc
+        self._jobs, self._n_calls, self._used = jobs, len(calls), True
+        try:
+            self._proc.stdin.write(_HEADER.pack(len(data)) + data)
+            self._proc.stdin.flush()
+        except OSError:
+            pass   # the child is gone: wait() reports how it ended
+
+    def wait(self, *, tick: Callable[[int], None] | None = None) -> list:
+        """Wait for the images and the calls of :meth:`submit`.
+
+        Parameters
+        ----------
+        tick : callable, optional
+            ``tick(done)`` after each image drawn (its PNG file may still be being written).
+
+        Returns
+        -------
+        list
+            The PNG files, all complete, then what the calls returned.
+
+        Raises
+        ------
+        RenderError
+            An image is blank, or the child process ended unexpectedly.
+        OSError
+            A PNG file could not be written.
+        Exception
+            What a call raised.
+        """
+        self._submitted()
+        while not self._finished:
+            if self._next() == "drawn" and tick is not None:
+                tick(self._drawn)
+        return [path for path, _, _ in self._jobs] + [self._results[j] for j in range(self._n_calls)]
+
+    def wait_calls(self, count: int | None = None) -> list:
+        """Wait for the first ``count`` calls of :meth:`submit` (all by default), which the child
+        makes one after the other, and return what they returned.
+
+        Raises
+        ------
+        RenderError
+            The child process ended unexpectedly, or an image failed.
+        Exception
+            What a call raised.
+        """
+        self._submitted()
+        count = self._n_calls if count is None else min(int(count), self._n_calls)
+        while any(j not in self._results for j in range(count)):
+            self._next()
+        return [self._results[j] for j in range(count)]
+
+    def _submitted(self) -> None:
+        if self._jobs is None:
+            raise RenderError("no images were submitted to the render worker")
+        if self._proc is None and not self._finished:
+            raise RenderError("the render worker is closed")
+
+    def _next(self) -> str:
+        """Process the next message of the child process; returns its kind. An error of the child
+        (or its unexpected end) is raised."""
+        message = self._messages.get()
+        kind = message[0]
+        if kind == "log":
+            logging.getLogger(message[2]).log(message[1], "%s", message[3])
+        elif kind == "drawn":
+            self._drawn += 1
+        elif kind == "called":
+            self._results[message[1]] = message[2]
+        elif kind == "done":   # the child exits by itself; close() collects it
+            self.frames, self.anti_aliasing = message[1], message[2]
+            self._results.update(enumerate(message[3]))
+            self._finished = True
+        elif kind == "error":
+            self.close()
+            raise message[1]
+        else:   # the child ended without a word
+            rc = self._stop()
+            details = _vtk_messages(self._stderr_text())
+            how = f"crashed (signal {-rc})" if rc is not None and rc < 0 else f"ended (exit code {rc})"
+            self.close()
+            raise RenderError(f"the process drawing the stress images {how}"
+                              f"{': ' + details if details else ''}")
+        return kind
+
+    def close(self) -> None:
+        """End the child process (at once if it is still drawing) and release its pipes."""
+        if self._proc is not None:
+            try:
+                self._proc.stdin.close()   # a child still waiting for images ends
+            except OSError:  # pragma: no cover - the child is gone
+                pass
+            try:
+                self._proc.wait(timeout=5.0 if self._used else 0.0)
+            except subprocess.TimeoutExpired:
+                pass
+            self._stop()
+            self._reader.join(timeout=5.0)
+            self._proc.stdout.close()
+            self._proc = None
+        if hasattr(self, "_stderr") and not self._stderr.closed:
+            self._stderr.close()

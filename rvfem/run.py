@@ -15,7 +15,10 @@ load cycle → evaluation → outputs — and writes::
     DIR/plots/*.png         bearing loads, roller loads, pin forces, pins in contact
 
 It is :func:`rvfem.analysis.analyse` (everything computed, nothing written) followed by the writers
-of :mod:`rvfem.outputs`, one per format. Nothing is lost: the outputs are written into a temporary
+of :mod:`rvfem.outputs`, one per format. With images, off-screen rendering is checked by a child
+process (:class:`rvfem.render.RenderWorker`) started with the run: the check runs while the mesh
+and the model are built, and the run waits for it before the load cycle (a failed check stops the
+run there); the same process then draws the stress images while the other files are written. Nothing is lost: the outputs are written into a temporary
 folder next to DIR (:func:`rvfem.outputs.result_folder`) and moved into place only when complete. An existing non-empty DIR is replaced only with ``overwrite=True`` (and only
 after the new results are complete); a run that fails or is interrupted leaves neither DIR (nor
 the previous results changed) nor the temporary folder.
@@ -61,12 +64,15 @@ STAGES: dict[str, str] = {
     "check": "checking the case, the output folder and off-screen rendering",
     "tables": "writing summary tables (CSV)",
     "vtk": "writing VTK files for ParaView",
-    "images": "rendering stress images",
     "plots": "plotting",
+    "images": "rendering stress images",
     "report": "writing the report",
 }
 """Stages of a run in order, with a one-line description (what the progress callback reports):
-those of :func:`rvfem.analysis.analyse`, then one per writer."""
+those of :func:`rvfem.analysis.analyse`, then one per writer. With images, the stress images, the
+mesh picture and the plots are drawn by a child process (:class:`rvfem.render.RenderWorker`) from
+the start of the writers on, while this process writes the tables and the VTK files; the ``plots``
+and ``images`` stages are the waits for them."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,7 +144,8 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
         Mesh cache folder; default :func:`rvfem.analysis.default_cache_dir` (the repository's
         ``meshes/`` in a source checkout, else the per-user cache).
     images : bool
-        Render the PyVista images (needs off-screen OpenGL; checked before anything is computed).
+        Render the PyVista images (needs off-screen OpenGL; checked while the mesh and the model
+        are built, and before the load cycle).
     field_step_deg : float, optional
         Also keep the displacement/stress fields every ``field_step_deg`` degrees (more VTU frames
         for a ParaView animation); by default only the case's ``analysis.saved_angles_deg``, the
@@ -169,48 +176,95 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
     _analysis.cycle_angles(case)
     _analysis.kept_field_angles(case, field_step_deg)
     outputs.check_output_folder(out_dir, overwrite)
+    worker = None
     if images:
-        from .render import check_rendering
+        from .render import RenderWorker
 
-        check_rendering()
+        worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
+        worker.check(wait=False)            # raises at once if this process knows it fails
     stages.end("check", t)
 
-    with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
-        result = analyse(case, provenance=provenance, field_step_deg=field_step_deg, cache_dir=cache_dir,
-                         progress=progress)
-        written: list[Path] = []
-
-        t = stages.start("tables")
-        written += outputs.write_tables(result, tmp)
-        written += outputs.write_case_json(result, tmp)
-        stages.end("tables", t)
-
-        n_fields = len(result.stress.snapshots)
-        t = stages.start("vtk", n_fields)
-        written += outputs.write_vtk(result, tmp, tick=lambda done, total: stages.tick("vtk", done, total))
-        stages.end("vtk", t, n_fields)
-
-        if images:
-            n_images = outputs.image_count(result)
-            t = stages.start("images", n_images)
-            written += outputs.write_images(result, tmp,
-                                            tick=lambda done, total: stages.tick("images", done, total))
-            stages.end("images", t, n_images)
-
-        t = stages.start("plots")
-        written += outputs.write_plots(result, tmp)
-        stages.end("plots", t)
-
-        t = stages.start("report")
-        timings = {"check": stages.seconds["check"], **result.timings,
-                   **{k: v for k, v in stages.seconds.items() if k != "check"}}
-        timings["total"] = time.perf_counter() - t_run
-        files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {"report.html", "summary.json"}))
-        summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
-        outputs.write_report(result, tmp, summary=summary)
-        stages.end("report", t)
-        summary["timings_s"]["report"] = stages.seconds["report"]
-        summary["timings_s"]["total"] = time.perf_counter() - t_run
-        outputs.write_summary(result, tmp, summary=summary)
+    try:
+        with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
+            try:
+                waited = [0.0]
+                result = analyse(case, provenance=provenance, field_step_deg=field_step_deg,
+                                 cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited))
+                stages.seconds["check"] += waited[0]
+                summary, files = _write_outputs(result, tmp, stages, worker, t_run)
+            finally:
+                if worker is not None:
+                    worker.close()   # before the folder is moved or removed: nothing writes into it
+    finally:
+        if worker is not None:
+            worker.close()
 
     return RunSummary(out_dir=out_dir, summary=summary, analysis=result, files=files)
+
+
+def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: list[float]) -> ProgressCallback:
+    """The progress callback of the analysis: waits for the rendering check of ``worker`` (if any)
+    when the load cycle starts (its RenderError aborts the analysis), adding the wait to
+    ``waited[0]``, then reports to ``progress``."""
+
+    def report(stage: str, done: int, total: int) -> None:
+        if worker is not None and stage == "cycle" and done == 0:
+            t = time.perf_counter()
+            try:
+                worker.check()
+            finally:
+                waited[0] += time.perf_counter() - t
+        if progress is not None:
+            progress(stage, done, total)
+
+    return report
+
+
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> tuple[dict, tuple[str, ...]]:
+    """Write every file of the result folder ``tmp``; returns the summary and the files.
+
+    The images and the plots are handed to ``worker`` first (its child process draws them
+    meanwhile); this process writes the tables and the VTK files, then waits for the plots and the
+    images, and writes the report and the summary. Without a worker the plots are drawn here.
+    """
+    written: list[Path] = []
+
+    t = stages.start("tables")
+    written += outputs.write_tables(result, tmp)
+    written += outputs.write_case_json(result, tmp)
+    stages.end("tables", t)
+
+    t_submit = time.perf_counter()
+    pending = None
+    if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
+        pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp))
+    submitted = time.perf_counter() - t_submit
+
+    n_fields = len(result.stress.snapshots)
+    t = stages.start("vtk", n_fields)
+    written += outputs.write_vtk(result, tmp, tick=lambda done, total: stages.tick("vtk", done, total))
+    stages.end("vtk", t, n_fields)
+
+    t = stages.start("plots")
+    written += pending.calls_result() if pending is not None else outputs.write_plots(result, tmp)
+    stages.end("plots", t)
+
+    if pending is not None:
+        n_images = outputs.image_count(result)
+        t = stages.start("images", n_images)
+        written += pending.result(tick=lambda done, total: stages.tick("images", done, total))
+        stages.end("images", t, n_images)
+        stages.seconds["images"] += submitted
+
+    t = stages.start("report")
+    timings = {"check": stages.seconds["check"], **result.timings,
+               **{k: v for k, v in stages.seconds.items() if k != "check"}}
+    timings["total"] = time.perf_counter() - t_run
+    files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {"report.html", "summary.json"}))
+    summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
+    outputs.write_report(result, tmp, summary=summary)
+    stages.end("report", t)
+    summary["timings_s"]["report"] = stages.seconds["report"]
+    summary["timings_s"]["total"] = time.perf_counter() - t_run
+    outputs.write_summary(result, tmp, summary=summary)
+    return summary, files

@@ -1,7 +1,7 @@
 """VTK output for ParaView: one ``.vtu`` per kept crank angle and a ``.pvd`` collection over θ.
 
-Each ``.vtu`` (written with meshio, binary, zlib-compressed) is the disc mesh in its own frame
-(z = 0) with
+Each ``.vtu`` (VTK XML, binary, zlib-compressed: meshio and ParaView read it) is the disc mesh in
+its own frame (z = 0) with
 
 point data (at the mesh vertices)
     ``displacement_mm`` (3 components, z = 0; as solved, includes the disc's rigid-body motion),
@@ -17,11 +17,21 @@ cell data (one value per triangle)
 For P2 models the file holds the linear mesh and the vertex values only (the edge-midpoint nodes
 are dropped). The ``.pvd`` lists the files with the crank angle in degrees as the time value, so
 ParaView's time controls step through the cycle.
+
+The files of one run share the mesh: :func:`vtu_mesh` encodes the points and the cells once (zlib
+level :data:`MESH_ZLIB_LEVEL`), and :func:`write_vtu` and :func:`write_envelope_vtu` take it
+(``mesh=``) instead of encoding them again. The field arrays are compressed with zlib at level
+:data:`ZLIB_LEVEL` with the strategy :data:`ZLIB_STRATEGY`. Every array is compressed in blocks of
+32 KiB (VTK's ``vtkZLibDataCompressor`` layout).
 """
 
 from __future__ import annotations
 
+import base64
 import os
+import sys
+import zlib
+from dataclasses import dataclass
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -29,7 +39,8 @@ import numpy as np
 
 from .postprocess import FieldSnapshot
 
-__all__ = ["POINT_FIELDS", "CELL_FIELDS", "ENVELOPE_FILE", "vtu_name", "write_vtu", "write_pvd", "write_envelope_vtu"]
+__all__ = ["POINT_FIELDS", "CELL_FIELDS", "ENVELOPE_FILE", "MESH_ZLIB_LEVEL", "ZLIB_LEVEL", "ZLIB_STRATEGY",
+           "VtuMesh", "vtu_mesh", "vtu_name", "write_vtu", "write_pvd", "write_envelope_vtu"]
 
 #: Point-data arrays of every ``.vtu`` (name → number of components).
 POINT_FIELDS = {
@@ -56,6 +67,108 @@ def vtu_name(theta_deg: float) -> str:
 def _xyz(a: np.ndarray) -> np.ndarray:
     return np.column_stack([a, np.zeros(len(a))])
 
+ZLIB_LEVEL = 1
+"""zlib level of the field arrays of the ``.vtu`` files (0-9)."""
+
+ZLIB_STRATEGY = zlib.Z_RLE
+"""zlib strategy of the field arrays. The stresses are nearly incompressible doubles (what zlib
+gains on them is mostly the repeated sign and exponent bytes and the zero z components): run-length
+matches at level 1 compress them in about a fifth of the time of zlib's default (level 6, default
+strategy), the files about 1 % larger."""
+
+MESH_ZLIB_LEVEL = 6
+"""zlib level of the points and the cells (default strategy): encoded once per run, so the
+smallest."""
+
+_BLOCK_BYTES = 32768
+_VTU_TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.int64): "Int64"}
+_VTK_TRIANGLE = 5
+
+
+def _compressed(block, level: int, strategy: int) -> bytes:
+    if strategy == zlib.Z_DEFAULT_STRATEGY:
+        return zlib.compress(block, level)
+    c = zlib.compressobj(level, zlib.DEFLATED, zlib.MAX_WBITS, 8, strategy)
+    return c.compress(block) + c.flush()
+
+
+def _encoded(data: np.ndarray, level: int, strategy: int) -> str:
+    """An array as the text of a binary, zlib-compressed ``DataArray`` (VTK's block header, UInt32,
+    then the compressed blocks, each base64-encoded)."""
+    raw = memoryview(np.ascontiguousarray(data)).cast("B")
+    n = len(raw)
+    blocks = [_compressed(raw[i:i + _BLOCK_BYTES], level, strategy) for i in range(0, n, _BLOCK_BYTES)]
+    last = n - (len(blocks) - 1) * _BLOCK_BYTES if blocks else 0
+    header = np.array([len(blocks), _BLOCK_BYTES, last] + [len(b) for b in blocks], dtype=np.uint32)
+    return (base64.b64encode(header.tobytes()) + base64.b64encode(b"".join(blocks))).decode("ascii")
+
+
+def _data_array(name: str, data: np.ndarray, level: int, strategy: int = zlib.Z_DEFAULT_STRATEGY) -> str:
+    data = np.asarray(data)
+    data = data.astype(data.dtype.newbyteorder("="), copy=False)
+    components = f' NumberOfComponents="{data.shape[1]}"' if data.ndim == 2 else ""
+    return (f'<DataArray type="{_VTU_TYPES[data.dtype]}" Name="{name}"{components} format="binary">\n'
+            f"{_encoded(data, level, strategy)}\n</DataArray>\n")
+
+
+@dataclass(frozen=True, eq=False)
+class VtuMesh:
+    """The mesh part of a ``.vtu`` file, encoded once for every file of the mesh.
+
+    Attributes
+    ----------
+    n_points, n_cells : int
+    xml : str
+        The ``Points`` and ``Cells`` elements.
+    """
+
+    n_points: int
+    n_cells: int
+    xml: str
+
+
+def vtu_mesh(points: np.ndarray, triangles: np.ndarray, *, level: int = MESH_ZLIB_LEVEL) -> VtuMesh:
+    """Encode the mesh of the ``.vtu`` files: points (z = 0) and triangles.
+
+    Parameters
+    ----------
+    points : ndarray (n_vertices, 2)
+        Mesh vertices, mm.
+    triangles : ndarray (n_elements, 3)
+        Vertex indices.
+    level : int
+        zlib level (default strategy).
+
+    Returns
+    -------
+    VtuMesh
+    """
+    xyz = _xyz(np.asarray(points, dtype=float))
+    tri = np.asarray(triangles, dtype=np.int64)
+    n = len(tri)
+    xml = ("<Points>\n" + _data_array("Points", xyz, level) + "</Points>\n<Cells>\n"
+           + _data_array("connectivity", tri.reshape(-1), level)
+           + _data_array("offsets", 3 * np.arange(1, n + 1, dtype=np.int64), level)
+           + _data_array("types", np.full(n, _VTK_TRIANGLE, dtype=np.int64), level) + "</Cells>\n")
+    return VtuMesh(n_points=len(xyz), n_cells=n, xml=xml)
+
+
+def _write_unstructured_grid(path: Path, mesh: VtuMesh, point_data: dict[str, np.ndarray],
+                             cell_data: dict[str, np.ndarray], level: int, strategy: int) -> Path:
+    byte_order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
+    parts = ['<?xml version="1.0"?>\n',
+             f'<VTKFile type="UnstructuredGrid" version="0.1" byte_order="{byte_order}" '
+             'compressor="vtkZLibDataCompressor">\n<UnstructuredGrid>\n',
+             f'<Piece NumberOfPoints="{mesh.n_points}" NumberOfCells="{mesh.n_cells}">\n', mesh.xml]
+    for tag, data in (("PointData", point_data), ("CellData", cell_data)):
+        if data:
+            parts.append(f"<{tag}>\n")
+            parts += [_data_array(name, values, level, strategy) for name, values in data.items()]
+            parts.append(f"</{tag}>\n")
+    parts.append("</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
+    path.write_bytes("".join(parts).encode("ascii"))
+    return path
+
 
 def _stress_arrays(state) -> dict[str, np.ndarray]:
     return {
@@ -69,7 +182,8 @@ def _stress_arrays(state) -> dict[str, np.ndarray]:
 
 
 def write_vtu(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray,
-              snapshot: FieldSnapshot) -> Path:
+              snapshot: FieldSnapshot, *, mesh: VtuMesh | None = None, level: int = ZLIB_LEVEL,
+              strategy: int = ZLIB_STRATEGY) -> Path:
     """Write the disc with the fields of one snapshot as a ``.vtu`` file.
 
     Parameters
@@ -80,13 +194,16 @@ def write_vtu(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
     triangles : ndarray (n_elements, 3)
         Vertex indices, in the element order of the stresses (``model.mesh.t.T``).
     snapshot : FieldSnapshot
+    mesh : VtuMesh, optional
+        ``vtu_mesh(points, triangles)``, encoded once for the files of a series (``points`` and
+        ``triangles`` are then not encoded again).
+    level, strategy : int
+        zlib level and strategy of the field arrays.
 
     Returns
     -------
     Path
     """
-    import meshio
-
     path = Path(path)
     nodal, element = snapshot.stress.nodal, snapshot.stress.element
     angle = np.asarray(nodal.angle1, dtype=float)
@@ -96,11 +213,9 @@ def write_vtu(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
         **_stress_arrays(nodal),
         "s1_direction": np.column_stack([np.cos(angle), np.sin(angle), np.zeros(len(angle))]),
     }
-    cell_data = {name: [values] for name, values in _stress_arrays(element).items()}
-    mesh = meshio.Mesh(_xyz(np.asarray(points, dtype=float)), [("triangle", np.asarray(triangles, dtype=np.int64))],
-                       point_data=point_data, cell_data=cell_data)
-    meshio.write(path, mesh, file_format="vtu", binary=True, compression="zlib")
-    return path
+    if mesh is None:
+        mesh = vtu_mesh(points, triangles)
+    return _write_unstructured_grid(path, mesh, point_data, _stress_arrays(element), level, strategy)
 
 
 def write_pvd(path: str | os.PathLike, entries: list[tuple[float, str]]) -> Path:
@@ -133,7 +248,8 @@ ENVELOPE_FILE = "disc_envelope.vtu"
 
 
 def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray,
-                       von_mises: np.ndarray, theta: np.ndarray) -> Path:
+                       von_mises: np.ndarray, theta: np.ndarray, *, mesh: VtuMesh | None = None,
+                       level: int = ZLIB_LEVEL, strategy: int = ZLIB_STRATEGY) -> Path:
     """Write the cycle's stress envelope as a ``.vtu``: point data ``von_mises_envelope_MPa``
     (the largest vertex von Mises stress of every vertex over every solved crank angle) and
     ``envelope_theta_deg`` (the crank angle at which it occurs).
@@ -147,12 +263,17 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
         MPa.
     theta : ndarray (n_vertices,)
         rad.
-    """
-    import meshio
+    mesh : VtuMesh, optional
+        ``vtu_mesh(points, triangles)`` (see :func:`write_vtu`).
+    level, strategy : int
+        zlib level and strategy of the arrays.
 
-    path = Path(path)
-    mesh = meshio.Mesh(_xyz(np.asarray(points, dtype=float)), [("triangle", np.asarray(triangles, dtype=np.int64))],
-                       point_data={"von_mises_envelope_MPa": np.asarray(von_mises, dtype=float),
-                                   "envelope_theta_deg": np.degrees(np.asarray(theta, dtype=float))})
-    meshio.write(path, mesh, file_format="vtu", binary=True, compression="zlib")
-    return path
+    Returns
+    -------
+    Path
+    """
+    if mesh is None:
+        mesh = vtu_mesh(points, triangles)
+    point_data = {"von_mises_envelope_MPa": np.asarray(von_mises, dtype=float),
+                  "envelope_theta_deg": np.degrees(np.asarray(theta, dtype=float))}
+    return _write_unstructured_grid(Path(path), mesh, point_data, {}, level, strategy)

@@ -107,8 +107,21 @@ def test_a_new_mesh_replaces_the_old_one(scenes, tmp_path):
     with render.StressRenderer(SIZE) as renderer:
         renderer.write(tmp_path / "first.png", full)
         second = renderer.write(tmp_path / "second.png", other)
+        assert renderer.frames == 2   # building the new disc renders nothing
     alone = render.stress_image(tmp_path / "alone.png", other, window_size=SIZE)
     assert np.count_nonzero(np.abs(_read(second) - _read(alone)).max(axis=2)) <= 2
+
+
+def test_a_warm_up_leaves_nothing_in_the_images(scenes, tmp_path):
+    with render.StressRenderer(SIZE) as renderer:
+        renderer.warm_up()
+        assert renderer.frames == 0
+        warm = [renderer.write(tmp_path / f"warm_{k}.png", s, **kw) for k, (s, kw) in enumerate(scenes)]
+        assert renderer.frames == len(scenes) and renderer.anti_aliasing == "fxaa"
+    with render.StressRenderer(SIZE) as renderer:
+        cold = [renderer.write(tmp_path / f"cold_{k}.png", s, **kw) for k, (s, kw) in enumerate(scenes)]
+    for a, b in zip(warm, cold):
+        assert np.count_nonzero(np.abs(_read(a) - _read(b)).max(axis=2)) <= 2
 
 
 def test_fxaa_that_does_not_render_falls_back_to_msaa(scenes, tmp_path, monkeypatch, caplog):
@@ -168,3 +181,78 @@ def test_repeated_shapes_are_the_pyvista_shapes():
         np.testing.assert_allclose(arrows.points[k * n:(k + 1) * n], one.points, atol=1e-5)
     assert arrows.n_cells == len(starts) * one.n_cells
     assert shapes.discs(np.zeros((0, 2)), 0.0, 0.0, 1.0, 8) is None
+
+
+def test_a_render_worker_draws_what_the_renderer_draws(scenes, tmp_path):
+    jobs = [(tmp_path / f"worker_{k}.png", s, kw) for k, (s, kw) in enumerate(scenes)]
+    ticks = []
+    with render.RenderWorker(SIZE) as worker:
+        assert worker.check(wait=True) == render.check_rendering()
+        paths = worker.draw(jobs, tick=ticks.append)
+        assert worker.frames == len(scenes) and worker.anti_aliasing == "fxaa"
+    assert paths == [p for p, _, _ in jobs] and ticks == list(range(1, len(scenes) + 1))
+    with render.StressRenderer(SIZE) as renderer:
+        here = [renderer.write(tmp_path / f"here_{k}.png", s, **kw) for k, (s, kw) in enumerate(scenes)]
+    for a, b in zip(paths, here):
+        assert np.array_equal(_read(a), _read(b))
+
+
+def test_a_render_worker_raises_the_errors_of_its_process(scenes, tmp_path):
+    with render.RenderWorker(SIZE) as worker:
+        with pytest.raises(OSError):   # the folder does not exist
+            worker.draw([(tmp_path / "missing" / "image.png", scenes[0][0], {})])
+        with pytest.raises(RenderError, match="one series"):
+            worker.submit([(tmp_path / "again.png", scenes[0][0], {})])
+
+
+def test_a_render_worker_makes_other_calls_meanwhile(scenes, tmp_path):
+    import shutil
+
+    source = tmp_path / "source.txt"
+    source.write_text("x")
+    calls = [(shutil.copyfile, dict(src=source, dst=tmp_path / f"copy_{k}.txt")) for k in range(2)]
+    with render.RenderWorker(SIZE) as worker:
+        worker.submit([(tmp_path / "image.png", scenes[0][0], {})], calls=calls)
+        assert worker.wait_calls() == [tmp_path / "copy_0.txt", tmp_path / "copy_1.txt"]
+        assert worker.wait() == [tmp_path / "image.png", tmp_path / "copy_0.txt", tmp_path / "copy_1.txt"]
+    assert (tmp_path / "copy_1.txt").read_text() == "x" and (tmp_path / "image.png").is_file()
+    with render.RenderWorker(SIZE) as worker:
+        worker.submit([(tmp_path / "image2.png", scenes[0][0], {})],
+                      calls=[(shutil.copyfile, dict(src=tmp_path / "missing.txt", dst=tmp_path / "c.txt"))])
+        with pytest.raises(FileNotFoundError):
+            worker.wait_calls()
+
+
+def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
+    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render, "_probe_result", None)
+    with render.RenderWorker(SIZE) as worker:
+        with pytest.raises(RenderError, match="off-screen rendering is not available.*crashed.*--no-images"):
+            worker.check()
+    # the process knows it now: a new worker fails at once, without a child process
+    worker = render.RenderWorker(SIZE)
+    with pytest.raises(RenderError, match="crashed"):
+        worker.check(wait=False)
+
+
+def test_a_failed_check_stops_a_run_before_the_load_cycle(monkeypatch, tmp_path):
+    from rvfem import run
+
+    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render, "_probe_result", None)
+    reached = []
+
+    def analyse(case, *, progress, **kwargs):
+        for stage in ("mesh", "model", "rigid", "cycle"):
+            progress(stage, 0, 1)
+            reached.append(stage)
+            progress(stage, 1, 1)
+        raise AssertionError("the load cycle ran")
+
+    monkeypatch.setattr(run, "analyse", analyse)
+    from conftest import CASES_DIR
+
+    with pytest.raises(RenderError, match="off-screen rendering is not available.*crashed"):
+        run.run_case(CASES_DIR / "rv40e_fanholes.toml", tmp_path / "out")
+    assert reached == ["mesh", "model", "rigid"]
+    assert list(tmp_path.iterdir()) == []
