@@ -77,7 +77,7 @@ STAGES: dict[str, str] = {
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
     "stress": "structural stress peak re-solved on P2 at its crank angles",
-    "attribution": "attribution: the reducer-stage models step by step (computed beside the stress stage)",
+    "attribution": "attribution: the reducer-stage models step by step (computed beside other stages)",
     "duty_cycle": "flexible load cycle at the other duty-cycle torques",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
@@ -739,21 +739,29 @@ def default_cache_dir() -> Path:
     return Path(platformdirs.user_cache_dir("rvfem")) / "meshes"
 
 
-def _recover_structural_peak(system, cycle, mesh, band, away):
-    """The structural peak recovered on P2 (:func:`rvfem.postprocess.recover_peak`) at the P1
-    envelope's peak angles; the P2 model of the same mesh is built here (or is the cycle's own for
-    a P2 case)."""
-    from . import postprocess
+def _p2_system(system, mesh):
+    """The P2 model of the cycle's disc (same mesh, models and geometry), assembled and factorised."""
     from .cycle import build_system
+
+    return build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
+                        geometry=system.geometry, pin_model=system.pin_model)
+
+
+def _recover_structural_peak(system, cycle, mesh, band, away, p2=None):
+    """The structural peak recovered on P2 (:func:`rvfem.postprocess.recover_peak`) at the P1
+    envelope's peak angles. The P2 model of the same mesh is ``p2`` (a future of
+    ``_timed(_p2_system, ...)``, built beside the load cycle) or built here, or is the cycle's own
+    for a P2 case."""
+    from . import postprocess
 
     t0 = time.perf_counter()
     if system.model.order == 2:
-        system_p2, system_p1 = system, None
+        system_p2, system_p1, setup = system, None, 0.0
+    elif p2 is not None:
+        (system_p2, setup), system_p1 = p2.result(), system
     else:
-        system_p2, system_p1 = build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
-                                            geometry=system.geometry,
-                                            pin_model=system.pin_model), system
-    setup = time.perf_counter() - t0
+        system_p2, system_p1 = _p2_system(system, mesh), system
+        setup = time.perf_counter() - t0
     angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
     return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
                                     p1_peak=away, system_p1=system_p1, setup_seconds=setup)
@@ -774,7 +782,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             angle_step_deg: float | None = None, bearing_model: str | None = None, order: int | None = None,
             field_step_deg: float | None = None, cache_dir: str | os.PathLike | None = None,
             progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
-            recover_stress: bool = True, duty_fe: bool = True) -> Analysis:
+            recover_stress: bool = True, duty_fe: bool = True, attribute: bool = True) -> Analysis:
     """Analyse a case completely, in memory.
 
     Parameters
@@ -798,11 +806,15 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         stage is skipped.
     recover_stress : bool
         Re-solve the disc on P2 at the structural peak's crank angles with the cycle's forces
-        (:func:`rvfem.postprocess.recover_peak`; stage ``stress``, about 5 s on the default case).
+        (:func:`rvfem.postprocess.recover_peak`; stage ``stress``, about 2 s on the default case).
     duty_fe : bool
         With a duty cycle: also solve the flexible load cycle at every other duty-cycle torque and
         give the service life from those loads (:func:`duty_cycle_fe`; stage ``duty_cycle``, one
         load cycle per torque, no new factorisation).
+    attribute : bool
+        Compute the attribution (:func:`rvfem.reducer.attribution`, stage ``attribution``). False
+        leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`):
+        :func:`rvfem.run.run_case` computes it while the output files are drawn.
 
     Returns
     -------
@@ -840,6 +852,22 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     t = stages.start("model")
     system = cycle_module.build_system(case, mesh, geometry=geometry)
     stages.end("model", t)
+    # work beside the stages that leave a core to spare: the P2 model of the stress stage
+    # (factorisation and array work, which release the interpreter) beside the load cycle's
+    # per-angle solves, then the attribution beside the stress stage
+    background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
+    try:
+        return _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
+                                   recover_stress, duty_fe, attribute)
+    finally:
+        background.shutdown(wait=True, cancel_futures=True)
+
+
+def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
+                        recover_stress, duty_fe, attribute=True):
+    """The stages of :func:`analyse` after the model; ``background`` runs the work beside them."""
+    from . import compare, postprocess, reducer
+    from . import cycle as cycle_module
 
     # the rigid model before the cycle: a case outside every rigid reference fails fast
     t = stages.start("rigid")
@@ -855,7 +883,13 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     n = len(thetas)
     t = stages.start("cycle", n)
 
+    p2 = []
+
     def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
+        # the first angle is solved once the compliance columns are (both cores): from here on
+        # the cycle is small dense solves on one core, and the P2 model is built on the other
+        if recover_stress and system.model.order == 1 and not p2:
+            p2.append(background.submit(_timed, _p2_system, system, mesh))
         if i < total:
             stages.tick("cycle", i, total)
 
@@ -875,20 +909,17 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
 
     # what the flexibility effect is made of: the modelling steps the case's own model does not
     # already give, on the same angles and the same compliance. Mostly small dense solves, it runs
-    # on a thread beside the stress stage (P2 factorisation and back-substitutions, which release
-    # the interpreter); the two share read-only data and the P1 compliance, whose cache is locked
-    pool = ThreadPoolExecutor(1, thread_name_prefix="rvfem-attribution")
-    pending = pool.submit(_timed, reducer.attribution, system, thetas,
-                          cycles={reducer.case_step(case): cycle})
-    try:
-        stress, roller_hertz, stiffness, duty = _evaluate(
-            case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
-            recover_stress)
+    # beside the stress stage (P2 back-substitutions and array work, which release the
+    # interpreter); the two share read-only data and the P1 compliance, whose cache is locked
+    pending = background.submit(_timed, attribution_of, system, thetas, cycle) if attribute else None
+    stress, roller_hertz, stiffness, duty = _evaluate(
+        case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
+        recover_stress, p2[0] if p2 else None)
+    attribution = None
+    if pending is not None:
         t = stages.start("attribution")
         attribution, attribution_seconds = pending.result()
         stages.end("attribution", t)
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
     if duty is not None and duty_fe:
         t = stages.start("duty_cycle")
         duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
@@ -896,7 +927,8 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         stages.end("duty_cycle", t)
 
     timings = dict(stages.seconds)
-    timings["attribution_compute"] = attribution_seconds
+    if pending is not None:
+        timings["attribution_compute"] = attribution_seconds
     timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
     timings["cycle_per_angle"] = stages.seconds["cycle"] / n
     return Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
@@ -906,6 +938,15 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
                     attribution=attribution, references=references)
 
 
+def attribution_of(system, thetas, cycle):
+    """The attribution of a case's flexible load cycle (:func:`rvfem.reducer.attribution`): the
+    modelling steps the case's own model does not already give, on the same angles and the same
+    compliance."""
+    from . import reducer
+
+    return reducer.attribution(system, thetas, cycles={reducer.case_step(system.case): cycle})
+
+
 def _timed(function, *args, **kwargs):
     """``(function(*args, **kwargs), wall time in s)``."""
     t0 = time.perf_counter()
@@ -913,7 +954,7 @@ def _timed(function, *args, **kwargs):
 
 
 def _evaluate(case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
-              recover_stress):
+              recover_stress, p2=None):
     """The stress stage (the structural peak re-solved on P2) and the rest of the evaluation:
     hot-spot histories, Hertz, torsional stiffness, duty-cycle lives from the rigid and flexible
     loads. Returns (StressResult, Hertz results, stiffness, DutyCycleResult or None)."""
@@ -922,7 +963,7 @@ def _evaluate(case, stages, system, mesh, cycle, comparison, rigid_analysis, pea
     recovered = None
     if recover_stress and away is not None:
         t = stages.start("stress")
-        recovered = _recover_structural_peak(system, cycle, mesh, band, away)
+        recovered = _recover_structural_peak(system, cycle, mesh, band, away, p2)
         stages.end("stress", t)
         if not any(math.isclose(s.theta_deg, recovered.peak.theta_deg, abs_tol=1e-9) for s in snapshots):
             snapshots = postprocess.field_snapshots(system, cycle, extra_angles=[

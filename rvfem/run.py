@@ -36,6 +36,7 @@ import dataclasses
 import logging
 import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -71,8 +72,9 @@ STAGES: dict[str, str] = {
 """Stages of a run in order, with a one-line description (what the progress callback reports):
 those of :func:`rvfem.analysis.analyse`, then one per writer. With images, the stress images, the
 mesh picture and the plots are drawn by a child process (:class:`rvfem.render.RenderWorker`) from
-the start of the writers on, while this process writes the tables and the VTK files; the ``plots``
-and ``images`` stages are the waits for them."""
+the start of the writers on, while this process writes the tables and the VTK files and computes
+the attribution on a thread (it enters only the summary and the report); the ``plots``,
+``images`` and ``attribution`` stages are then the waits for them, reported after ``images``."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -188,10 +190,12 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
         with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
             try:
                 waited = [0.0]
+                # with a render worker the attribution is computed here while the worker draws
                 result = analyse(case, provenance=provenance, field_step_deg=field_step_deg,
-                                 cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited))
+                                 cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
+                                 attribute=worker is None)
                 stages.seconds["check"] += waited[0]
-                summary, files = _write_outputs(result, tmp, stages, worker, t_run)
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run)
             finally:
                 if worker is not None:
                     worker.close()   # before the folder is moved or removed: nothing writes into it
@@ -220,15 +224,51 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
     return report
 
 
-def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> tuple[dict, tuple[str, ...]]:
-    """Write every file of the result folder ``tmp``; returns the summary and the files.
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float):
+    """Write every file of the result folder ``tmp``; returns the summary, the files and the
+    analysis (with its attribution).
 
     The images and the plots are handed to ``worker`` first (its child process draws them
-    meanwhile); this process writes the tables and the VTK files, then waits for the plots and the
-    images, and writes the report and the summary. Without a worker the plots are drawn here.
+    meanwhile); this process writes the tables and the VTK files and computes the attribution (if
+    the analysis left it, on a thread: it enters only the summary and the report), then waits for
+    the plots and the images, and writes the report and the summary. Without a worker the plots are
+    drawn here.
     """
     written: list[Path] = []
+    pool = attribution = None
+    if result.attribution is None:
+        pool = ThreadPoolExecutor(1, thread_name_prefix="rvfem-attribution")
+        attribution = pool.submit(_analysis._timed, _analysis.attribution_of, result.system, result.theta,
+                                  result.cycle)
+    try:
+        written += _write_files(result, tmp, stages, worker)
+        if attribution is not None:
+            t = stages.start("attribution")
+            value, seconds = attribution.result()
+            stages.end("attribution", t)
+            result = dataclasses.replace(result, attribution=value,
+                                         timings={**result.timings, "attribution_compute": seconds})
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
 
+    t = stages.start("report")
+    timings = {"check": stages.seconds["check"], **result.timings,
+               **{k: v for k, v in stages.seconds.items() if k != "check"}}
+    timings["total"] = time.perf_counter() - t_run
+    files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {"report.html", "summary.json"}))
+    summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
+    outputs.write_report(result, tmp, summary=summary)
+    stages.end("report", t)
+    summary["timings_s"]["report"] = stages.seconds["report"]
+    summary["timings_s"]["total"] = time.perf_counter() - t_run
+    outputs.write_summary(result, tmp, summary=summary)
+    return summary, files, result
+
+
+def _write_files(result, tmp: Path, stages: Stages, worker) -> list[Path]:
+    """The tables, the VTK files, the plots and the images (drawn by ``worker`` if given)."""
+    written: list[Path] = []
     t = stages.start("tables")
     written += outputs.write_tables(result, tmp)
     written += outputs.write_case_json(result, tmp)
@@ -255,16 +295,4 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float) -> t
         written += pending.result(tick=lambda done, total: stages.tick("images", done, total))
         stages.end("images", t, n_images)
         stages.seconds["images"] += submitted
-
-    t = stages.start("report")
-    timings = {"check": stages.seconds["check"], **result.timings,
-               **{k: v for k, v in stages.seconds.items() if k != "check"}}
-    timings["total"] = time.perf_counter() - t_run
-    files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {"report.html", "summary.json"}))
-    summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
-    outputs.write_report(result, tmp, summary=summary)
-    stages.end("report", t)
-    summary["timings_s"]["report"] = stages.seconds["report"]
-    summary["timings_s"]["total"] = time.perf_counter() - t_run
-    outputs.write_summary(result, tmp, summary=summary)
-    return summary, files
+    return written
