@@ -915,6 +915,7 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
     stress, roller_hertz, stiffness, duty = _evaluate(
         case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
         recover_stress, p2[0] if p2 else None)
+    p2.clear()                      # the P2 model (a few hundred MB) is not needed any more
     attribution = None
     if pending is not None:
         t = stages.start("attribution")
