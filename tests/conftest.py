@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -147,3 +148,18 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if item.path.name in END_TO_END_MODULES:
             item.add_marker(pytest.mark.slow)
+
+
+def structured_annulus(r_in=8.0, r_out=30.0, n_r=6, n_t=72):
+    """Triangles of a structured annulus, its vertices and its two boundary loops."""
+    r = np.linspace(r_in, r_out, n_r)
+    t = np.linspace(0.0, 2 * np.pi, n_t, endpoint=False)
+    rr, tt = np.meshgrid(r, t, indexing="ij")
+    points = np.column_stack([(rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel()])
+    idx = np.arange(n_r * n_t).reshape(n_r, n_t)
+    a, b = idx[:-1, :], np.roll(idx[:-1, :], -1, axis=1)
+    c, d = idx[1:, :], np.roll(idx[1:, :], -1, axis=1)
+    triangles = np.vstack([np.column_stack([a.ravel(), b.ravel(), d.ravel()]),
+                           np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
+    loop = lambda k: np.column_stack([idx[k], np.roll(idx[k], -1)])  # noqa: E731
+    return points, triangles, {"central_hole": loop(0), "profile": loop(-1)}

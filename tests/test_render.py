@@ -16,6 +16,7 @@ import math
 import numpy as np
 import pytest
 
+from conftest import structured_annulus
 from rvfem import render
 from rvfem.errors import RenderError
 
@@ -32,19 +33,6 @@ def _read(path):
         return np.asarray(im.convert("RGB")).astype(int)
 
 
-def _annulus(r_in=8.0, r_out=30.0, n_r=6, n_t=72):
-    """Triangles of a structured annulus, its vertices and its two boundary loops."""
-    r = np.linspace(r_in, r_out, n_r)
-    t = np.linspace(0.0, 2 * np.pi, n_t, endpoint=False)
-    rr, tt = np.meshgrid(r, t, indexing="ij")
-    points = np.column_stack([(rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel()])
-    idx = np.arange(n_r * n_t).reshape(n_r, n_t)
-    a, b = idx[:-1, :], np.roll(idx[:-1, :], -1, axis=1)
-    c, d = idx[1:, :], np.roll(idx[1:, :], -1, axis=1)
-    triangles = np.vstack([np.column_stack([a.ravel(), b.ravel(), d.ravel()]),
-                           np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
-    loop = lambda k: np.column_stack([idx[k], np.roll(idx[k], -1)])  # noqa: E731
-    return points, triangles, {"central_hole": loop(0), "profile": loop(-1)}
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +43,7 @@ def scenes():
         render.check_rendering()
     except RenderError as exc:  # pragma: no cover - a machine without off-screen OpenGL
         pytest.skip(str(exc))
-    points, triangles, boundaries = _annulus()
+    points, triangles, boundaries = structured_annulus()
     x, y = points.T
     r = np.hypot(x, y)
     pins = 33.0 * np.column_stack([np.cos(np.linspace(0, 2 * np.pi, 16, endpoint=False)),
@@ -101,7 +89,7 @@ def test_a_series_looks_like_single_images(scenes, tmp_path):
 
 def test_a_new_mesh_replaces_the_old_one(scenes, tmp_path):
     full, _ = scenes[0]
-    points, triangles, boundaries = _annulus(r_in=12.0, r_out=28.0, n_r=4, n_t=40)
+    points, triangles, boundaries = structured_annulus(r_in=12.0, r_out=28.0, n_r=4, n_t=40)
     other = dataclasses.replace(full, points=points, triangles=triangles, boundaries=boundaries,
                                 von_mises=np.linspace(0.0, 100.0, len(points)), deformation=np.zeros_like(points))
     with render.StressRenderer(SIZE) as renderer:

@@ -16,17 +16,11 @@ import pytest
 
 from rvfem import vtkio
 
+from conftest import structured_annulus
+
 
 def _disc(n_r=5, n_t=40, r_in=8.0, r_out=30.0):
-    r = np.linspace(r_in, r_out, n_r)
-    t = np.linspace(0.0, 2 * np.pi, n_t, endpoint=False)
-    rr, tt = np.meshgrid(r, t, indexing="ij")
-    points = np.column_stack([(rr * np.cos(tt)).ravel(), (rr * np.sin(tt)).ravel()])
-    idx = np.arange(n_r * n_t).reshape(n_r, n_t)
-    a, b = idx[:-1, :], np.roll(idx[:-1, :], -1, axis=1)
-    c, d = idx[1:, :], np.roll(idx[1:, :], -1, axis=1)
-    triangles = np.vstack([np.column_stack([a.ravel(), b.ravel(), d.ravel()]),
-                           np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
+    points, triangles, _ = structured_annulus(r_in=r_in, r_out=r_out, n_r=n_r, n_t=n_t)
     return points, triangles
 
 
