@@ -935,8 +935,9 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         # column j of G is valid once the load columns of contact j are known (C is filled
         # column-wise and symmetric, so the rows of every other contact come with it)
         touched = np.unique(np.concatenate([W.indices, WL.indices]))
-        WLsub = WL[touched, :].toarray()
-        subs.append((touched, W[touched, :].toarray(), WLsub, WLsub != 0))
+        WLsub = WL[touched, :]
+        # sparse: each contact touches two to four columns, so Wᵀ·C·W_load costs O(touched²)
+        subs.append((touched, W[touched, :].T.tocsr(), WLsub.tocsc(), WLsub.toarray() != 0))
     moment = RL[:, 2::3].sum(axis=1)                 # Mz of each contact on its own body
     carrier = torque is not None                     # without a carrier: no φ unknown
     torque = 0.0 if torque is None else torque
@@ -951,32 +952,32 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
 
     ensured = np.zeros(nc, dtype=bool)              # contacts whose load columns are known
 
+    def G_full(idx):
+        """G with the columns of contacts ``idx`` valid (the others are not read with weight)."""
+        new = idx[~ensured[idx]]
+        if new.size:
+            for k, (b, (touched, _, _, nonzero)) in enumerate(zip(bodies, subs)):
+                local = new[(new >= offs[k]) & (new < offs[k + 1])] - offs[k]
+                if local.size:
+                    b.compliance.ensure(touched[nonzero[:, local].any(axis=1)])
+            ensured[new] = True
+        versions = tuple(b.compliance.version for b in bodies)
+        if cache["versions"] != versions:
+            G = np.zeros((nc, nc))
+            for k, (b, (touched, WsubT, WLsub, _)) in enumerate(zip(bodies, subs)):
+                G[offs[k]:offs[k + 1], offs[k]:offs[k + 1]] = \
+                    WsubT @ (b.compliance.C[np.ix_(touched, touched)] @ WLsub)
+            cache["G"] = G if coupling is None else G + coupling
+            cache["versions"] = versions
+        return cache["G"]
+
     def G_cols(idx):
         if idx.size == 0:
             return np.zeros((nc, 0))
-        new = idx[~ensured[idx]]
-        for k, (b, (touched, _, _, nonzero)) in enumerate(zip(bodies, subs)):
-            local = new[(new >= offs[k]) & (new < offs[k + 1])] - offs[k]
-            if local.size:
-                b.compliance.ensure(touched[nonzero[:, local].any(axis=1)])
-        ensured[new] = True
-        versions = tuple(b.compliance.version for b in bodies)
-        if cache["versions"] != versions:
-            if nb == 1:
-                touched, Wsub, WLsub, _ = subs[0]
-                G = Wsub.T @ bodies[0].compliance.C[np.ix_(touched, touched)] @ WLsub
-            else:
-                G = np.zeros((nc, nc))
-                for k, (b, (touched, Wsub, WLsub, _)) in enumerate(zip(bodies, subs)):
-                    G[offs[k]:offs[k + 1], offs[k]:offs[k + 1]] = \
-                        Wsub.T @ b.compliance.C[np.ix_(touched, touched)] @ WLsub
-            cache["G"] = G if coupling is None else G + coupling
-            cache["versions"] = versions
-        return cache["G"][:, idx]
+        return G_full(idx)[:, idx]
 
     def state(lam, a, phi):
-        nz = np.flatnonzero(lam != 0)
-        v = G_cols(nz) @ lam[nz] + Rc @ a
+        v = G_full(np.flatnonzero(lam != 0)) @ lam + Rc @ a      # λ = 0 off the valid columns
         delta = offset + lever * phi - v
         q = np.zeros(nc)
         dq = np.zeros(nc)
