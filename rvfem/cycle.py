@@ -490,16 +490,49 @@ def _contact_map(Qk: tuple[np.ndarray, np.ndarray], *pairs: tuple[sp.spmatrix, s
 
     dense_blocks = [(W0, dense(t, W0.shape[1]), dense(w, W0.shape[1])) for W0, t, w in blocks]
     _, T, A = dense_blocks[0]
-    try:
-        M = np.linalg.solve(A.T @ A, A.T @ T)
-    except np.linalg.LinAlgError:
-        raise ValueError("the turned contacts are not the solved ones (a contact without weights)") from None
-    M[np.abs(M) < 1e-12] = 0.0
+    match = _matching(A, T)
+    if match is not None:
+        source, factor = match
+        M = np.zeros((A.shape[1], T.shape[1]))
+        M[source, np.arange(T.shape[1])] = factor
+
+        def apply(A):
+            return A[:, source] * factor
+    else:                     # contacts that share columns (a bore's x and y springs): least squares
+        try:
+            M = np.linalg.solve(A.T @ A, A.T @ T)
+        except np.linalg.LinAlgError:
+            raise ValueError("the turned contacts are not the solved ones (a contact without weights)") from None
+        M[np.abs(M) < 1e-12] = 0.0
+
+        def apply(A):
+            return A @ M
     for W0, T, A in dense_blocks:
         scale = max(float(np.abs(W0.data).max()) if W0.nnz else 0.0, 1e-30)
-        if T.size and np.abs(A @ M - T).max() > 1e-8 * scale:
+        if T.size and np.abs(apply(A) - T).max() > 1e-8 * scale:
             raise ValueError("the turned contacts are not the solved ones")
     return M
+
+
+def _matching(A: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """(source, factor) with T[:, j] = factor[j]·A[:, source[j]] when every column of T is one
+    column of A times a factor (pins and rollers turn into pins and rollers), found by the first
+    row each column touches; None when two columns of A or of T start at the same row (the
+    least-squares map then decides). Not checked here."""
+    if A.shape[1] == 0:
+        return np.zeros(0, dtype=int), np.zeros(0)
+    first_a = np.argmax(A != 0, axis=0)
+    first_t = np.argmax(T != 0, axis=0)
+    if (len(np.unique(first_a)) < A.shape[1] or len(np.unique(first_t)) < T.shape[1]
+            or not (A != 0).any(axis=0).all()):
+        return None
+    order = np.argsort(first_a)
+    pos = np.searchsorted(first_a[order], first_t)
+    if np.any(pos >= len(order)) or np.any(first_a[order][np.minimum(pos, len(order) - 1)] != first_t):
+        return None
+    source = order[pos]                                    # the solved contact of each turned one
+    a = A[:, source]
+    return source, np.einsum("ij,ij->j", a, T) / np.einsum("ij,ij->j", a, a)
 
 
 def symmetry_plan(thetas: np.ndarray, order: int = 1, mirror: bool = False):
