@@ -825,7 +825,6 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     CaseError, GeometryError, MeshError, ContactError
         From the stages.
     """
-    from . import compare, postprocess, reducer
     from . import cycle as cycle_module
     from .geometry import disc_geometry
     from .mesh import mesh_case
@@ -866,7 +865,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
 def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
                         recover_stress, duty_fe, attribute=True):
     """The stages of :func:`analyse` after the model; ``background`` runs the work beside them."""
-    from . import compare, postprocess, reducer
+    from . import compare, postprocess
     from . import cycle as cycle_module
 
     # the rigid model before the cycle: a case outside every rigid reference fails fast
