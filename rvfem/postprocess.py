@@ -405,18 +405,6 @@ def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *
     return tuple(angles[:count])
 
 
-def _fields(system, results) -> list[np.ndarray]:
-    """Displacement fields of solved angles (:func:`rvfem.cycle.displacement`), one
-    back-substitution per distinct solved angle: on a symmetric model an angle obtained by symmetry
-    is its origin's field turned (:func:`rvfem.cycle.displacements`), exactly as
-    :func:`~rvfem.cycle.displacement` gives it."""
-    from .cycle import displacement, displacements
-
-    if getattr(system, "node_rotation", None) is not None:
-        return list(displacements(system, results))
-    return [displacement(system, r) for r in results]
-
-
 def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
                  exclude: dict[str, float] | None = None, p1_peak: PeakStress | None = None,
                  system_p1=None, setup_seconds: float = 0.0) -> RecoveredPeak:
@@ -456,7 +444,7 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     """
     import time
 
-    from .cycle import displacement
+    from .cycle import displacement, displacements
     from .fem.stress import displacement_gradients
 
     t0 = time.perf_counter()
@@ -468,7 +456,7 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     candidates = np.flatnonzero(mask)
     ks = [nearest_index(cycle.theta, float(theta)) for theta in angles]
     best = None
-    for k, u in zip(ks, _fields(system_p2, [cycle.solutions[k] for k in ks])):
+    for k, u in zip(ks, displacements(system_p2, [cycle.solutions[k] for k in ks])):
         g = displacement_gradients(model, u)
         vm = fem.stress_fields(model, u, gradients=g).nodal.von_mises
         v = int(candidates[first_max(vm[candidates])[0]])
