@@ -740,11 +740,15 @@ def default_cache_dir() -> Path:
 
 
 def _p2_system(system, mesh):
-    """The P2 model of the cycle's disc (same mesh, models and geometry), assembled and factorised."""
+    """The P2 model of the cycle's disc (same mesh, models and geometry), assembled and factorised;
+    the heap its temporaries leave behind is given back (:func:`rvfem._arrays.release_freed_memory`)."""
+    from ._arrays import release_freed_memory
     from .cycle import build_system
 
-    return build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
-                        geometry=system.geometry, pin_model=system.pin_model)
+    system_p2 = build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
+                             geometry=system.geometry, pin_model=system.pin_model)
+    release_freed_memory()
+    return system_p2
 
 
 def _recover_structural_peak(system, cycle, mesh, band, away, p2=None):

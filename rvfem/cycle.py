@@ -196,7 +196,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
                         "full disc", symmetry)
             symmetry, node_rotation = 1, None
     times["interface"] = time.perf_counter() - t0
-    compliance = Compliance(factor.solve, iface.B, rigid_modes=rigid,
+    compliance = Compliance(factor.solve, iface.B, factor.batch, None if factor.concurrent else 1, rigid_modes=rigid,
                             vertex_dofs=model.node_dofs[:model.n_vertices].ravel(),
                             rotation=rotation, order=symmetry)
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,

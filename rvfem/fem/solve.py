@@ -11,7 +11,8 @@ not at all); the contact solver carries the rigid motion as explicit unknowns
 derived in docs/theory.md ("The condensed contact problem").
 
 The sparse direct solver is chosen by measurement (``benchmarks/bench_factorization.py``):
-CHOLMOD (scikit-sparse) or PARDISO (pypardiso) when installed, else scipy's SuperLU in symmetric
+CHOLMOD through scikit-sparse when installed, else CHOLMOD through cholespy (a dependency: its
+wheels carry CHOLMOD), else PARDISO (pypardiso) when installed, else scipy's SuperLU in symmetric
 mode.
 
 References
@@ -55,20 +56,26 @@ logger = logging.getLogger(__name__)
 #: (``benchmarks/bench_factorization.py``, numbers in its docstring): on a 15k-vertex annulus
 #: CHOLMOD back-substitutes 1000 columns in 3.8 s (P1) / 24 s (P2), PARDISO in 5.1 s / 29 s,
 #: SuperLU (symmetric mode, MMD on AᵀA+A) in 7.1 s / 65 s; factorisation 0.2–2.6 s for all.
-SOLVER_PREFERENCE: tuple[str, ...] = ("cholmod", "pardiso", "superlu")
+#: cholespy's CHOLMOD (reference BLAS, one thread) on the default fan-hole disc: 0.79 ms a P1
+#: column (38k DOFs) against SuperLU's 2.0 ms, P1 factorisation 0.12 s (SuperLU 0.10 s), P2
+#: (147k DOFs) 0.89 s (0.72 s), and a P2 factor of 89 MB resident against SuperLU's 147 MB.
+SOLVER_PREFERENCE: tuple[str, ...] = ("cholmod", "cholespy", "pardiso", "superlu")
 
 
 def available_solvers() -> tuple[str, ...]:
     """Sparse direct solvers importable here, in :data:`SOLVER_PREFERENCE` order.
 
-    ``"superlu"`` (scipy) is always available; ``"cholmod"`` needs scikit-sparse and
-    ``"pardiso"`` needs pypardiso (Intel MKL). Neither is a dependency of rvfem.
+    ``"superlu"`` (scipy) is always available and ``"cholespy"`` is a dependency of rvfem (it
+    may still be missing where it has no wheels); ``"cholmod"`` needs scikit-sparse and
+    ``"pardiso"`` needs pypardiso (Intel MKL), neither of which is a dependency.
     """
     found = []
     for name in SOLVER_PREFERENCE:
         if name == "superlu":
             found.append(name)
         elif name == "cholmod" and importlib.util.find_spec("sksparse") is not None:
+            found.append(name)
+        elif name == "cholespy" and importlib.util.find_spec("cholespy") is not None:
             found.append(name)
         elif name == "pardiso" and importlib.util.find_spec("pypardiso") is not None:
             found.append(name)
@@ -108,6 +115,25 @@ def _factor_cholmod(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
     return factor
 
 
+def _factor_cholespy(lower: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
+    # CHOLMOD (supernodal, its own choice of ordering) as wrapped by cholespy, which ships wheels
+    # with CHOLMOD, METIS and a reference BLAS. CHOLMOD reads the lower triangle only (stype −1),
+    # which is all it is given (:data:`_LOWER_TRIANGLE`). The solve holds the GIL and wants
+    # C-ordered right-hand sides.
+    from cholespy import CholeskySolverD, MatrixType  # optional
+
+    factor = CholeskySolverD(lower.shape[0], lower.indptr.astype(np.int32), lower.indices.astype(np.int32),
+                             lower.data, MatrixType.CSC)
+
+    def solve(b: np.ndarray) -> np.ndarray:
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        x = np.empty_like(b)
+        factor.solve(b, x)
+        return x
+
+    return solve
+
+
 def _factor_pardiso(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
     import pypardiso  # optional
 
@@ -122,7 +148,17 @@ def _factor_pardiso(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
     return solve
 
 
-_FACTORIZERS = {"superlu": _factor_superlu, "cholmod": _factor_cholmod, "pardiso": _factor_pardiso}
+#: Backends whose solve holds the GIL: their back-substitutions gain nothing from threads.
+_SERIAL_SOLVES = frozenset({"cholespy"})
+#: Backends given the lower triangle of the stiffness only (in CSC form).
+_LOWER_TRIANGLE = frozenset({"cholespy"})
+#: Backends that take C-ordered right-hand sides (the others Fortran-ordered ones).
+_C_ORDER = frozenset({"cholespy"})
+#: Right-hand sides per call, by backend (see :class:`Factorization`); 16 for the others.
+_SOLVE_BATCH = {"cholespy": 8}
+
+_FACTORIZERS = {"superlu": _factor_superlu, "cholmod": _factor_cholmod, "cholespy": _factor_cholespy,
+                "pardiso": _factor_pardiso}
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,6 +176,14 @@ class Factorization:
     n_dofs : int
     factor_seconds : float
         Wall time of the factorisation, s.
+    concurrent : bool
+        Whether back-substitutions on several threads run at once (SuperLU releases the GIL;
+        cholespy holds it, so threads would only take turns).
+    batch : int
+        Right-hand sides per back-substitution call that cost least per column (measured on the
+        default fan-hole disc, 38k DOFs: SuperLU 16; cholespy 8, whose reference-BLAS supernodal
+        solve slows down once the block of right-hand sides leaves the cache, 0.79 ms a column
+        at 8 against 1.08 ms at 16 and 1.52 ms at 128).
     """
 
     solver: str
@@ -147,6 +191,8 @@ class Factorization:
     free_dofs: np.ndarray
     n_dofs: int
     factor_seconds: float
+    concurrent: bool
+    batch: int
     _solve: Callable[[np.ndarray], np.ndarray] = field(repr=False)
 
     def solve(self, rhs: np.ndarray | sp.spmatrix) -> np.ndarray:
@@ -171,7 +217,8 @@ class Factorization:
         u = np.zeros(b.shape)
         if b.ndim == 2 and b.shape[1] == 0:
             return u
-        u[self.free_dofs] = np.asarray(self._solve(np.asarray(b[self.free_dofs], order="F"))).reshape(
+        order = "C" if self.solver in _C_ORDER else "F"     # the backend's own layout: no copies
+        u[self.free_dofs] = np.asarray(self._solve(np.asarray(b[self.free_dofs], order=order))).reshape(
             u[self.free_dofs].shape
         )
         return u
@@ -195,6 +242,30 @@ def default_support(model: FEModel) -> np.ndarray:
     d = p[ib] - p[ia]
     comp_b = 1 if abs(d[0]) >= abs(d[1]) else 0
     return np.array([model.node_dofs[ia, 0], model.node_dofs[ia, 1], model.node_dofs[ib, comp_b]])
+
+
+def _submatrix(stiffness: sp.spmatrix, keep: np.ndarray, lower: bool = False) -> sp.csc_matrix:
+    """``stiffness[keep][:, keep]`` of a symmetric matrix (or its lower triangle) as a CSC matrix
+    with sorted indices, in one pass over the entries (fancy indexing copies the whole matrix
+    twice; for the P2 disc that is 100 MB). The rows of the CSR form are taken as the columns,
+    which gives the transpose: the same matrix, as the stiffness is symmetric
+    (tests/test_fem.py)."""
+    k = sp.csr_matrix(stiffness)
+    k.sort_indices()
+    n = k.shape[0]
+    kept = np.zeros(n, dtype=bool)
+    kept[keep] = True
+    number = np.cumsum(kept, dtype=np.int32) - 1            # new index of a kept DOF
+    row = np.repeat(np.arange(n, dtype=np.int32), np.diff(k.indptr))
+    entry = kept[k.indices] & kept[row]
+    if lower:
+        entry &= k.indices >= row       # CSR column ≥ row: the lower triangle of the CSC view
+    counts = np.bincount(row[entry], minlength=n)[kept]
+    del row
+    indptr = np.concatenate([[0], np.cumsum(counts)])
+    sub = sp.csc_matrix((k.data[entry], number[k.indices[entry]], indptr), shape=(int(kept.sum()),) * 2)
+    sub.has_sorted_indices = True                         # kept rows stay in order
+    return sub
 
 
 def factorize_matrix(
@@ -222,13 +293,13 @@ def factorize_matrix(
         solver = available_solvers()[0]
     elif solver not in _FACTORIZERS:
         raise ValueError(f"unknown solver {solver!r}; choose from {sorted(_FACTORIZERS)} or 'auto'")
-    k = sp.csc_matrix(stiffness)[free][:, free].tocsc()
-    k.sort_indices()
+    k = _submatrix(stiffness, free, lower=solver in _LOWER_TRIANGLE)
     t0 = time.perf_counter()
     solve = _FACTORIZERS[solver](k)
     dt = time.perf_counter() - t0
     logger.info("factorised %d DOFs (nnz %d) with %s in %.3f s", k.shape[0], k.nnz, solver, dt)
-    return Factorization(solver, _readonly(sup), _readonly(free), int(n), dt, solve)
+    return Factorization(solver, _readonly(sup), _readonly(free), int(n), dt, solver not in _SERIAL_SOLVES,
+                         _SOLVE_BATCH.get(solver, 16), solve)
 
 
 def factorize(model: FEModel, support_dofs: np.ndarray | None = None, solver: str = "auto") -> Factorization:

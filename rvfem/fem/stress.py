@@ -118,37 +118,64 @@ def _vertex_weights(model: FEModel) -> tuple[np.ndarray, np.ndarray]:
     return w, denom
 
 
-def nodal_stress_operator(model: FEModel) -> sp.csr_matrix:
+def nodal_stress_operator(model: FEModel, vertices: np.ndarray | None = None) -> sp.csr_matrix:
     """The linear map from displacements to the vertex stresses of :func:`stress_fields`.
 
     ``S @ u`` stacks (σxx, σyy, σxy) at the mesh vertices — area-averaged element values, exactly
     as ``stress_fields(model, u).nodal`` — for many fields at the cost of one sparse product each
     (the load cycle's stress envelope uses it at every crank angle).
 
+    Parameters
+    ----------
+    model : FEModel
+    vertices : array_like of int, optional
+        Only the rows of these (distinct) vertices (default all): the hot-spot histories need a few rows, and
+        the whole operator's assembly holds about 100 MB of temporaries on the default disc. The
+        rows are those of the whole operator exactly (the same entries, summed in the same order).
+
     Returns
     -------
     scipy.sparse.csr_matrix
-        ``(3·n_vertices, n_dofs)``, MPa/mm; rows ``[0, nv)`` σxx, ``[nv, 2nv)`` σyy, ``[2nv, 3nv)`` σxy.
+        ``(3·m, n_dofs)``, MPa/mm, m the number of vertices (``n_vertices`` by default); rows
+        ``[0, m)`` σxx, ``[m, 2m)`` σyy, ``[2m, 3m)`` σxy, the vertices in the order given.
     """
     basis = model._stress_basis                              # scalar: one function per local node
     t = model.mesh.t
     nv = model.n_vertices
+    row_of = np.arange(nv)
+    elements = slice(None)
+    if vertices is not None:
+        vertices = np.asarray(vertices, dtype=np.int64).ravel()
+        if np.unique(vertices).size != vertices.size:
+            raise ValueError("nodal_stress_operator: the vertices must be distinct")
+        row_of = np.full(nv, -1)
+        row_of[vertices] = np.arange(vertices.size)
+        elements = np.flatnonzero((row_of[t] >= 0).any(axis=0))   # the triangles at those vertices
+        nv = vertices.size
     w, denom = _vertex_weights(model)
-    rows, cols, vals = [], [], []
+    w, tt = w[:, elements], t[:, elements]
+    n_el = tt.shape[1]
+    blocks = len(basis.basis) * 2 * 3 * 3
+    rows = np.empty((blocks, n_el), dtype=np.int64)
+    cols = np.empty((blocks, n_el), dtype=np.int64)
+    vals = np.empty((blocks, n_el))
+    b = 0
     for a, (phi_a,) in enumerate(basis.basis):
-        dphi = phi_a.grad[:, :, :3]                          # (2, n_elements, 3 vertices)
+        dphi = phi_a.grad[:, elements, :3]                   # (2, n_elements, 3 vertices)
         for i in range(2):                                   # the vector function (a, component i)
             g = np.zeros((2,) + dphi.shape)
             g[i] = dphi
             comps = _plane_stress(model, g)                  # each (n_elements, 3 vertices)
-            dof = model.node_dofs[basis.element_dofs[a], i]
+            dof = model.node_dofs[basis.element_dofs[a][elements], i]
             for c, sc in enumerate(comps):
                 for k in range(3):
-                    v = t[k]
-                    rows.append(c * nv + v)
-                    cols.append(dof)
-                    vals.append(sc[:, k] * w[k] / denom[v])
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                    v = tt[k]
+                    rows[b] = np.where(row_of[v] >= 0, c * nv + row_of[v], -1)
+                    cols[b] = dof
+                    vals[b] = sc[:, k] * w[k] / denom[v]
+                    b += 1
+    keep = (rows >= 0).ravel() if vertices is not None else slice(None)     # −1: another vertex
+    return sp.csr_matrix((vals.ravel()[keep], (rows.ravel()[keep], cols.ravel()[keep])),
                          shape=(3 * nv, model.n_dofs))
 
 
