@@ -30,7 +30,7 @@ import tomllib
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
 
 import numpy as np
 
@@ -751,22 +751,121 @@ def _p2_system(system, mesh):
     return system_p2
 
 
+class _CycleLoads(NamedTuple):
+    """The part of a load cycle the P2 recovery reads (:func:`rvfem.postprocess.recover_peak`):
+    the crank angles and, for the angles it re-solves, their :class:`rvfem.cycle.AngleLoads`."""
+
+    theta: np.ndarray
+    solutions: dict
+
+
+#: The P2 model of the child process of :class:`_P2Model` (one per child).
+_CHILD_P2: list = []
+
+
+def _p2_child_build(case, mesh, bearing_model, pin_model) -> float:
+    """In the child process of :class:`_P2Model`: build the P2 model; its wall time, s."""
+    from ._arrays import release_freed_memory
+    from .cycle import build_system
+
+    t0 = time.perf_counter()
+    _CHILD_P2[:] = [build_system(case, mesh, order=2, bearing_model=bearing_model, pin_model=pin_model)]
+    release_freed_memory()
+    return time.perf_counter() - t0
+
+
+def _p2_child_recover(cycle_loads, angles, points, boundaries, band, away, setup):
+    """In the child process of :class:`_P2Model`: the recovered peak (without its P1 value)."""
+    from . import postprocess
+
+    return postprocess.recover_peak(_CHILD_P2[0], cycle_loads, angles, points, boundaries, exclude=band,
+                                    p1_peak=away, setup_seconds=setup)
+
+
+def _start_p2_child():
+    """A child process for :class:`_P2Model`, already importing what it needs; None where no
+    child process can be started (the P2 model is then built on a thread)."""
+    from ._child import ChildProcess
+
+    try:
+        child = ChildProcess("P2 model")
+    except OSError as exc:
+        log.info("the P2 model is built on a thread (%s)", exc)
+        return None
+    child.call(_p2_child_imports)
+    return child
+
+
+def _p2_child_imports() -> None:
+    """In the child process of :class:`_P2Model`: import the modules of the P2 model, and yield
+    the processor to the load cycle where the two compete for it (the P2 model has the whole
+    cycle's time to be ready)."""
+    import importlib
+
+    for name in ("rvfem.cycle", "rvfem.postprocess"):
+        importlib.import_module(name)
+    if hasattr(os, "nice"):
+        os.nice(P2_CHILD_NICENESS)
+
+
+#: Niceness added to the P2 model's child process (Unix ``nice``): the load cycle goes first.
+P2_CHILD_NICENESS = 10
+
+
+class _P2Model:
+    """The P2 model of a P1 cycle's disc (same mesh and models), built beside the load cycle.
+
+    It is built in a child process (:class:`rvfem._child.ChildProcess`): its assembly and
+    factorisation would otherwise take turns with the load cycle in this interpreter (CHOLMOD
+    through cholespy holds it), and its few hundred MB stay out of this process. The angles to
+    re-solve go there as :class:`rvfem.cycle.AngleLoads`, the recovered peak comes back. Without a
+    ``child`` (none could be started), the model is built on the ``background`` thread and used here.
+    """
+
+    def __init__(self, system, mesh, background, child=None):
+        self._child = child
+        if child is not None:
+            self._built = child.call(_p2_child_build, system.case, mesh, system.bearing_model, system.pin_model)
+        else:
+            self._built = background.submit(_timed, _p2_system, system, mesh)
+
+    def recover(self, system, cycle, angles, mesh, band, away):
+        """:func:`rvfem.postprocess.recover_peak` on this P2 model, with the P1 value at the peak."""
+        from . import postprocess
+        from .cycle import AngleLoads
+
+        if self._child is None:
+            system_p2, setup = self._built.result()
+            return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
+                                            p1_peak=away, system_p1=system, setup_seconds=setup)
+        setup = self._built.result()
+        ks = {postprocess.nearest_index(cycle.theta, float(a)) for a in angles}
+        loads = _CycleLoads(np.asarray(cycle.theta), {k: AngleLoads.of(cycle.solutions[k]) for k in ks})
+        recovered = self._child.call(_p2_child_recover, loads, angles, mesh.points, mesh.boundaries, band,
+                                     away, setup).result()
+        return dataclasses.replace(recovered, p1_at_peak_MPa=postprocess.p1_stress_at(system, cycle, recovered.peak))
+
+    def close(self) -> None:
+        """End the child process (its P2 model with it)."""
+        if self._child is not None:
+            self._child.close()
+
+
 def _recover_structural_peak(system, cycle, mesh, band, away, p2=None):
     """The structural peak recovered on P2 (:func:`rvfem.postprocess.recover_peak`) at the P1
-    envelope's peak angles. The P2 model of the same mesh is ``p2`` (a future of
-    ``_timed(_p2_system, ...)``, built beside the load cycle) or built here, or is the cycle's own
-    for a P2 case."""
+    envelope's peak angles. The P2 model of the same mesh is ``p2`` (a :class:`_P2Model`, built
+    beside the load cycle) or built here, or is the cycle's own for a P2 case."""
     from . import postprocess
 
     t0 = time.perf_counter()
+    angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
+    if p2 is not None and system.model.order == 1:
+        return p2.recover(system, cycle, angles, mesh, band, away)
     if system.model.order == 2:
         system_p2, system_p1, setup = system, None, 0.0
-    elif p2 is not None:
-        (system_p2, setup), system_p1 = p2.result(), system
     else:
         system_p2, system_p1 = _p2_system(system, mesh), system
         setup = time.perf_counter() - t0
-    angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
     return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
                                     p1_peak=away, system_p1=system_p1, setup_seconds=setup)
 
@@ -786,7 +885,8 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             angle_step_deg: float | None = None, bearing_model: str | None = None, order: int | None = None,
             field_step_deg: float | None = None, cache_dir: str | os.PathLike | None = None,
             progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
-            recover_stress: bool = True, duty_fe: bool = True, attribute: bool = True) -> Analysis:
+            recover_stress: bool = True, duty_fe: bool = True, attribute: bool = True,
+            on_model: Callable[[Any], None] | None = None) -> Analysis:
     """Analyse a case completely, in memory.
 
     Parameters
@@ -819,6 +919,9 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         Compute the attribution (:func:`rvfem.reducer.attribution`, stage ``attribution``). False
         leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`):
         :func:`rvfem.run.run_case` computes it while the output files are drawn.
+    on_model : callable, optional
+        ``on_model(system)`` with the disc's :class:`rvfem.cycle.DiscSystem` once it is built,
+        before the load cycle (:func:`rvfem.run.run_case` has the mesh picture drawn meanwhile).
 
     Returns
     -------
@@ -847,27 +950,32 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         saved = kept_field_angles(case, field_step_deg)
         thetas = cycle_angles(case)
 
-    t = stages.start("mesh")
-    geometry = disc_geometry(case)
-    mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
-    stages.end("mesh", t)
-
-    t = stages.start("model")
-    system = cycle_module.build_system(case, mesh, geometry=geometry)
-    stages.end("model", t)
-    # work beside the stages that leave a core to spare: the P2 model of the stress stage
-    # (factorisation and array work, which release the interpreter) beside the load cycle's
-    # per-angle solves, then the attribution beside the stress stage
+    # the P2 model of the stress stage is built in a child process beside the load cycle
+    # (:class:`_P2Model`); the process starts now, so that its imports are done meanwhile
+    child = _start_p2_child() if recover_stress and case.analysis.element_order == 1 else None
     background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
     try:
+        t = stages.start("mesh")
+        geometry = disc_geometry(case)
+        mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
+        stages.end("mesh", t)
+
+        t = stages.start("model")
+        system = cycle_module.build_system(case, mesh, geometry=geometry)
+        stages.end("model", t)
+        if on_model is not None:
+            on_model(system)
+        # the attribution runs beside the stress stage (background thread)
         return _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
-                                   recover_stress, duty_fe, attribute)
+                                   recover_stress, duty_fe, attribute, child)
     finally:
         background.shutdown(wait=True, cancel_futures=True)
+        if child is not None:
+            child.close()
 
 
 def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
-                        recover_stress, duty_fe, attribute=True):
+                        recover_stress, duty_fe, attribute=True, child=None):
     """The stages of :func:`analyse` after the model; ``background`` runs the work beside them."""
     from . import compare, postprocess
     from . import cycle as cycle_module
@@ -886,39 +994,39 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
     n = len(thetas)
     t = stages.start("cycle", n)
 
-    p2 = []
+    # the P2 model of the stress stage, built in a child process during the load cycle
+    p2 = [_P2Model(system, mesh, background, child)] if recover_stress and system.model.order == 1 else []
 
-    def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
-        # the first angle is solved once the compliance columns are (both cores): from here on
-        # the cycle is small dense solves on one core, and the P2 model is built on the other
-        if recover_stress and system.model.order == 1 and not p2:
-            p2.append(background.submit(_timed, _p2_system, system, mesh))
-        if i < total:
-            stages.tick("cycle", i, total)
+    try:
+        def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
+            if i < total:
+                stages.tick("cycle", i, total)
 
-    cycle = cycle_module.load_cycle(system, thetas, progress=report, saved_angles_deg=saved, stress_envelope=True)
-    stages.end("cycle", t, n)
+        cycle = cycle_module.load_cycle(system, thetas, progress=report, saved_angles_deg=saved, stress_envelope=True)
+        stages.end("cycle", t, n)
 
-    t = stages.start("evaluation")
-    comparison = compare.rigid_vs_flexible(case, cycle)
-    # peaks over every solved angle (the cycle's stress envelope); their fields are kept too
-    peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
-    band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
-    band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
-    away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
-    snapshots = postprocess.field_snapshots(
-        system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
-    stages.end("evaluation", t)
+        t = stages.start("evaluation")
+        comparison = compare.rigid_vs_flexible(case, cycle)
+        # peaks over every solved angle (the cycle's stress envelope); their fields are kept too
+        peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
+        band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
+        band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
+        away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
+        snapshots = postprocess.field_snapshots(
+            system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
+        stages.end("evaluation", t)
 
-    # what the flexibility effect is made of: the modelling steps the case's own model does not
-    # already give, on the same angles and the same compliance. Mostly small dense solves, it runs
-    # beside the stress stage (P2 back-substitutions and array work, which release the
-    # interpreter); the two share read-only data and the P1 compliance, whose cache is locked
-    pending = background.submit(_timed, attribution_of, system, thetas, cycle) if attribute else None
-    stress, roller_hertz, stiffness, duty = _evaluate(
-        case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
-        recover_stress, p2[0] if p2 else None)
-    p2.clear()                      # the P2 model (a few hundred MB) is not needed any more
+        # what the flexibility effect is made of: the modelling steps the case's own model does not
+        # already give, on the same angles and the same compliance. Mostly small dense solves, it runs
+        # beside the stress stage (whose P2 re-solve is made in the P2 model's child process); the
+        # two share read-only data and the P1 compliance, whose cache is locked
+        pending = background.submit(_timed, attribution_of, system, thetas, cycle) if attribute else None
+        stress, roller_hertz, stiffness, duty = _evaluate(
+            case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
+            recover_stress, p2[0] if p2 else None)
+    finally:
+        for model in p2:            # the P2 model (a few hundred MB) is not needed any more
+            model.close()
     attribution = None
     if pending is not None:
         t = stages.start("attribution")

@@ -350,6 +350,18 @@ class AngleResult:
         return np.linalg.norm(self.bearing_forces, axis=1)
 
     @property
+    def column_loads(self) -> np.ndarray:
+        """The contact loads on the interface columns, ``W_load·λ`` (friction included), N: with
+        the rigid motion, all a displacement field needs (:func:`displacements`)."""
+        W = self.contacts.W if self.contacts.W_load is None else self.contacts.W_load
+        return W @ self.solution.force
+
+    @property
+    def rigid_motion(self) -> np.ndarray:
+        """The disc's rigid motion (x, y in mm, rotation in rad) of the solve."""
+        return self.solution.rigid
+
+    @property
     def pins_in_contact(self) -> int:
         return int(np.count_nonzero(self.pin_forces > 1e-9 * max(self.pin_forces.max(), 1.0)))
 
@@ -642,14 +654,40 @@ def displacement(system: DiscSystem, result: AngleResult) -> np.ndarray:
 def _solved_fields(system: DiscSystem, results: list[AngleResult]) -> np.ndarray:
     """Displacement fields (n_dofs, m) of solved angles, mm: the contact loads (friction
     included) back-substituted together, plus each angle's rigid motion."""
-    loads, rigid = [], []
-    for r in results:
-        cset = r.contacts
-        W = cset.W if cset.W_load is None else cset.W_load      # the loads (friction included)
-        loads.append(W @ r.solution.force)
-        rigid.append(r.solution.rigid)
-    f = system.interface.B @ np.stack(loads, axis=1)
-    return system.compliance.fields(np.asarray(f)) + system.rigid_modes @ np.stack(rigid, axis=1)
+    f = system.interface.B @ np.stack([r.column_loads for r in results], axis=1)
+    rigid = np.stack([r.rigid_motion for r in results], axis=1)
+    return system.compliance.fields(np.asarray(f)) + system.rigid_modes @ rigid
+
+
+@dataclass(frozen=True, eq=False)
+class AngleLoads:
+    """What the displacement field of an angle is made of (:func:`displacements` takes it as it
+    takes an :class:`AngleResult`): small, and free of the contact laws, so that it can be sent to
+    another process (the P2 stress recovery of :func:`rvfem.analysis.analyse`).
+
+    Attributes
+    ----------
+    theta : float
+        Crank angle, rad.
+    column_loads : ndarray (n_columns,)
+        ``W_load·λ``, N.
+    rigid_motion : ndarray (3,)
+    origin : (AngleLoads, int) or None
+        As for :class:`AngleResult`.
+    """
+
+    theta: float
+    column_loads: np.ndarray
+    rigid_motion: np.ndarray
+    origin: tuple | None = None
+
+    @classmethod
+    def of(cls, result: AngleResult) -> AngleLoads:
+        origin = None
+        if result.origin is not None:
+            root, k = result.origin
+            origin = (cls.of(root), k)
+        return cls(float(result.theta), np.asarray(result.column_loads), np.asarray(result.rigid_motion), origin)
 
 
 @dataclass(frozen=True)

@@ -47,8 +47,10 @@ import hashlib
 import json
 import logging
 import math
+import signal
 import os
 import tempfile
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -181,6 +183,29 @@ class DiscMesh:
 # ------------------------------------------------------------------------------------------------
 
 
+def _ignore_sigpipe_again() -> None:
+    """Undo what ``gmsh.initialize`` does to SIGPIPE when Python ignores it (its default).
+
+    Gmsh sets the signal back to its default action, which ends the process: a write to a pipe
+    whose reader is gone (a child process that has ended) would then kill the run instead of
+    raising ``BrokenPipeError``. Python's choice is put back for the whole process (from the main
+    thread by ``signal``, from another thread by the C library's ``signal``).
+    """
+    if not hasattr(signal, "SIGPIPE") or signal.getsignal(signal.SIGPIPE) is not signal.SIG_IGN:
+        return
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+        return
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        libc.signal(int(signal.SIGPIPE), ctypes.c_void_p(1))          # SIG_IGN
+    except (OSError, AttributeError):  # pragma: no cover - no C library to ask
+        log.debug("SIGPIPE left as Gmsh set it")
+
+
 @contextlib.contextmanager
 def gmsh_session(model: str = "disc"):
     """The only place where Gmsh is initialised: yields the ``gmsh`` module with a fresh model.
@@ -192,6 +217,7 @@ def gmsh_session(model: str = "disc"):
     if gmsh.isInitialized():
         raise MeshError("a Gmsh session is already open; Gmsh sessions cannot nest")
     gmsh.initialize(readConfigFiles=False, interruptible=False)
+    _ignore_sigpipe_again()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.logger.start()

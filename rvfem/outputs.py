@@ -70,6 +70,8 @@ __all__ = [
     "write_vtk",
     "write_images",
     "submit_images",
+    "start_mesh_picture",
+    "mesh_picture",
     "PendingImages",
     "write_plots",
     "plot_calls",
@@ -783,21 +785,48 @@ def _image_set(analysis, images: Path) -> _ImageSet:
                   f"{pk.feature_label}")
         stress.append((images / f"{key}.png", close, dict(focus=(pk.x_mm, pk.y_mm), half_height=half,
                                                           marker=(pk.x_mm, pk.y_mm), show_edges=True)))
-    b0 = bores[0] * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bores[0]))
-    mesh_picture = dict(path=images / "mesh.png", points=vertices, triangles=triangles, boundaries=mesh.boundaries,
-                        closeup_centre=(float(b0[0]), float(b0[1])),
-                        title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
-                              f"(min quality {mesh.min_quality:.2f})",
-                        closeup_title="close-up: the rim under the bore of bearing 1")
-    return _ImageSet(stress=stress, mesh=mesh_picture)
+    return _ImageSet(stress=stress, mesh=mesh_picture(a.system, images))
+
+
+def mesh_picture(system, images: str | os.PathLike) -> dict:
+    """The keyword arguments of :func:`rvfem.plots.mesh_plot` for ``images/mesh.png`` of a run:
+    the whole mesh and a close-up of the rim under the bore of bearing 1. It needs the model only,
+    so a run can have it drawn while the load cycle is solved (:func:`start_mesh_picture`)."""
+    from .geometry import crank_centres
+
+    case, mesh = system.case, system.mesh
+    bore = crank_centres(case)[0]
+    b0 = bore * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bore))
+    return dict(path=Path(images) / "mesh.png", points=system.model.mesh.p.T, triangles=system.model.mesh.t.T,
+                boundaries=mesh.boundaries, closeup_centre=(float(b0[0]), float(b0[1])),
+                title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
+                      f"(min quality {mesh.min_quality:.2f})",
+                closeup_title="close-up: the rim under the bore of bearing 1")
+
+
+def start_mesh_picture(system, folder: str | os.PathLike, worker) -> int:
+    """Have a render worker's child process draw ``images/mesh.png`` at once (its second thread),
+    while this process goes on; give the returned number to :func:`submit_images`.
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    from .plots import mesh_plot
+
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    (number,) = worker.start_calls([(mesh_plot, mesh_picture(system, images))])
+    return number
 
 
 class PendingImages:
     """The images of :func:`submit_images`, being drawn by a :class:`rvfem.render.RenderWorker`;
     :meth:`result` waits for them, :meth:`calls_result` for the other calls."""
 
-    def __init__(self, image_set: _ImageSet, worker, n_calls: int):
-        self._set, self._worker, self._n_calls = image_set, worker, n_calls
+    def __init__(self, image_set: _ImageSet, worker, calls: list[int], mesh_call: int):
+        self._set, self._worker, self._calls, self._mesh_call = image_set, worker, calls, mesh_call
 
     def calls_result(self) -> list:
         """Wait for the calls given to :func:`submit_images` (the child makes them before the mesh
@@ -808,7 +837,7 @@ class PendingImages:
         RenderError, Exception
             From the render worker, or what a call raised.
         """
-        return self._worker.wait_calls(self._n_calls)
+        return self._worker.wait_calls(self._calls)
 
     def result(self, *, tick: TickCallback | None = None) -> list[Path]:
         """Wait for the images.
@@ -835,11 +864,12 @@ class PendingImages:
                 tick(done, total)
 
         done = self._worker.wait(tick=one_more)
-        return [Path(p) for p in done[:len(self._set.stress)]] + [Path(done[-1])]
+        n = len(self._set.stress)
+        return [Path(p) for p in done[:n]] + [Path(done[n + self._mesh_call])]
 
 
 def submit_images(analysis, folder: str | os.PathLike, worker, *,
-                  calls: Iterable[tuple[Callable, dict]] = ()) -> PendingImages:
+                  calls: Iterable[tuple[Callable, dict]] = (), mesh_call: int | None = None) -> PendingImages:
     """Start the images of :func:`write_images` in a render worker's child process, which draws
     them while this process does other work (the mesh picture in a second thread of the child);
     :meth:`PendingImages.result` waits for them.
@@ -853,6 +883,8 @@ def submit_images(analysis, folder: str | os.PathLike, worker, *,
     calls : iterable of (function, dict)
         Other drawings for the child's second thread, made before the mesh picture (e.g.
         :func:`plot_calls`); :meth:`PendingImages.calls_result` waits for them.
+    mesh_call : int, optional
+        The number :func:`start_mesh_picture` returned, if the mesh picture was started already.
 
     Returns
     -------
@@ -869,8 +901,10 @@ def submit_images(analysis, folder: str | os.PathLike, worker, *,
 
     image_set = _image_set(analysis, images)
     calls = list(calls)
-    worker.submit(image_set.stress, calls=calls + [(mesh_plot, image_set.mesh)])
-    return PendingImages(image_set, worker, len(calls))
+    if mesh_call is not None:
+        return PendingImages(image_set, worker, worker.submit(image_set.stress, calls=calls), mesh_call)
+    numbers = worker.submit(image_set.stress, calls=calls + [(mesh_plot, image_set.mesh)])
+    return PendingImages(image_set, worker, numbers[:-1], numbers[-1])
 
 
 def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None,

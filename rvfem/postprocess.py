@@ -405,6 +405,16 @@ def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *
     return tuple(angles[:count])
 
 
+def p1_stress_at(system_p1, cycle, peak: PeakStress) -> float:
+    """The P1 vertex von Mises stress of the cycle at a peak's vertex and crank angle, MPa (what
+    :attr:`RecoveredPeak.p1_at_peak_MPa` compares the P2 value with)."""
+    from .cycle import displacement
+
+    k = nearest_index(cycle.theta, math.radians(peak.theta_deg))
+    u1 = displacement(system_p1, cycle.solutions[k])
+    return float(fem.stress_fields(system_p1.model, u1).nodal.von_mises[vertex_of(system_p1.mesh.points, peak)])
+
+
 def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
                  exclude: dict[str, float] | None = None, p1_peak: PeakStress | None = None,
                  system_p1=None, setup_seconds: float = 0.0) -> RecoveredPeak:
@@ -444,17 +454,17 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     """
     import time
 
-    from .cycle import displacement, displacements
+    from .cycle import displacements
     from .fem.stress import displacement_gradients
 
     t0 = time.perf_counter()
     model = system_p2.model
-    if system_p2.interface.B.shape[1] != cycle.solutions[0].contacts.W.shape[0]:
+    ks = [nearest_index(cycle.theta, float(theta)) for theta in angles]
+    if any(system_p2.interface.B.shape[1] != cycle.solutions[k].column_loads.shape[0] for k in ks):
         raise ValueError("the P2 model's interface does not match the P1 cycle's")
     points = np.asarray(points, dtype=float)
     mask = _mask(points, boundaries, exclude)
     candidates = np.flatnonzero(mask)
-    ks = [nearest_index(cycle.theta, float(theta)) for theta in angles]
     best = None
     for k, u in zip(ks, displacements(system_p2, [cycle.solutions[k] for k in ks])):
         g = displacement_gradients(model, u)
@@ -478,10 +488,7 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     envelope[vertex] = value
     peak = peak_von_mises(StressEnvelope(envelope, np.full(len(points), float(cycle.theta[k]))), points,
                           boundaries)
-    p1_here = math.nan
-    if system_p1 is not None:
-        u1 = displacement(system_p1, cycle.solutions[k])
-        p1_here = float(fem.stress_fields(system_p1.model, u1).nodal.von_mises[vertex])
+    p1_here = p1_stress_at(system_p1, cycle, peak) if system_p1 is not None else math.nan
     return RecoveredPeak(
         peak=peak,
         p1_MPa=float(p1_peak.von_mises_MPa) if p1_peak is not None else math.nan,

@@ -25,7 +25,6 @@ import os
 import pickle
 import queue
 import re
-import struct
 import subprocess
 import sys
 import tempfile
@@ -38,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._child import HEADER, picklable, receive, send
 from .errors import RenderError
 
 log = logging.getLogger(__name__)
@@ -837,8 +837,6 @@ from rvfem.render import _serve
 _serve({window_size!r}, {compress_level!r}, {anti_aliasing!r})
 """
 
-_HEADER = struct.Struct("<Q")
-
 ImageJob = tuple[str | os.PathLike, StressScene, dict]
 """One stress image for :meth:`RenderWorker.draw`: (PNG path, scene, keyword arguments of
 :meth:`StressRenderer.write`)."""
@@ -846,37 +844,6 @@ ImageJob = tuple[str | os.PathLike, StressScene, dict]
 Call = tuple[Callable, dict]
 """Another drawing for :meth:`RenderWorker.submit`: (function, keyword arguments). The function
 must be importable by name (a module-level function, e.g. :func:`rvfem.plots.mesh_plot`)."""
-
-
-def _send(stream, message, lock: threading.Lock | None = None) -> None:
-    data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-    if lock is None:
-        stream.write(_HEADER.pack(len(data)) + data)
-        stream.flush()
-        return
-    with lock:
-        stream.write(_HEADER.pack(len(data)) + data)
-        stream.flush()
-
-
-def _receive(stream):
-    """The next message of a stream of :func:`_send`, or None at its end."""
-    header = stream.read(_HEADER.size)
-    if len(header) < _HEADER.size:
-        return None
-    (n,) = _HEADER.unpack(header)
-    data = stream.read(n)
-    if len(data) < n:
-        return None
-    return pickle.loads(data)
-
-
-def _picklable(exc: BaseException) -> BaseException:
-    try:
-        pickle.loads(pickle.dumps(exc))
-        return exc
-    except Exception:
-        return RenderError(f"{type(exc).__name__}: {exc}")
 
 
 class _ForwardLog(logging.Handler):
@@ -888,7 +855,7 @@ class _ForwardLog(logging.Handler):
 
     def emit(self, record: logging.LogRecord) -> None:
         try:
-            _send(self._stream, ("log", record.levelno, record.name, record.getMessage()), self._lock)
+            send(self._stream, ("log", record.levelno, record.name, record.getMessage()), self._lock)
         except Exception:  # pragma: no cover - the parent is gone
             pass
 
@@ -909,21 +876,30 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-worker-calls")
     try:
         renderer = StressRenderer(window_size, compress_level=compress_level, anti_aliasing=anti_aliasing)
+        futures = []
+
+        def start(calls):            # numbered in the order they arrive, as the parent counts them
+            for function, kwargs in calls:
+                future, j = pool.submit(function, **kwargs), len(futures)
+                futures.append(future)
+                future.add_done_callback(
+                    lambda f, j=j: f.exception() is None and send(out, ("called", j, f.result()), lock))
+
         renderer.warm_up()
-        message = _receive(sys.stdin.buffer)
+        message = receive(sys.stdin.buffer)
+        while message is not None and message[0] == "call":     # drawings that need no images
+            start(message[1])
+            message = receive(sys.stdin.buffer)
         if message is None or message[0] != "draw":
             return
         _, jobs, calls = message
-        futures = [pool.submit(function, **kwargs) for function, kwargs in calls]
-        for j, future in enumerate(futures):
-            future.add_done_callback(
-                lambda f, j=j: f.exception() is None and _send(out, ("called", j, f.result()), lock))
+        start(calls)
         for i, (path, scene, options) in enumerate(jobs):
             renderer.write(path, scene, **options)
-            _send(out, ("drawn", i), lock)
+            send(out, ("drawn", i), lock)
         renderer.close()
         results = [future.result() for future in futures]
-        _send(out, ("done", renderer.frames, renderer.anti_aliasing, results), lock)
+        send(out, ("done", renderer.frames, renderer.anti_aliasing, results), lock)
         out.close()
         os._exit(0)   # every file is complete: skip tearing VTK down, the parent need not wait for it
     except BaseException as exc:  # noqa: BLE001 - every failure goes to the parent
@@ -931,7 +907,7 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
         if renderer is not None:
             renderer.close(raise_errors=False)
         try:
-            _send(out, ("error", _picklable(exc)), lock)
+            send(out, ("error", picklable(exc)), lock)
         except OSError:  # pragma: no cover - the parent is gone
             pass
 
@@ -1027,7 +1003,7 @@ class RenderWorker:
                 if line.startswith(b"RVFEM-RENDER "):
                     self._messages.put(("probe", line.decode("ascii", "replace").split()))
                     break
-            while (message := _receive(stream)) is not None:
+            while (message := receive(stream)) is not None:
                 self._messages.put(message)
         except Exception as exc:  # pragma: no cover - a broken pipe
             log.debug("reading the render process failed: %s", exc)
@@ -1119,7 +1095,53 @@ class RenderWorker:
         self.submit(jobs, calls=calls)
         return self.wait(tick=tick)
 
-    def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> None:
+    def start_calls(self, calls: Sequence[Call]) -> list[int]:
+        """Hand over drawings that need no stress images, which the child process starts at once
+        in its second thread (e.g. the mesh picture while the caller still computes); what they
+        return comes with :meth:`wait_calls` and :meth:`wait` like the calls of :meth:`submit`.
+        Only before :meth:`submit`.
+
+        Parameters
+        ----------
+        calls : sequence of (function, dict)
+            As for :meth:`submit`.
+
+        Returns
+        -------
+        list of int
+            The numbers of the calls (for :meth:`wait_calls`).
+
+        Raises
+        ------
+        RenderError
+            Off-screen rendering is not available, or the images were submitted already.
+        """
+        self.check()
+        if self._jobs is not None:
+            raise RenderError("calls are started before the images are submitted")
+        return self._send_calls(("call", self._picklable_calls(calls)))
+
+    def _picklable_calls(self, calls: Sequence[Call]) -> list:
+        return [(function, dict(kwargs)) for function, kwargs in calls]
+
+    def _send_calls(self, message) -> list[int]:
+        """Write ``message`` (whose last item is its calls) to the child; the calls' numbers."""
+        try:
+            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        except (pickle.PicklingError, AttributeError, TypeError) as exc:
+            raise TypeError(f"the images and calls cannot be handed to the render process "
+                            f"(functions must be importable by name): {exc}") from exc
+        first = self._n_calls
+        self._n_calls += len(message[-1])
+        self._used = True
+        try:
+            self._proc.stdin.write(HEADER.pack(len(data)) + data)
+            self._proc.stdin.flush()
+        except OSError:
+            pass   # the child is gone: wait() reports how it ended
+        return list(range(first, self._n_calls))
+
+    def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> list[int]:
         """Hand a series of stress images over to the child process, which starts drawing them
         (once per worker); :meth:`wait` waits for them.
 
@@ -1133,6 +1155,12 @@ class RenderWorker:
             Each function must be importable by name; its arguments and its return value are
             pickled.
 
+        Returns
+        -------
+        list of int
+            The numbers of the calls (for :meth:`wait_calls`; they follow those of
+            :meth:`start_calls`).
+
         Raises
         ------
         RenderError
@@ -1142,18 +1170,9 @@ class RenderWorker:
         if self._jobs is not None:
             raise RenderError("a render worker draws one series of images")
         jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
-        calls = [(function, dict(kwargs)) for function, kwargs in calls]
-        try:
-            data = pickle.dumps(("draw", jobs, calls), protocol=pickle.HIGHEST_PROTOCOL)
-        except (pickle.PicklingError, AttributeError, TypeError) as exc:
-            raise TypeError(f"the images and calls cannot be handed to the render process "
-                            f"(functions must be importable by name): {exc}") from exc
-        self._jobs, self._n_calls, self._used = jobs, len(calls), True
-        try:
-            self._proc.stdin.write(_HEADER.pack(len(data)) + data)
-            self._proc.stdin.flush()
-        except OSError:
-            pass   # the child is gone: wait() reports how it ended
+        numbers = self._send_calls(("draw", jobs, self._picklable_calls(calls)))
+        self._jobs = jobs
+        return numbers
 
     def wait(self, *, tick: Callable[[int], None] | None = None) -> list:
         """Wait for the images and the calls of :meth:`submit`.
@@ -1166,7 +1185,8 @@ class RenderWorker:
         Returns
         -------
         list
-            The PNG files, all complete, then what the calls returned.
+            The PNG files, all complete, then what the calls returned, in the order of their
+            numbers (those of :meth:`start_calls` first).
 
         Raises
         ------
@@ -1183,9 +1203,10 @@ class RenderWorker:
                 tick(self._drawn)
         return [path for path, _, _ in self._jobs] + [self._results[j] for j in range(self._n_calls)]
 
-    def wait_calls(self, count: int | None = None) -> list:
-        """Wait for the first ``count`` calls of :meth:`submit` (all by default), which the child
-        makes one after the other, and return what they returned.
+    def wait_calls(self, numbers: Sequence[int] | None = None) -> list:
+        """Wait for the calls of these numbers (those :meth:`start_calls` and :meth:`submit`
+        returned; all by default), which the child makes one after the other, and return what
+        they returned.
 
         Raises
         ------
@@ -1195,10 +1216,10 @@ class RenderWorker:
             What a call raised.
         """
         self._submitted()
-        count = self._n_calls if count is None else min(int(count), self._n_calls)
-        while any(j not in self._results for j in range(count)):
+        numbers = range(self._n_calls) if numbers is None else [int(j) for j in numbers]
+        while any(j not in self._results for j in numbers):
             self._next()
-        return [self._results[j] for j in range(count)]
+        return [self._results[j] for j in numbers]
 
     def _submitted(self) -> None:
         if self._jobs is None:

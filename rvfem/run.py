@@ -36,10 +36,9 @@ import dataclasses
 import logging
 import os
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from . import analysis as _analysis
 from . import outputs
@@ -70,11 +69,12 @@ STAGES: dict[str, str] = {
     "report": "writing the report",
 }
 """Stages of a run in order, with a one-line description (what the progress callback reports):
-those of :func:`rvfem.analysis.analyse`, then one per writer. With images, the stress images, the
-mesh picture and the plots are drawn by a child process (:class:`rvfem.render.RenderWorker`) from
-the start of the writers on, while this process writes the tables and the VTK files and computes
-the attribution on a thread (it enters only the summary and the report); the ``plots``,
-``images`` and ``attribution`` stages are then the waits for them, reported after ``images``."""
+those of :func:`rvfem.analysis.analyse`, then one per writer. With images, the stress images and
+the plots are drawn by a child process (:class:`rvfem.render.RenderWorker`) from the start of the
+writers on (the mesh picture from the end of the ``model`` stage on, during the load cycle), while
+this process writes the tables and the VTK files and then computes the attribution (it enters only
+the summary and the report; stage ``attribution``, reported after ``vtk``); the ``plots`` and
+``images`` stages are then the waits for the child process."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,13 +189,22 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
     try:
         with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
             try:
-                waited = [0.0]
+                waited, mesh_call = [0.0], []
+
+                def draw_mesh(system):   # the worker draws the mesh picture during the load cycle
+                    t = time.perf_counter()
+                    try:
+                        mesh_call.append(outputs.start_mesh_picture(system, tmp, worker))
+                    finally:
+                        waited[0] += time.perf_counter() - t   # the rendering check, if not done
+
                 # with a render worker the attribution is computed here while the worker draws
                 result = analyse(case, provenance=provenance, field_step_deg=field_step_deg,
                                  cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
-                                 attribute=worker is None)
+                                 attribute=worker is None, on_model=draw_mesh if worker is not None else None)
                 stages.seconds["check"] += waited[0]
-                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run)
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run,
+                                                        mesh_call[0] if mesh_call else None)
             finally:
                 if worker is not None:
                     worker.close()   # before the folder is moved or removed: nothing writes into it
@@ -224,33 +233,30 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
     return report
 
 
-def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float):
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None):
     """Write every file of the result folder ``tmp``; returns the summary, the files and the
     analysis (with its attribution).
 
     The images and the plots are handed to ``worker`` first (its child process draws them
-    meanwhile); this process writes the tables and the VTK files and computes the attribution (if
-    the analysis left it, on a thread: it enters only the summary and the report), then waits for
-    the plots and the images, and writes the report and the summary. Without a worker the plots are
-    drawn here.
+    meanwhile); this process writes the tables and the VTK files, then computes the attribution
+    (if the analysis left it: it enters only the summary and the report; after the VTK files,
+    which a thread of pure Python beside them would slow down), then waits for the plots and the
+    images, and writes the report and the summary. Without a worker the plots are drawn here.
     """
     written: list[Path] = []
-    pool = attribution = None
-    if result.attribution is None:
-        pool = ThreadPoolExecutor(1, thread_name_prefix="rvfem-attribution")
-        attribution = pool.submit(_analysis._timed, _analysis.attribution_of, result.system, result.theta,
-                                  result.cycle)
-    try:
-        written += _write_files(result, tmp, stages, worker)
-        if attribution is not None:
-            t = stages.start("attribution")
-            value, seconds = attribution.result()
-            stages.end("attribution", t)
-            result = dataclasses.replace(result, attribution=value,
-                                         timings={**result.timings, "attribution_compute": seconds})
-    finally:
-        if pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
+    computed = []
+
+    def attribute() -> None:
+        t = stages.start("attribution")
+        computed.append(_analysis._timed(_analysis.attribution_of, result.system, result.theta, result.cycle))
+        stages.end("attribution", t)
+
+    written += _write_files(result, tmp, stages, worker, mesh_call,
+                            meanwhile=attribute if result.attribution is None else None)
+    if computed:
+        (value, seconds), = computed
+        result = dataclasses.replace(result, attribution=value,
+                                     timings={**result.timings, "attribution_compute": seconds})
 
     t = stages.start("report")
     timings = {"check": stages.seconds["check"], **result.timings,
@@ -266,8 +272,11 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float):
     return summary, files, result
 
 
-def _write_files(result, tmp: Path, stages: Stages, worker) -> list[Path]:
-    """The tables, the VTK files, the plots and the images (drawn by ``worker`` if given)."""
+def _write_files(result, tmp: Path, stages: Stages, worker, mesh_call: int | None = None,
+                 meanwhile: Callable[[], None] | None = None) -> list[Path]:
+    """The tables, the VTK files, the plots and the images (drawn by ``worker`` if given; the mesh
+    picture is its call ``mesh_call`` if it was started already); ``meanwhile()`` is called after
+    the VTK files, before the plots are waited for."""
     written: list[Path] = []
     t = stages.start("tables")
     written += outputs.write_tables(result, tmp)
@@ -277,13 +286,16 @@ def _write_files(result, tmp: Path, stages: Stages, worker) -> list[Path]:
     t_submit = time.perf_counter()
     pending = None
     if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
-        pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp))
+        pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
+                                        mesh_call=mesh_call)
     submitted = time.perf_counter() - t_submit
 
     n_fields = len(result.stress.snapshots)
     t = stages.start("vtk", n_fields)
     written += outputs.write_vtk(result, tmp, tick=lambda done, total: stages.tick("vtk", done, total))
     stages.end("vtk", t, n_fields)
+    if meanwhile is not None:
+        meanwhile()
 
     t = stages.start("plots")
     written += pending.calls_result() if pending is not None else outputs.write_plots(result, tmp)

@@ -241,6 +241,34 @@ def test_gmsh_session_finalizes_on_error_and_is_silent(capfd, tmp_path):
     assert out == "" and err == ""
 
 
+@pytest.mark.skipif(not Path("/proc/self/status").is_file(), reason="reads the signal masks from /proc")
+def test_gmsh_session_leaves_sigpipe_ignored():
+    """Gmsh's initialisation sets SIGPIPE back to ending the process; the session puts Python's
+    choice (ignored: a write to a closed pipe raises BrokenPipeError) back, also from a thread."""
+    import signal
+    import threading
+
+    def ignored() -> bool:
+        line = next(t for t in Path("/proc/self/status").read_text().splitlines() if t.startswith("SigIgn:"))
+        return bool(int(line.split()[1], 16) & (1 << (signal.SIGPIPE - 1)))
+
+    assert ignored()
+    with gmsh_session():
+        assert ignored()
+    assert ignored()
+    seen = []
+
+    def in_a_thread():
+        with gmsh_session():
+            pass
+        seen.append(ignored())
+
+    thread = threading.Thread(target=in_a_thread)
+    thread.start()
+    thread.join()
+    assert seen == [True]
+
+
 @pytest.mark.slow
 def test_default_fanholes_case_size_and_quality(tmp_path):
     """The project's default case at its own sizes: 10-20k nodes (the load cycle budget), good

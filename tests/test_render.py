@@ -209,6 +209,18 @@ def test_a_render_worker_makes_other_calls_meanwhile(scenes, tmp_path):
                       calls=[(shutil.copyfile, dict(src=tmp_path / "missing.txt", dst=tmp_path / "c.txt"))])
         with pytest.raises(FileNotFoundError):
             worker.wait_calls()
+    # calls started before the images (a run's mesh picture during its load cycle) are numbered
+    # first; those of the images follow
+    with render.RenderWorker(SIZE) as worker:
+        early = worker.start_calls([(shutil.copyfile, dict(src=source, dst=tmp_path / "early.txt"))])
+        later = worker.submit([(tmp_path / "image3.png", scenes[0][0], {})],
+                              calls=[(shutil.copyfile, dict(src=source, dst=tmp_path / "late.txt"))])
+        assert (early, later) == ([0], [1])
+        assert worker.wait_calls(later) == [tmp_path / "late.txt"]
+        assert worker.wait() == [tmp_path / "image3.png", tmp_path / "early.txt", tmp_path / "late.txt"]
+        with pytest.raises(RenderError, match="before the images"):
+            worker.start_calls([(shutil.copyfile, dict(src=source, dst=tmp_path / "too_late.txt"))])
+    assert (tmp_path / "early.txt").read_text() == "x"
 
 
 def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):

@@ -25,9 +25,11 @@ References
 
 from __future__ import annotations
 
+import atexit
 import importlib.util
 import logging
 import time
+import weakref
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -115,23 +117,39 @@ def _factor_cholmod(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
     return factor
 
 
+class _CholespyFactor:
+    """A cholespy factor, dropped at interpreter exit (:func:`_drop_cholespy_factors`): nanobind,
+    which cholespy is built with, reports every instance still alive when its module is torn down
+    as a leak, which factors held by lingering objects (a notebook's results) would be."""
+
+    alive: weakref.WeakSet = weakref.WeakSet()
+
+    def __init__(self, lower: sp.csc_matrix):
+        from cholespy import CholeskySolverD, MatrixType  # optional
+
+        self.factor = CholeskySolverD(lower.shape[0], lower.indptr.astype(np.int32),
+                                      lower.indices.astype(np.int32), lower.data, MatrixType.CSC)
+        _CholespyFactor.alive.add(self)
+
+    def __call__(self, b: np.ndarray) -> np.ndarray:
+        b = np.ascontiguousarray(b, dtype=np.float64)
+        x = np.empty_like(b)
+        self.factor.solve(b, x)
+        return x
+
+
+@atexit.register
+def _drop_cholespy_factors() -> None:
+    for holder in list(_CholespyFactor.alive):
+        holder.factor = None
+
+
 def _factor_cholespy(lower: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
     # CHOLMOD (supernodal, its own choice of ordering) as wrapped by cholespy, which ships wheels
     # with CHOLMOD, METIS and a reference BLAS. CHOLMOD reads the lower triangle only (stype −1),
     # which is all it is given (:data:`_LOWER_TRIANGLE`). The solve holds the GIL and wants
     # C-ordered right-hand sides.
-    from cholespy import CholeskySolverD, MatrixType  # optional
-
-    factor = CholeskySolverD(lower.shape[0], lower.indptr.astype(np.int32), lower.indices.astype(np.int32),
-                             lower.data, MatrixType.CSC)
-
-    def solve(b: np.ndarray) -> np.ndarray:
-        b = np.ascontiguousarray(b, dtype=np.float64)
-        x = np.empty_like(b)
-        factor.solve(b, x)
-        return x
-
-    return solve
+    return _CholespyFactor(lower)
 
 
 def _factor_pardiso(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:

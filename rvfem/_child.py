@@ -1,0 +1,169 @@
+"""A child Python process that runs functions for its parent: pickled calls over its standard input,
+pickled results over its standard output.
+
+It is started with ``python -c`` (as the render worker is, :class:`rvfem.render.RenderWorker`), not
+with :mod:`multiprocessing`, whose "spawn" start method imports the parent's main module again in
+the child: a user's script without an ``if __name__ == "__main__"`` guard would run a second time.
+The framing helpers (:func:`send`, :func:`receive`, :func:`picklable`) are shared with the render
+worker.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import pickle
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+HEADER = struct.Struct("<Q")
+"""Length prefix of a message (little-endian unsigned 64-bit)."""
+
+
+def send(stream, message, lock: threading.Lock | None = None) -> None:
+    """Write one pickled, length-prefixed message to a binary stream and flush it."""
+    data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    if lock is None:
+        stream.write(HEADER.pack(len(data)) + data)
+        stream.flush()
+        return
+    with lock:
+        stream.write(HEADER.pack(len(data)) + data)
+        stream.flush()
+
+
+def receive(stream):
+    """The next message of a stream of :func:`send`, or None at its end."""
+    header = stream.read(HEADER.size)
+    if len(header) < HEADER.size:
+        return None
+    (n,) = HEADER.unpack(header)
+    data = stream.read(n)
+    if len(data) < n:
+        return None
+    return pickle.loads(data)
+
+
+def picklable(exc: BaseException) -> BaseException:
+    """``exc`` if it survives pickling, else a RuntimeError with its type and message."""
+    try:
+        pickle.loads(pickle.dumps(exc))
+        return exc
+    except Exception:
+        return RuntimeError(f"{type(exc).__name__}: {exc}")
+
+
+_PROGRAM = r"""
+import sys
+sys.path.insert(0, {root!r})
+from rvfem._child import _serve
+_serve()
+"""
+
+
+class ChildProcess:
+    """A Python child process that runs module-level functions for this one, one call after the
+    other, each returning a :class:`concurrent.futures.Future`.
+
+    Parameters
+    ----------
+    name : str
+        What the process is for (in error messages).
+
+    Notes
+    -----
+    The functions must be importable by name; their arguments and results are pickled. An
+    exception of a call is raised by its future's ``result()``; if the child ends unexpectedly,
+    every pending call raises RuntimeError with the end of its standard error.
+    """
+
+    def __init__(self, name: str):
+        self.name = name
+        self._stderr = tempfile.TemporaryFile()
+        root = str(Path(__file__).resolve().parents[1])
+        self._proc = subprocess.Popen([sys.executable, "-c", _PROGRAM.format(root=root)], stdin=subprocess.PIPE,
+                                      stdout=subprocess.PIPE, stderr=self._stderr)
+        self._pending: dict[int, Future] = {}
+        self._lock = threading.Lock()
+        self._count = 0
+        self._reader = threading.Thread(target=self._read, name=f"rvfem-{name}", daemon=True)
+        self._reader.start()
+
+    def call(self, function: Callable, *args) -> Future:
+        """Run ``function(*args)`` in the child process (after the calls before it)."""
+        future: Future = Future()
+        with self._lock:
+            number, self._count = self._count, self._count + 1
+            self._pending[number] = future
+        try:
+            send(self._proc.stdin, (number, function, args))
+        except OSError:   # the child is gone: the reader fails the pending calls
+            pass
+        return future
+
+    def _read(self) -> None:
+        stream = self._proc.stdout
+        while (message := receive(stream)) is not None:
+            kind, number, value = message
+            with self._lock:
+                future = self._pending.pop(number)
+            if kind == "ok":
+                future.set_result(value)
+            else:
+                future.set_exception(value)
+        self._proc.wait()
+        with self._lock:
+            pending, self._pending = list(self._pending.values()), {}
+        if pending:
+            self._stderr.seek(0)
+            tail = self._stderr.read().decode(errors="replace").strip().splitlines()[-5:]
+            error = RuntimeError(f"the {self.name} process ended (exit code {self._proc.returncode})"
+                                 + (": " + " | ".join(tail) if tail else ""))
+            for future in pending:
+                future.set_exception(error)
+
+    def close(self) -> None:
+        """End the child process: at once if it is still running a call (whose future then fails)."""
+        try:
+            self._proc.stdin.close()
+        except OSError:
+            pass
+        try:
+            self._proc.wait(timeout=0.5)
+        except subprocess.TimeoutExpired:
+            self._proc.kill()
+            self._proc.wait()
+        self._reader.join(timeout=5.0)
+        self._stderr.close()
+
+    def __enter__(self) -> ChildProcess:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _serve() -> None:
+    """The child's loop: run each call received, send its result or its exception, until the
+    parent closes the pipe."""
+    out = os.fdopen(os.dup(1), "wb")   # results to the parent; any other output goes to stderr
+    os.dup2(2, 1)
+    stream = sys.stdin.buffer
+    while (message := receive(stream)) is not None:
+        number, function, args = message
+        try:
+            reply = ("ok", number, function(*args))
+        except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
+            reply = ("error", number, picklable(exc))
+        try:
+            send(out, reply)
+        except Exception as exc:  # the result does not pickle
+            send(out, ("error", number, RuntimeError(f"the result of {function.__name__} cannot be sent: {exc}")))
