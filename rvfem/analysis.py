@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
 
 import numpy as np
 
-from . import hertz, iso281, rigid
+from . import hertz, iso281, registry, rigid
 from .case import Case, apply_overrides, case_to_dict, file_sha256, load_case, parse_override
 from .errors import CaseError
 
@@ -782,6 +782,17 @@ def _p2_child_recover(cycle_loads, angles, points, boundaries, band, away, setup
                                     p1_peak=away, setup_seconds=setup)
 
 
+def _models_in_package(case) -> bool:
+    """Whether the case's bearing and pin models are rvfem's own, which a child process knows too
+    (a model registered at run time, by a notebook or a test module, exists in this process only:
+    its P2 model is then built on a thread here)."""
+    try:
+        classes = (registry.bearing_model(case.crank_bearing.model), registry.pin_model(case.pins.model))
+    except KeyError:
+        return False
+    return all(c.__module__.split(".")[0] == __package__ for c in classes)
+
+
 def _start_p2_child():
     """A child process for :class:`_P2Model`, already importing what it needs; None where no
     child process can be started (the P2 model is then built on a thread)."""
@@ -952,7 +963,8 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
 
     # the P2 model of the stress stage is built in a child process beside the load cycle
     # (:class:`_P2Model`); the process starts now, so that its imports are done meanwhile
-    child = _start_p2_child() if recover_stress and case.analysis.element_order == 1 else None
+    child = (_start_p2_child() if recover_stress and case.analysis.element_order == 1 and _models_in_package(case)
+             else None)
     background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
     try:
         t = stages.start("mesh")

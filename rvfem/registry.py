@@ -58,7 +58,8 @@ def _resolve(name: str, registered: dict, builtin: dict, kind: str) -> type:
     try:
         return registered[name]
     except KeyError:
-        raise KeyError(f"unknown {kind} model {name!r}; known: {', '.join([*builtin, *registered])}") from None
+        known = ", ".join(dict.fromkeys([*builtin, *registered]))
+        raise KeyError(f"unknown {kind} model {name!r}; known: {known}") from None
 
 
 def bearing_model(name: str) -> type:

@@ -647,6 +647,24 @@ def test_p2_recovery_matches_a_full_p2_cycle(coarse_case_file, cache_dir):
     assert p2.stress.recovered is None and p1.stress.recovered.p1_MPa == p1.stress.away_from_contacts.von_mises_MPa
 
 
+@pytest.mark.slow
+def test_p2_model_in_its_child_process_gives_what_it_gives_here(coarse_case_file, cache_dir):
+    """The P2 re-solve of a run is made in a child process from the angles' column loads
+    (rvfem.cycle.AngleLoads); the same re-solve with the P2 model built in this process, from the
+    cycle's results themselves, gives the same peak (to round-off: the two factorisations may
+    round differently) and the same P1 value."""
+    from rvfem.analysis import _recover_structural_peak
+
+    a = analyse(coarse_case_file, cache_dir=cache_dir, attribute=False)
+    here = _recover_structural_peak(a.system, a.cycle, a.mesh, a.stress.band_mm, a.stress.away_from_contacts)
+    there = a.stress.recovered
+    assert there.peak.von_mises_MPa == pytest.approx(here.peak.von_mises_MPa, rel=1e-12)   # measured 0
+    assert (there.peak.x_mm, there.peak.y_mm, there.peak.theta_deg) == (here.peak.x_mm, here.peak.y_mm,
+                                                                        here.peak.theta_deg)
+    assert there.p1_at_peak_MPa == here.p1_at_peak_MPa and there.angles_deg == here.angles_deg
+    assert there.estimated_error_MPa == pytest.approx(here.estimated_error_MPa, rel=1e-9, abs=1e-12)
+
+
 def test_features_are_numbered_from_one(summary):
     for at in (summary["stress"]["structural_peak"]["at"], summary["stress"]["contact_zone"]["at"]):
         stem, _, number = at["feature"].rpartition("_")
