@@ -65,7 +65,7 @@ _PROGRAM = r"""
 import sys
 sys.path.insert(0, {root!r})
 from rvfem._child import _serve
-_serve()
+_serve({niceness!r})
 """
 
 
@@ -77,6 +77,9 @@ class ChildProcess:
     ----------
     name : str
         What the process is for (in error messages).
+    niceness : int
+        Added to the child's niceness (Unix ``nice``) before it imports anything: background
+        work that should leave the processor to this process where the two compete.
 
     Notes
     -----
@@ -85,11 +88,12 @@ class ChildProcess:
     every pending call raises RuntimeError with the end of its standard error.
     """
 
-    def __init__(self, name: str):
+    def __init__(self, name: str, niceness: int = 0):
         self.name = name
         self._stderr = tempfile.TemporaryFile()
         root = str(Path(__file__).resolve().parents[1])
-        self._proc = subprocess.Popen([sys.executable, "-c", _PROGRAM.format(root=root)], stdin=subprocess.PIPE,
+        program = _PROGRAM.format(root=root, niceness=int(niceness))
+        self._proc = subprocess.Popen([sys.executable, "-c", program], stdin=subprocess.PIPE,
                                       stdout=subprocess.PIPE, stderr=self._stderr)
         self._pending: dict[int, Future] = {}
         self._lock = threading.Lock()
@@ -151,9 +155,11 @@ class ChildProcess:
         self.close()
 
 
-def _serve() -> None:
+def _serve(niceness: int = 0) -> None:
     """The child's loop: run each call received, send its result or its exception, until the
     parent closes the pipe."""
+    if niceness and hasattr(os, "nice"):
+        os.nice(niceness)
     out = os.fdopen(os.dup(1), "wb")   # results to the parent; any other output goes to stderr
     os.dup2(2, 1)
     stream = sys.stdin.buffer

@@ -799,7 +799,7 @@ def _start_p2_child():
     from ._child import ChildProcess
 
     try:
-        child = ChildProcess("P2 model")
+        child = ChildProcess("P2 model", niceness=P2_CHILD_NICENESS)
     except OSError as exc:
         log.info("the P2 model is built on a thread (%s)", exc)
         return None
@@ -808,18 +808,16 @@ def _start_p2_child():
 
 
 def _p2_child_imports() -> None:
-    """In the child process of :class:`_P2Model`: import the modules of the P2 model, and yield
-    the processor to the load cycle where the two compete for it (the P2 model has the whole
-    cycle's time to be ready)."""
+    """In the child process of :class:`_P2Model`: import the modules of the P2 model."""
     import importlib
 
     for name in ("rvfem.cycle", "rvfem.postprocess"):
         importlib.import_module(name)
-    if hasattr(os, "nice"):
-        os.nice(P2_CHILD_NICENESS)
 
 
-#: Niceness added to the P2 model's child process (Unix ``nice``): the load cycle goes first.
+#: Niceness added to the P2 model's child process (Unix ``nice``): where the two compete for the
+#: processor, the mesh, the model and the load cycle go first (the P2 model has the whole cycle's
+#: time to be ready).
 P2_CHILD_NICENESS = 10
 
 
