@@ -815,10 +815,15 @@ def start_mesh_picture(system, folder: str | os.PathLike, worker) -> int:
     """
     from .plots import mesh_plot
 
+    (number,) = worker.start_calls([(mesh_plot, mesh_picture(system, _images_folder(folder)))])
+    return number
+
+
+def _images_folder(folder: str | os.PathLike) -> Path:
+    """``folder/images``, created if missing."""
     images = Path(folder) / "images"
     images.mkdir(exist_ok=True)
-    (number,) = worker.start_calls([(mesh_plot, mesh_picture(system, images))])
-    return number
+    return images
 
 
 class PendingImages:
@@ -895,10 +900,9 @@ def submit_images(analysis, folder: str | os.PathLike, worker, *,
     RenderError
         If off-screen rendering is not possible here.
     """
-    images = Path(folder) / "images"
-    images.mkdir(exist_ok=True)
     from .plots import mesh_plot
 
+    images = _images_folder(folder)
     image_set = _image_set(analysis, images)
     calls = list(calls)
     if mesh_call is not None:
@@ -927,8 +931,7 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
     from . import render
     from .plots import mesh_plot
 
-    images = Path(folder) / "images"
-    images.mkdir(exist_ok=True)
+    images = _images_folder(folder)
     total = image_count(analysis)
     out: list[Path] = []
 
