@@ -25,11 +25,10 @@ def release_freed_memory() -> None:
     peak is reached; the call takes a few milliseconds and changes no state.
     """
     import ctypes
-    import ctypes.util
 
     try:
-        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):  # not glibc
+        ctypes.CDLL(None).malloc_trim(0)       # the C library already loaded into the process
+    except (OSError, AttributeError, TypeError):  # not glibc (or no dlopen of the process)
         pass
 
 

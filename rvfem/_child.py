@@ -19,7 +19,7 @@ import sys
 import tempfile
 import threading
 from collections.abc import Callable
-from concurrent.futures import Future
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 log = logging.getLogger(__name__)
@@ -69,6 +69,10 @@ _serve({niceness!r})
 """
 
 
+class ChildProcessEnded(RuntimeError):
+    """The child process of a :class:`ChildProcess` ended before it answered a call."""
+
+
 class ChildProcess:
     """A Python child process that runs module-level functions for this one, one call after the
     other, each returning a :class:`concurrent.futures.Future`.
@@ -83,9 +87,11 @@ class ChildProcess:
 
     Notes
     -----
-    The functions must be importable by name; their arguments and results are pickled. An
-    exception of a call is raised by its future's ``result()``; if the child ends unexpectedly,
-    every pending call raises RuntimeError with the end of its standard error.
+    The functions must be importable by name; their arguments and results are pickled. The calls
+    are written to the child by a thread of their own, so that :meth:`call` returns at once even
+    while the child is still starting. An exception of a call is raised by its future's
+    ``result()``; once the child has ended, every call not answered raises
+    :class:`ChildProcessEnded` with the end of its standard error.
     """
 
     def __init__(self, name: str, niceness: int = 0):
@@ -93,11 +99,17 @@ class ChildProcess:
         self._stderr = tempfile.TemporaryFile()
         root = str(Path(__file__).resolve().parents[1])
         program = _PROGRAM.format(root=root, niceness=int(niceness))
-        self._proc = subprocess.Popen([sys.executable, "-c", program], stdin=subprocess.PIPE,
-                                      stdout=subprocess.PIPE, stderr=self._stderr)
+        try:
+            self._proc = subprocess.Popen([sys.executable, "-c", program], stdin=subprocess.PIPE,
+                                          stdout=subprocess.PIPE, stderr=self._stderr)
+        except BaseException:
+            self._stderr.close()
+            raise
         self._pending: dict[int, Future] = {}
         self._lock = threading.Lock()
         self._count = 0
+        self._ended: ChildProcessEnded | None = None
+        self._writer = ThreadPoolExecutor(1, thread_name_prefix=f"rvfem-{name}-writer")
         self._reader = threading.Thread(target=self._read, name=f"rvfem-{name}", daemon=True)
         self._reader.start()
 
@@ -105,37 +117,55 @@ class ChildProcess:
         """Run ``function(*args)`` in the child process (after the calls before it)."""
         future: Future = Future()
         with self._lock:
-            number, self._count = self._count, self._count + 1
+            number = self._count
+            data = pickle.dumps((number, function, args), protocol=pickle.HIGHEST_PROTOCOL)  # may raise
+            if self._ended is not None:
+                future.set_exception(self._ended)
+                return future
+            self._count += 1
             self._pending[number] = future
-        try:
-            send(self._proc.stdin, (number, function, args))
-        except OSError:   # the child is gone: the reader fails the pending calls
-            pass
+            self._writer.submit(self._write, data)
         return future
+
+    def _write(self, data: bytes) -> None:
+        try:
+            self._proc.stdin.write(HEADER.pack(len(data)) + data)
+            self._proc.stdin.flush()
+        except (OSError, ValueError):   # the child is gone (or closed): the reader fails the calls
+            pass
 
     def _read(self) -> None:
         stream = self._proc.stdout
-        while (message := receive(stream)) is not None:
-            kind, number, value = message
-            with self._lock:
-                future = self._pending.pop(number)
-            if kind == "ok":
-                future.set_result(value)
-            else:
-                future.set_exception(value)
-        self._proc.wait()
-        with self._lock:
-            pending, self._pending = list(self._pending.values()), {}
-        if pending:
+        try:
+            while (message := receive(stream)) is not None:
+                kind, number, value = message
+                with self._lock:
+                    future = self._pending.pop(number)
+                if kind == "ok":
+                    future.set_result(value)
+                else:
+                    future.set_exception(value)
+        except Exception as exc:  # pragma: no cover - a message that does not unpickle
+            log.error("the %s process sent what cannot be read: %s", self.name, exc)
+        finally:
+            try:
+                self._proc.wait(timeout=5.0)
+            except subprocess.TimeoutExpired:  # pragma: no cover - output closed, process alive
+                self._proc.kill()
+                self._proc.wait()
             self._stderr.seek(0)
             tail = self._stderr.read().decode(errors="replace").strip().splitlines()[-5:]
-            error = RuntimeError(f"the {self.name} process ended (exit code {self._proc.returncode})"
-                                 + (": " + " | ".join(tail) if tail else ""))
+            ended = ChildProcessEnded(f"the {self.name} process ended (exit code {self._proc.returncode})"
+                                      + (": " + " | ".join(tail) if tail else ""))
+            with self._lock:
+                self._ended = ended
+                pending, self._pending = list(self._pending.values()), {}
             for future in pending:
-                future.set_exception(error)
+                future.set_exception(ended)
 
     def close(self) -> None:
         """End the child process: at once if it is still running a call (whose future then fails)."""
+        self._writer.shutdown(wait=False, cancel_futures=True)   # a write under way finishes
         try:
             self._proc.stdin.close()
         except OSError:
@@ -145,7 +175,8 @@ class ChildProcess:
         except subprocess.TimeoutExpired:
             self._proc.kill()
             self._proc.wait()
-        self._reader.join(timeout=5.0)
+        self._reader.join(timeout=10.0)
+        self._proc.stdout.close()
         self._stderr.close()
 
     def __enter__(self) -> ChildProcess:

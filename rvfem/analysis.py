@@ -27,7 +27,7 @@ import math
 import os
 import time
 import tomllib
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
@@ -843,16 +843,27 @@ class _P2Model:
         from . import postprocess
         from .cycle import AngleLoads
 
-        if self._child is None:
-            system_p2, setup = self._built.result()
-            return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
-                                            p1_peak=away, system_p1=system, setup_seconds=setup)
-        setup = self._built.result()
-        ks = {postprocess.nearest_index(cycle.theta, float(a)) for a in angles}
-        loads = _CycleLoads(np.asarray(cycle.theta), {k: AngleLoads.of(cycle.solutions[k]) for k in ks})
-        recovered = self._child.call(_p2_child_recover, loads, angles, mesh.points, mesh.boundaries, band,
-                                     away, setup).result()
-        return dataclasses.replace(recovered, p1_at_peak_MPa=postprocess.p1_stress_at(system, cycle, recovered.peak))
+        from ._child import ChildProcessEnded
+
+        if self._child is not None:
+            try:
+                setup = self._built.result()
+                ks = {postprocess.nearest_index(cycle.theta, float(a)) for a in angles}
+                roots: dict = {}
+                loads = _CycleLoads(np.asarray(cycle.theta),
+                                    {k: AngleLoads.of(cycle.solutions[k], roots) for k in ks})
+                recovered = self._child.call(_p2_child_recover, loads, angles, mesh.points, mesh.boundaries,
+                                             band, away, setup).result()
+                return dataclasses.replace(recovered,
+                                           p1_at_peak_MPa=postprocess.p1_stress_at(system, cycle, recovered.peak))
+            except ChildProcessEnded as exc:   # e.g. ended by the system for want of memory
+                log.warning("%s; the P2 model is built here instead", exc)
+                t0 = time.perf_counter()
+                self._built = Future()
+                self._built.set_result((_p2_system(system, mesh), time.perf_counter() - t0))
+        system_p2, setup = self._built.result()
+        return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
+                                        p1_peak=away, system_p1=system, setup_seconds=setup)
 
     def close(self) -> None:
         """End the child process (its P2 model with it)."""
@@ -1037,6 +1048,7 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
     finally:
         for model in p2:            # the P2 model (a few hundred MB) is not needed any more
             model.close()
+        p2.clear()
     attribution = None
     if pending is not None:
         t = stages.start("attribution")

@@ -682,12 +682,19 @@ class AngleLoads:
     origin: tuple | None = None
 
     @classmethod
-    def of(cls, result: AngleResult) -> AngleLoads:
-        origin = None
-        if result.origin is not None:
-            root, k = result.origin
-            origin = (cls.of(root), k)
-        return cls(float(result.theta), np.asarray(result.column_loads), np.asarray(result.rigid_motion), origin)
+    def of(cls, result: AngleResult, roots: dict | None = None) -> AngleLoads:
+        """The loads of ``result``; ``roots`` (id of a result → its AngleLoads, filled here) makes
+        results that share an origin share its AngleLoads too, so that :func:`displacements`
+        solves it once."""
+        roots = {} if roots is None else roots
+        if id(result) not in roots:
+            origin = None
+            if result.origin is not None:
+                root, k = result.origin
+                origin = (cls.of(root, roots), k)
+            roots[id(result)] = cls(float(result.theta), np.asarray(result.column_loads),
+                                    np.asarray(result.rigid_motion), origin)
+        return roots[id(result)]
 
 
 @dataclass(frozen=True)

@@ -47,8 +47,8 @@ import hashlib
 import json
 import logging
 import math
-import signal
 import os
+import signal
 import tempfile
 import threading
 from dataclasses import dataclass, field
@@ -197,11 +197,9 @@ def _ignore_sigpipe_again() -> None:
         signal.signal(signal.SIGPIPE, signal.SIG_IGN)
         return
     import ctypes
-    import ctypes.util
 
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        libc.signal(int(signal.SIGPIPE), ctypes.c_void_p(1))          # SIG_IGN
+        ctypes.CDLL(None).signal(int(signal.SIGPIPE), ctypes.c_void_p(1))          # SIG_IGN
     except (OSError, AttributeError):  # pragma: no cover - no C library to ask
         log.debug("SIGPIPE left as Gmsh set it")
 

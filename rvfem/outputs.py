@@ -834,8 +834,9 @@ class PendingImages:
         self._set, self._worker, self._calls, self._mesh_call = image_set, worker, calls, mesh_call
 
     def calls_result(self) -> list:
-        """Wait for the calls given to :func:`submit_images` (the child makes them before the mesh
-        picture) and return what they returned.
+        """Wait for the calls given to :func:`submit_images` (the child makes them one after the
+        other, after the mesh picture if that was started first, else before it) and return what
+        they returned.
 
         Raises
         ------
@@ -886,8 +887,9 @@ def submit_images(analysis, folder: str | os.PathLike, worker, *,
     worker : rvfem.render.RenderWorker
         Checked (:meth:`~rvfem.render.RenderWorker.check`) or not; it draws one series.
     calls : iterable of (function, dict)
-        Other drawings for the child's second thread, made before the mesh picture (e.g.
-        :func:`plot_calls`); :meth:`PendingImages.calls_result` waits for them.
+        Other drawings for the child's second thread (e.g. :func:`plot_calls`), made before the
+        mesh picture unless that was started already; :meth:`PendingImages.calls_result` waits
+        for them.
     mesh_call : int, optional
         The number :func:`start_mesh_picture` returned, if the mesh picture was started already.
 

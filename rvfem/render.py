@@ -966,6 +966,7 @@ class RenderWorker:
         self._results: dict[int, object] = {}
         self._finished = False
         self._messages: queue.Queue = queue.Queue()
+        self._writer = None
         self._proc = None
         if isinstance(_probe_result, RenderError):   # this process knows already: no child
             self._checked = _probe_result
@@ -1096,10 +1097,11 @@ class RenderWorker:
         return self.wait(tick=tick)
 
     def start_calls(self, calls: Sequence[Call]) -> list[int]:
-        """Hand over drawings that need no stress images, which the child process starts at once
-        in its second thread (e.g. the mesh picture while the caller still computes); what they
-        return comes with :meth:`wait_calls` and :meth:`wait` like the calls of :meth:`submit`.
-        Only before :meth:`submit`.
+        """Hand over drawings that need no stress images, which the child process starts in its
+        second thread as soon as it is ready (e.g. the mesh picture while the caller still
+        computes); what they return comes with :meth:`wait_calls` and :meth:`wait` like the calls
+        of :meth:`submit`. Only before :meth:`submit`; returns at once (a thread of this process
+        writes the calls to the child, which reads them once its plotter is ready).
 
         Parameters
         ----------
@@ -1134,12 +1136,17 @@ class RenderWorker:
         first = self._n_calls
         self._n_calls += len(message[-1])
         self._used = True
-        try:
-            self._proc.stdin.write(HEADER.pack(len(data)) + data)
-            self._proc.stdin.flush()
-        except OSError:
-            pass   # the child is gone: wait() reports how it ended
+        if self._writer is None:   # one thread writes, in order: the child reads only once it is ready
+            self._writer = ThreadPoolExecutor(1, thread_name_prefix="rvfem-render-writer")
+        self._writer.submit(self._write, HEADER.pack(len(data)) + data)
         return list(range(first, self._n_calls))
+
+    def _write(self, data: bytes) -> None:
+        try:
+            self._proc.stdin.write(data)
+            self._proc.stdin.flush()
+        except (OSError, ValueError, AttributeError):
+            pass   # the child is gone (or closed): wait() reports how it ended
 
     def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> list[int]:
         """Hand a series of stress images over to the child process, which starts drawing them
@@ -1256,6 +1263,9 @@ class RenderWorker:
 
     def close(self) -> None:
         """End the child process (at once if it is still drawing) and release its pipes."""
+        if self._writer is not None:
+            self._writer.shutdown(wait=False, cancel_futures=True)   # a write under way finishes
+            self._writer = None
         if self._proc is not None:
             try:
                 self._proc.stdin.close()   # a child still waiting for images ends

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 import os
+import pickle
 
 import pytest
 
-from rvfem._child import ChildProcess
+from rvfem._child import ChildProcess, ChildProcessEnded
 
 
 def test_calls_run_in_order_in_another_process_and_their_errors_come_back():
@@ -22,7 +23,20 @@ def test_calls_run_in_order_in_another_process_and_their_errors_come_back():
         assert child.call(math.floor, 2.5).result(timeout=30) == 2    # the child goes on after an error
 
 
-def test_a_child_that_ends_fails_its_pending_calls():
+def test_a_child_that_ends_fails_its_pending_calls_and_the_later_ones():
     with ChildProcess("test") as child:
-        with pytest.raises(RuntimeError, match="the test process ended.*exit code 3"):
-            child.call(os._exit, 3).result(timeout=30)
+        ending = child.call(os._exit, 3)
+        after = child.call(math.floor, 2.5)              # sent before the child ended
+        with pytest.raises(ChildProcessEnded, match="the test process ended.*exit code 3"):
+            ending.result(timeout=30)
+        with pytest.raises(ChildProcessEnded):
+            after.result(timeout=30)
+        with pytest.raises(ChildProcessEnded):           # made after it ended: fails at once
+            child.call(math.floor, 2.5).result(timeout=1)
+
+
+def test_a_call_that_cannot_be_sent_raises_at_once():
+    with ChildProcess("test") as child:
+        with pytest.raises((pickle.PicklingError, AttributeError)):
+            child.call(lambda: 1)                        # a lambda does not pickle
+        assert child.call(math.floor, 2.5).result(timeout=30) == 2

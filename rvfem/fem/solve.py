@@ -127,8 +127,10 @@ class _CholespyFactor:
     def __init__(self, lower: sp.csc_matrix):
         from cholespy import CholeskySolverD, MatrixType  # optional
 
+        # handed over in CSR form: cholespy converts it into CSC arrays of its own, which it then
+        # sorts and resizes in place (given CSC arrays, it would do so to NumPy's buffers)
         self.factor = CholeskySolverD(lower.shape[0], lower.indptr.astype(np.int32),
-                                      lower.indices.astype(np.int32), lower.data, MatrixType.CSC)
+                                      lower.indices.astype(np.int32), lower.data, MatrixType.CSR)
         _CholespyFactor.alive.add(self)
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
@@ -145,9 +147,10 @@ def _drop_cholespy_factors() -> None:
 
 
 def _factor_cholespy(lower: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
-    # CHOLMOD (supernodal, its own choice of ordering) as wrapped by cholespy, which ships wheels
-    # with CHOLMOD, METIS and a reference BLAS. CHOLMOD reads the lower triangle only (stype −1),
-    # which is all it is given (:data:`_LOWER_TRIANGLE`). The solve holds the GIL and wants
+    # CHOLMOD (its own choice of ordering and of a supernodal or simplicial factor) as wrapped by
+    # cholespy, which ships wheels with CHOLMOD, METIS and a reference BLAS. CHOLMOD reads the
+    # lower triangle only (stype −1), which is all it is given, as a CSR matrix
+    # (:data:`_LOWER_TRIANGLE`). The solve holds the GIL and wants
     # C-ordered right-hand sides.
     return _CholespyFactor(lower)
 
@@ -168,7 +171,7 @@ def _factor_pardiso(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
 
 #: Backends whose solve holds the GIL: their back-substitutions gain nothing from threads.
 _SERIAL_SOLVES = frozenset({"cholespy"})
-#: Backends given the lower triangle of the stiffness only (in CSC form).
+#: Backends given the lower triangle of the stiffness only (as a CSR matrix).
 _LOWER_TRIANGLE = frozenset({"cholespy"})
 #: Backends that take C-ordered right-hand sides (the others Fortran-ordered ones).
 _C_ORDER = frozenset({"cholespy"})
@@ -199,7 +202,7 @@ class Factorization:
         cholespy holds it, so threads would only take turns).
     batch : int
         Right-hand sides per back-substitution call that cost least per column (measured on the
-        default fan-hole disc, 38k DOFs: SuperLU 16; cholespy 8, whose reference-BLAS supernodal
+        default fan-hole disc, 38k DOFs: SuperLU 16; cholespy 8, whose reference-BLAS
         solve slows down once the block of right-hand sides leaves the cache, 0.79 ms a column
         at 8 against 1.08 ms at 16 and 1.52 ms at 128).
     """
@@ -262,12 +265,14 @@ def default_support(model: FEModel) -> np.ndarray:
     return np.array([model.node_dofs[ia, 0], model.node_dofs[ia, 1], model.node_dofs[ib, comp_b]])
 
 
-def _submatrix(stiffness: sp.spmatrix, keep: np.ndarray, lower: bool = False) -> sp.csc_matrix:
-    """``stiffness[keep][:, keep]`` of a symmetric matrix (or its lower triangle) as a CSC matrix
-    with sorted indices, in one pass over the entries (fancy indexing copies the whole matrix
-    twice; for the P2 disc that is 100 MB). The rows of the CSR form are taken as the columns,
-    which gives the transpose: the same matrix, as the stiffness is symmetric
-    (tests/test_fem.py)."""
+def _submatrix(stiffness: sp.spmatrix, keep: np.ndarray, lower: bool = False) -> sp.spmatrix:
+    """``stiffness[keep][:, keep]`` of a symmetric matrix with sorted indices, in one pass over the
+    entries (fancy indexing copies the whole matrix twice; for the P2 disc that is 100 MB).
+
+    The whole matrix comes as CSC: the rows of the CSR form taken as the columns, which gives the
+    transpose, the same matrix as the stiffness is symmetric (tests/test_fem.py). With ``lower``
+    only its lower triangle comes, as CSR.
+    """
     k = sp.csr_matrix(stiffness)
     k.sort_indices()
     n = k.shape[0]
@@ -277,12 +282,14 @@ def _submatrix(stiffness: sp.spmatrix, keep: np.ndarray, lower: bool = False) ->
     row = np.repeat(np.arange(n, dtype=np.int32), np.diff(k.indptr))
     entry = kept[k.indices] & kept[row]
     if lower:
-        entry &= k.indices >= row       # CSR column ≥ row: the lower triangle of the CSC view
+        entry &= k.indices <= row       # column ≤ row
     counts = np.bincount(row[entry], minlength=n)[kept]
     del row
     indptr = np.concatenate([[0], np.cumsum(counts)])
-    sub = sp.csc_matrix((k.data[entry], number[k.indices[entry]], indptr), shape=(int(kept.sum()),) * 2)
-    sub.has_sorted_indices = True                         # kept rows stay in order
+    shape = (int(kept.sum()),) * 2
+    form = sp.csr_matrix if lower else sp.csc_matrix
+    sub = form((k.data[entry], number[k.indices[entry]], indptr), shape=shape)
+    sub.has_sorted_indices = True                         # kept entries stay in order
     return sub
 
 
@@ -297,7 +304,7 @@ def factorize_matrix(
         ``(n, n)``, N/mm.
     support_dofs : array_like of int
         DOFs removed (held at zero). They must make the remaining matrix positive definite.
-    solver : {"auto", "cholmod", "pardiso", "superlu"}
+    solver : {"auto", "cholmod", "cholespy", "pardiso", "superlu"}
         "auto" takes the first of :func:`available_solvers` (the choice is logged at INFO level).
 
     Returns
@@ -328,7 +335,7 @@ def factorize(model: FEModel, support_dofs: np.ndarray | None = None, solver: st
     model : FEModel
     support_dofs : array_like of int, optional
         DOFs held at zero; default :func:`default_support` (three DOFs, statically determinate).
-    solver : {"auto", "cholmod", "pardiso", "superlu"}
+    solver : {"auto", "cholmod", "cholespy", "pardiso", "superlu"}
         See :func:`factorize_matrix`.
 
     Returns
