@@ -27,7 +27,7 @@ import math
 import os
 import time
 import tomllib
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
@@ -740,13 +740,18 @@ def default_cache_dir() -> Path:
 
 
 def _p2_system(system, mesh):
-    """The P2 model of the cycle's disc (same mesh, models and geometry), assembled and factorised;
-    the heap its temporaries leave behind is given back (:func:`rvfem._arrays.release_freed_memory`)."""
+    """The P2 model of the cycle's disc (same mesh, models and geometry), assembled and factorised."""
+    return _build_p2(system.case, mesh, system.bearing_model, system.pin_model, system.geometry)
+
+
+def _build_p2(case, mesh, bearing_model, pin_model, geometry=None):
+    """The P2 model of a case's disc, assembled and factorised; the heap its temporaries leave
+    behind is given back (:func:`rvfem._arrays.release_freed_memory`)."""
     from ._arrays import release_freed_memory
     from .cycle import build_system
 
-    system_p2 = build_system(system.case, mesh, order=2, bearing_model=system.bearing_model,
-                             geometry=system.geometry, pin_model=system.pin_model)
+    system_p2 = build_system(case, mesh, order=2, bearing_model=bearing_model, geometry=geometry,
+                             pin_model=pin_model)
     release_freed_memory()
     return system_p2
 
@@ -765,12 +770,8 @@ _CHILD_P2: list = []
 
 def _p2_child_build(case, mesh, bearing_model, pin_model) -> float:
     """In the child process of :class:`_P2Model`: build the P2 model; its wall time, s."""
-    from ._arrays import release_freed_memory
-    from .cycle import build_system
-
     t0 = time.perf_counter()
-    _CHILD_P2[:] = [build_system(case, mesh, order=2, bearing_model=bearing_model, pin_model=pin_model)]
-    release_freed_memory()
+    _CHILD_P2[:] = [_build_p2(case, mesh, bearing_model, pin_model)]
     return time.perf_counter() - t0
 
 
@@ -838,32 +839,35 @@ class _P2Model:
         else:
             self._built = background.submit(_timed, _p2_system, system, mesh)
 
-    def recover(self, system, cycle, angles, mesh, band, away):
-        """:func:`rvfem.postprocess.recover_peak` on this P2 model, with the P1 value at the peak."""
+    def recover_in_child(self, system, cycle, angles, mesh, band, away):
+        """:func:`rvfem.postprocess.recover_peak` made in the child process, with the P1 value at
+        the peak added here; None without a child, or when it has ended (e.g. ended by the system
+        for want of memory: the P2 model is then built here, :meth:`model`)."""
         from . import postprocess
+        from ._child import ChildProcessEnded
         from .cycle import AngleLoads
 
-        from ._child import ChildProcessEnded
+        if self._child is None:
+            return None
+        try:
+            setup = self._built.result()
+            ks = {postprocess.nearest_index(cycle.theta, float(a)) for a in angles}
+            roots: dict = {}
+            loads = _CycleLoads(np.asarray(cycle.theta), {k: AngleLoads.of(cycle.solutions[k], roots) for k in ks})
+            recovered = self._child.call(_p2_child_recover, loads, angles, mesh.points, mesh.boundaries, band,
+                                         away, setup).result()
+        except ChildProcessEnded as exc:
+            log.warning("%s; the P2 model is built here instead", exc)
+            self._child, self._built = None, None
+            return None
+        return dataclasses.replace(recovered, p1_at_peak_MPa=postprocess.p1_stress_at(system, cycle, recovered.peak))
 
-        if self._child is not None:
-            try:
-                setup = self._built.result()
-                ks = {postprocess.nearest_index(cycle.theta, float(a)) for a in angles}
-                roots: dict = {}
-                loads = _CycleLoads(np.asarray(cycle.theta),
-                                    {k: AngleLoads.of(cycle.solutions[k], roots) for k in ks})
-                recovered = self._child.call(_p2_child_recover, loads, angles, mesh.points, mesh.boundaries,
-                                             band, away, setup).result()
-                return dataclasses.replace(recovered,
-                                           p1_at_peak_MPa=postprocess.p1_stress_at(system, cycle, recovered.peak))
-            except ChildProcessEnded as exc:   # e.g. ended by the system for want of memory
-                log.warning("%s; the P2 model is built here instead", exc)
-                t0 = time.perf_counter()
-                self._built = Future()
-                self._built.set_result((_p2_system(system, mesh), time.perf_counter() - t0))
-        system_p2, setup = self._built.result()
-        return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
-                                        p1_peak=away, system_p1=system, setup_seconds=setup)
+    def model(self, system, mesh):
+        """The P2 model in this process and the time it took, s: the one the ``background`` thread
+        built, or one built now."""
+        if self._built is not None:
+            return self._built.result()
+        return _timed(_p2_system, system, mesh)
 
     def close(self) -> None:
         """End the child process (its P2 model with it)."""
@@ -877,15 +881,15 @@ def _recover_structural_peak(system, cycle, mesh, band, away, p2=None):
     beside the load cycle) or built here, or is the cycle's own for a P2 case."""
     from . import postprocess
 
-    t0 = time.perf_counter()
     angles = postprocess.peak_angles(cycle, mesh.points, mesh.boundaries, exclude=band)
-    if p2 is not None and system.model.order == 1:
-        return p2.recover(system, cycle, angles, mesh, band, away)
     if system.model.order == 2:
         system_p2, system_p1, setup = system, None, 0.0
+    elif p2 is None:
+        (system_p2, setup), system_p1 = _timed(_p2_system, system, mesh), system
+    elif (recovered := p2.recover_in_child(system, cycle, angles, mesh, band, away)) is not None:
+        return recovered
     else:
-        system_p2, system_p1 = _p2_system(system, mesh), system
-        setup = time.perf_counter() - t0
+        (system_p2, setup), system_p1 = p2.model(system, mesh), system
     return postprocess.recover_peak(system_p2, cycle, angles, mesh.points, mesh.boundaries, exclude=band,
                                     p1_peak=away, system_p1=system_p1, setup_seconds=setup)
 

@@ -582,9 +582,7 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     points = np.asarray(system.mesh.points, dtype=float)
     names = tuple(spots)
     vertices = tuple(vertex_of(points, spots[n]) for n in names)
-    distinct, which = np.unique(vertices, return_inverse=True)      # two spots may share a vertex
-    sub = nodal_stress_operator(system.model, distinct)[
-        np.concatenate([which + c * distinct.size for c in range(3)])]  # (3·hot spots, n_dofs)
+    sub = nodal_stress_operator(system.model, vertices)            # (3·hot spots, n_dofs)
     Z = system.compliance.fields(sub.T.toarray())                  # A·S_hᵀ, (n_dofs, 3·hot spots)
     ZB = np.asarray(system.interface.B.T @ Z).T                    # (3·hot spots, n_columns)
     SR = np.asarray(sub @ system.rigid_modes)                      # ≈ 0: rigid motions do not strain

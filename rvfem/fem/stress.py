@@ -129,7 +129,7 @@ def nodal_stress_operator(model: FEModel, vertices: np.ndarray | None = None) ->
     ----------
     model : FEModel
     vertices : array_like of int, optional
-        Only the rows of these (distinct) vertices (default all): the hot-spot histories need a few rows, and
+        Only the rows of these vertices, in the order given (default all; one may come twice): the hot-spot histories need a few rows, and
         the whole operator's assembly holds about 100 MB of temporaries on the default disc. The
         rows are those of the whole operator exactly (the same entries, summed in the same order).
 
@@ -146,8 +146,10 @@ def nodal_stress_operator(model: FEModel, vertices: np.ndarray | None = None) ->
     elements = slice(None)
     if vertices is not None:
         vertices = np.asarray(vertices, dtype=np.int64).ravel()
-        if np.unique(vertices).size != vertices.size:
-            raise ValueError("nodal_stress_operator: the vertices must be distinct")
+        distinct, which = np.unique(vertices, return_inverse=True)
+        if distinct.size < vertices.size:    # the rows of each vertex once, then in the order given
+            rows = nodal_stress_operator(model, distinct)
+            return rows[np.concatenate([which + c * distinct.size for c in range(3)])]
         row_of = np.full(nv, -1)
         row_of[vertices] = np.arange(vertices.size)
         elements = np.flatnonzero((row_of[t] >= 0).any(axis=0))   # the triangles at those vertices
