@@ -32,15 +32,42 @@ def release_freed_memory() -> None:
         pass
 
 
-def first_max(a, rtol: float = 1e-9) -> tuple[int, ...]:
-    """Index of the first largest entry of ``a`` (C order) among those within ``rtol`` of the
-    largest: on a symmetric disc the maxima of a load cycle come in equal copies (bearing i at θ,
-    bearing i + 1 at θ + 360°/N) that differ by round-off only, and the choice among them must
-    not depend on it."""
+TIE_RTOL = 1e-9
+"""Values within this fraction of the largest count as equal to it (:func:`near_max`)."""
+
+
+def near_max(a, rtol: float = TIE_RTOL) -> np.ndarray:
+    """Flat indices (C order) of the entries of ``a`` within ``rtol`` of its largest: on a
+    symmetric disc the maxima of a load cycle come in equal copies (bearing i at θ, bearing i + 1
+    at θ + 360°/N) that differ by round-off only, and the choice among them must not depend on
+    it."""
     a = np.asarray(a, dtype=float)
     top = float(np.max(a))
-    flat = int(np.flatnonzero(a.ravel() >= top - rtol * abs(top))[0])
+    return np.flatnonzero(a.ravel() >= top - rtol * abs(top))
+
+
+def first_max(a, rtol: float = TIE_RTOL) -> tuple[int, ...]:
+    """Index of the first largest entry of ``a`` (C order) among those within ``rtol`` of the
+    largest (:func:`near_max`)."""
+    a = np.asarray(a, dtype=float)
+    flat = int(near_max(a, rtol)[0])
     return tuple(int(i) for i in np.unravel_index(flat, a.shape))
+
+
+def max_load_index(bearing_forces: np.ndarray) -> tuple[int, int]:
+    """Angle index and bearing index of the largest bearing load |F| of a cycle (the first of
+    equal ones, :func:`first_max`).
+
+    Parameters
+    ----------
+    bearing_forces : ndarray (n, N, 2)
+
+    Returns
+    -------
+    (int, int)
+    """
+    k, i = first_max(np.linalg.norm(bearing_forces, axis=2))
+    return int(k), int(i)
 
 
 def chain_edges(edges) -> tuple[tuple[np.ndarray, bool], ...]:

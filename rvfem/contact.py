@@ -392,8 +392,9 @@ class Compliance:
         """Make sure ``C[:, columns]`` is available.
 
         Missing columns are back-substituted in batches of :attr:`batch` right-hand sides, on
-        :attr:`workers` threads (SciPy's SuperLU releases the GIL: 1.6× on two cores, measured);
-        with a rotation map only those of one sector, the rest are rotated copies.
+        :attr:`workers` threads (SciPy's SuperLU releases the GIL: 1.6× on two cores, measured;
+        cholespy holds it, and its systems use one thread); with a rotation map only those of one
+        sector, the rest are rotated copies.
         """
         columns = np.asarray(columns, dtype=int)
         if self.known[columns].all():
@@ -757,6 +758,11 @@ class ContactSet:
     W_load: sp.csc_matrix | None = None
     bearing: np.ndarray | None = None
 
+    @property
+    def load_weights(self) -> sp.csc_matrix:
+        """The weights the contact forces load the disc along: ``W_load``, or ``W`` without one."""
+        return self.W if self.W_load is None else self.W_load
+
 
 @dataclass(frozen=True)
 class AngleSolution:
@@ -923,7 +929,7 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
     subs = []
     for k, (b, c) in enumerate(zip(bodies, csets)):
         W = c.W.tocsc()                              # gaps/approaches are measured along W
-        WL = W if c.W_load is None else c.W_load.tocsc()   # loads act along W_load
+        WL = c.load_weights.tocsc()                  # loads act along W_load
         rows = slice(offs[k], offs[k + 1])
         Rc[rows, 3 * k:3 * k + 3] = np.asarray(W.T @ b.interface.resultants)
         RL[rows, 3 * k:3 * k + 3] = np.asarray(WL.T @ b.interface.resultants)
@@ -1115,7 +1121,7 @@ def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, flo
     oscillate between contact states without settling.
     """
     cset = body.cset
-    WL = cset.W if cset.W_load is None else cset.W_load
+    WL = cset.load_weights
     moments = np.abs(np.asarray(WL.T @ body.interface.resultants[:, 2]))
     out = []
     for idx, law in cset.laws:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._arrays import first_max
+from ._arrays import first_max, max_load_index
 from .case import Case, CrankBearing
 
 __all__ = [
@@ -351,8 +351,7 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
         q = stribeck_max_roller_load(rigid_max_N, z)
         out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_case_contacts(case, q),
                                             bearing=rigid_max_bearing, theta_deg=rigid_max_at_deg)
-    loads = np.linalg.norm(bearing_forces, axis=2)
-    k, i = first_max(loads)
+    k, i = max_load_index(bearing_forces)
     q = stribeck_max_roller_load(float(np.linalg.norm(bearing_forces[k, i])), z)
     out["stribeck_flexible"] = RollerHertz("stribeck_flexible", q, *_case_contacts(case, q), bearing=int(i),
                                            theta_deg=math.degrees(float(theta[k])))

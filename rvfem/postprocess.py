@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fem
-from ._arrays import first_max
+from ._arrays import first_max, max_load_index, near_max
 
 __all__ = [
     "FieldSnapshot",
@@ -136,22 +136,6 @@ def feature_label(name: str) -> str:
     return name
 
 
-def max_load_index(bearing_forces: np.ndarray) -> tuple[int, int]:
-    """Angle index and bearing index of the largest bearing load |F| of a cycle.
-
-    Parameters
-    ----------
-    bearing_forces : ndarray (n, N, 2)
-
-    Returns
-    -------
-    (int, int)
-    """
-    loads = np.linalg.norm(bearing_forces, axis=2)
-    k, i = first_max(loads)
-    return int(k), int(i)
-
-
 def nearest_index(thetas: np.ndarray, theta: float) -> int:
     """Index of the angle in ``thetas`` (rad) closest to ``theta`` (rad) on the circle."""
     return int(np.argmin(np.abs(np.angle(np.exp(1j * (np.asarray(thetas) - theta))))))
@@ -261,10 +245,7 @@ def peak_von_mises(source, points: np.ndarray,
     """
     env = stress_envelope(source)
     points = np.asarray(points, dtype=float)
-    mask = np.ones(len(points), dtype=bool)
-    for name, band in (exclude or {}).items():
-        if name in boundaries and band > 0:
-            mask &= _distances(points, points[np.asarray(boundaries[name])[:, 0]]) >= band
+    mask = _mask(points, boundaries, exclude)
     if not mask.any():
         return None
     candidates = np.flatnonzero(mask)
@@ -366,9 +347,7 @@ def _first_peak(env: StressEnvelope, candidates: np.ndarray) -> int:
     """Position in ``candidates`` of the largest envelope value; among values within 1e-9 of it
     (on a symmetric disc the peak has rotated copies that differ by round-off) the one reached
     at the smallest crank angle, then the lowest vertex."""
-    vm = env.von_mises[candidates]
-    top = float(vm.max())
-    tied = np.flatnonzero(vm >= top - 1e-9 * abs(top))
+    tied = near_max(env.von_mises[candidates])
     theta = np.mod(env.theta[candidates][tied], 2.0 * np.pi)
     return int(tied[np.lexsort((tied, np.round(theta, 9)))[0]])
 
@@ -586,8 +565,7 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     Z = system.compliance.fields(sub.T.toarray())                  # A·S_hᵀ, (n_dofs, 3·hot spots)
     ZB = np.asarray(system.interface.B.T @ Z).T                    # (3·hot spots, n_columns)
     SR = np.asarray(sub @ system.rigid_modes)                      # ≈ 0: rigid motions do not strain
-    comps = np.stack([ZB @ ((r.contacts.W if r.contacts.W_load is None else r.contacts.W_load)
-                            @ r.solution.force) + SR @ r.solution.rigid
+    comps = np.stack([ZB @ r.column_loads + SR @ r.rigid_motion
                       for r in cycle.solutions])                   # (n, 3·hot spots)
     k = len(vertices)
     state = StressState.from_components(comps[:, :k], comps[:, k:2 * k], comps[:, 2 * k:])

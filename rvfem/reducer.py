@@ -347,7 +347,7 @@ def _bodies(stage: ReducerStage, theta: float):
 
 def _directions(system, cset) -> np.ndarray:
     """Unit force on the disc per unit λ of each contact, (n_contacts, 2), disc frame."""
-    WL = cset.W if cset.W_load is None else cset.W_load
+    WL = cset.load_weights
     return np.asarray(WL.T @ system.interface.resultants[:, :2])
 
 
@@ -455,7 +455,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         for d in range(len(systems)):
             wanted[d].append(own[d] if (swap, k) == (0, 0) else own[d ^ swap] + k * step)
     for d, s in enumerate(systems):
-        contact_sets(s, wanted[d] + [_disc_angles(stage, float(thetas[i]))[d] for i in solve_at])
+        contact_sets(s, wanted[d])               # the solved angles are among them (source[i] = i)
     for s in {id(s): s for s in systems}.values():
         ks = [k for k, t in enumerate(systems) if t is s]
         s.compliance.ensure(likely_columns(s, [cset(k, _disc_angles(stage, float(thetas[i]))[k])

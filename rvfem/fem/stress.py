@@ -2,8 +2,8 @@
 
 σ = λ* tr(ε) I + 2μ ε with ε = sym ∇u and the plane-stress constants λ*, μ of
 :func:`~rvfem.fem.model.plane_stress_constants` ([1]_ § 4.2, [2]_ § 15). Element stresses are
-evaluated with scikit-fem (``CellBasis.interpolate(u).grad``) at the reference vertices and the
-centroid of every triangle. Vertex stresses are recovered by area-weighted averaging of the element
+evaluated from the gradients of scikit-fem's scalar basis functions
+(:func:`displacement_gradients`) at the reference vertices and the centroid of every triangle. Vertex stresses are recovered by area-weighted averaging of the element
 values at the vertex over the triangles sharing it: for P1 (constant element stress) this is the
 lumped-mass L2 projection onto continuous P1 ([1]_ § 14.3); for P2 the element stress is linear and
 its vertex values are averaged. :func:`stress_fields` and :func:`nodal_stress_operator` share one
