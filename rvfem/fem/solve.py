@@ -118,17 +118,23 @@ def _factor_cholmod(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
 
 
 class _CholespyFactor:
-    """A cholespy factor, dropped at interpreter exit (:func:`_drop_cholespy_factors`): nanobind,
+    """CHOLMOD (its own choice of ordering and of a supernodal or simplicial factor) as wrapped by
+    cholespy, which ships wheels with CHOLMOD, METIS and a reference BLAS; called with
+    right-hand sides, it solves (C-ordered ones: :data:`_C_ORDER`; the solve holds the GIL).
+
+    CHOLMOD reads the lower triangle only (stype −1), which is all it is given
+    (:data:`_LOWER_TRIANGLE`), as a CSR matrix: cholespy converts it into CSC arrays of its own,
+    which it then sorts and resizes in place (given CSC arrays, it would do so to NumPy's
+    buffers). Factors are dropped at interpreter exit (:func:`_drop_cholespy_factors`): nanobind,
     which cholespy is built with, reports every instance still alive when its module is torn down
-    as a leak, which factors held by lingering objects (a notebook's results) would be."""
+    as a leak, which factors held by lingering objects (a notebook's results) would be.
+    """
 
     alive: weakref.WeakSet = weakref.WeakSet()
 
-    def __init__(self, lower: sp.csc_matrix):
+    def __init__(self, lower: sp.csr_matrix):
         from cholespy import CholeskySolverD, MatrixType  # optional
 
-        # handed over in CSR form: cholespy converts it into CSC arrays of its own, which it then
-        # sorts and resizes in place (given CSC arrays, it would do so to NumPy's buffers)
         self.factor = CholeskySolverD(lower.shape[0], lower.indptr.astype(np.int32),
                                       lower.indices.astype(np.int32), lower.data, MatrixType.CSR)
         _CholespyFactor.alive.add(self)
@@ -144,15 +150,6 @@ class _CholespyFactor:
 def _drop_cholespy_factors() -> None:
     for holder in list(_CholespyFactor.alive):
         holder.factor = None
-
-
-def _factor_cholespy(lower: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
-    # CHOLMOD (its own choice of ordering and of a supernodal or simplicial factor) as wrapped by
-    # cholespy, which ships wheels with CHOLMOD, METIS and a reference BLAS. CHOLMOD reads the
-    # lower triangle only (stype −1), which is all it is given, as a CSR matrix
-    # (:data:`_LOWER_TRIANGLE`). The solve holds the GIL and wants
-    # C-ordered right-hand sides.
-    return _CholespyFactor(lower)
 
 
 def _factor_pardiso(a: sp.csc_matrix) -> Callable[[np.ndarray], np.ndarray]:
@@ -178,7 +175,7 @@ _C_ORDER = frozenset({"cholespy"})
 #: Right-hand sides per call, by backend (see :class:`Factorization`); 16 for the others.
 _SOLVE_BATCH = {"cholespy": 8}
 
-_FACTORIZERS = {"superlu": _factor_superlu, "cholmod": _factor_cholmod, "cholespy": _factor_cholespy,
+_FACTORIZERS = {"superlu": _factor_superlu, "cholmod": _factor_cholmod, "cholespy": _CholespyFactor,
                 "pardiso": _factor_pardiso}
 
 
