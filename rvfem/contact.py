@@ -292,7 +292,7 @@ class Compliance:
         self.workers = workers or min(4, os.cpu_count() or 1)
         self.B = B
         n = B.shape[1]
-        self.C = np.zeros((n, n))
+        self.C = np.zeros((n, n), order="F")     # filled a column at a time
         self.known = np.zeros(n, dtype=bool)
         self.solve_seconds = 0.0
         self.version = 0
@@ -1025,6 +1025,7 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         Jm = np.zeros((n, n))
         r = np.zeros(n)
         si = np.flatnonzero(spring)
+        open_springs = si[(dq[si] == 0) & (q[si] == 0)]
         r[si] = lam[si] - q[si]
         Jm[si, si] = 1.0
         Jm[np.ix_(si, J)] += dq[si, None] * Gj[si]
@@ -1054,6 +1055,9 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         step = y * cscale
         lam = lam + step[:nc]
         lam[ii] = 0.0
+        # an open spring's row reads λ = q = 0 exactly; the solve leaves round-off (1e-18 N),
+        # which would mark the contact as loaded and fetch its compliance columns for nothing
+        lam[open_springs] = 0.0
         a = a + step[eq]
         if carrier:
             phi = phi + step[nc + nr]

@@ -791,9 +791,11 @@ def likely_columns(system: DiscSystem, sets: list[ContactSet]) -> np.ndarray:
         moment = np.asarray(W.T @ system.interface.resultants[:, 2])[:zp]
         gap = np.where(cset.signorini[:zp], cset.gap0[:zp], -cset.offset[:zp])
         likely = np.ones(W.shape[1], dtype=bool)
-        # a flexible disc also loads pins just past the ends of the classical loaded arc, whose
-        # lever arms are small and of either sign: keep those within 25 % of the largest arm
-        likely[:zp] = (gap <= 1e-3) & (moment * np.sign(T) <= 0.25 * np.abs(moment).max())
+        # a flexible disc also loads pins past the ends of the classical loaded arc, whose lever
+        # arms are small or of the other sign (default fan-hole case: loaded pins up to 0.68 of
+        # the largest arm on that side): keep those within half the largest arm, which leaves
+        # about 8 % of the columns to be computed when first needed
+        likely[:zp] = (gap <= 1e-3) & (moment * np.sign(T) <= 0.5 * np.abs(moment).max())
         cols.append(W[:, np.flatnonzero(likely)].indices)
     return np.unique(np.concatenate(cols))
 
