@@ -225,23 +225,24 @@ def main(argv=None) -> int:
         print(f"stage model: {sym['stage']}")
 
     # naive: a handful of angles, no reuse (full mesh, so that every angle is a real solve)
-    system = full["system"]
-    picks = thetas[:: max(1, len(thetas) // args.naive_angles)][: args.naive_angles]
-    naive = NaiveCompliance(system.model, system.interface.B)
-    naive_system = dataclasses.replace(system, compliance=naive, contact_sets={})
-    t0 = time.perf_counter()
-    for th in picks:
+    if args.naive_angles > 0:
+        system = full["system"]
+        picks = thetas[:: max(1, len(thetas) // args.naive_angles)][: args.naive_angles]
+        naive = NaiveCompliance(system.model, system.interface.B)
+        naive_system = dataclasses.replace(system, compliance=naive, contact_sets={})
+        t0 = time.perf_counter()
+        for th in picks:
+            naive.new_angle()
+            cycle.solve_angle(naive_system, float(th))
+        t_naive = (time.perf_counter() - t0) / len(picks)
+        t_cond = full["cycle_s"] / len(thetas)
+        print(f"naive: {t_naive:.2f} s/angle ({naive.factorizations / len(picks):.1f} factorisations per angle) "
+              f"vs condensed {t_cond * 1e3:.1f} ms/angle (full mesh): ratio {t_naive / t_cond:.0f}x")
+        ref = cycle.solve_angle(system, float(picks[-1]))
         naive.new_angle()
-        cycle.solve_angle(naive_system, float(th))
-    t_naive = (time.perf_counter() - t0) / len(picks)
-    t_cond = full["cycle_s"] / len(thetas)
-    print(f"naive: {t_naive:.2f} s/angle ({naive.factorizations / len(picks):.1f} factorisations per angle) "
-          f"vs condensed {t_cond * 1e3:.1f} ms/angle (full mesh): ratio {t_naive / t_cond:.0f}x")
-    ref = cycle.solve_angle(system, float(picks[-1]))
-    naive.new_angle()
-    nv = cycle.solve_angle(naive_system, float(picks[-1]))
-    print(f"  max difference of bearing loads naive vs condensed: "
-          f"{np.abs(ref.bearing_loads - nv.bearing_loads).max():.2e} N")
+        nv = cycle.solve_angle(naive_system, float(picks[-1]))
+        print(f"  max difference of bearing loads naive vs condensed: "
+              f"{np.abs(ref.bearing_loads - nv.bearing_loads).max():.2e} N")
     print(f"peak memory of this process (max RSS) {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB")
 
     if not args.no_run:

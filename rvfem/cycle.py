@@ -33,7 +33,7 @@ from .case import Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
 from .errors import CaseError
 from .geometry import crank_centres
-from .models import roller_angles
+from .models import bearing_contacts_many, roller_angles
 
 
 log = logging.getLogger(__name__)
@@ -214,39 +214,55 @@ def pin_contacts(system: DiscSystem, theta: float, pc=None):
     flank curvature at each pin's closest point (the Hertz law depends on it). ``pc`` passes the
     angle's :class:`rvfem.geometry.PinContacts` if they are already computed.
     """
-    from .geometry import pin_centres, pin_profile_contacts, profile_curvature
-    from .models import ContactGroup
+    from .geometry import pin_profile_contacts
+
+    if pc is None:
+        pc = pin_profile_contacts(system.geometry, theta)
+    return pin_contacts_many(system, [pc])[0]
+
+
+def pin_contacts_many(system: DiscSystem, pcs) -> list:
+    """:func:`pin_contacts` of many crank angles from their :class:`rvfem.geometry.PinContacts`:
+    the closest points of all of them located on the footprint grid at once."""
+    from .geometry import pin_centres, profile_curvature
+    from .models import ContactGroup, contact_columns
 
     case = system.case
     prof = system.interface.grids["profile"]
-    if pc is None:
-        pc = pin_profile_contacts(system.geometry, theta)
+    n_columns = system.interface.n_columns
     zp = case.pins.count
-    s = prof.arc_of(np.asarray(pc.point))
-    inward = -np.asarray(pc.normal)
+    if not pcs:
+        return []
+    s = prof.arc_of(np.concatenate([pc.point for pc in pcs]))
+    inward = -np.concatenate([pc.normal for pc in pcs])
     cols, wts = prof.columns_at(s, inward)   # pins push along the inward normal
-    shape = (system.interface.n_columns, zp)
-    index = (cols.ravel(), np.repeat(np.arange(zp), cols.shape[1]))
-    W = sp.csc_matrix((wts.ravel(), index), shape=shape)
-    W_load = None
+    curvature = profile_curvature(system.geometry.profile, np.concatenate([pc.segment for pc in pcs]),
+                                  np.concatenate([pc.param for pc in pcs]))
     mu = case.analysis.friction
     if mu > 0:
         # Coulomb friction along the known sliding direction: the pin centre's velocity relative
         # to the disc (the pins are taken as not rolling in their grooves); the friction force on
         # the disc drags its surface along with the pin: μ·λ·sign(v·t)·t, t the profile tangent
         h = 1e-6
-        vel = (pin_centres(case, theta + h) - pin_centres(case, theta - h)) / (2 * h)
+        vel = np.concatenate([(pin_centres(case, pc.theta + h) - pin_centres(case, pc.theta - h)) / (2 * h)
+                              for pc in pcs])
         tangent = np.stack([-inward[:, 1], inward[:, 0]], axis=1)
         slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
-        _, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
-        W_load = sp.csc_matrix((pin_load.ravel(), index), shape=shape)
-    law = system.pins.law(pc, profile_curvature(system.geometry.profile, pc.segment, pc.param))
-    rigid = law is None
-    return ContactGroup(
-        W=W, signorini=np.full(zp, rigid), gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
-        offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
-        laws=[] if rigid else [(np.arange(zp), law)], names=[f"pin {j + 1}" for j in range(zp)],
-        bearing=np.full(zp, -1), W_load=W_load)
+        load_cols, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
+    names = [f"pin {j + 1}" for j in range(zp)]
+    out = []
+    for a, pc in enumerate(pcs):
+        rows = slice(a * zp, (a + 1) * zp)
+        W_load = None if mu == 0 else contact_columns(n_columns, load_cols[rows], pin_load[rows])
+        law = system.pins.law(pc, curvature[rows])
+        rigid = law is None
+        out.append(ContactGroup(
+            W=contact_columns(n_columns, cols[rows], wts[rows]), signorini=np.full(zp, rigid),
+            gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
+            offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
+            laws=[] if rigid else [(np.arange(zp), law)], names=names,
+            bearing=np.full(zp, -1), W_load=W_load))
+    return out
 
 
 def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
@@ -276,21 +292,22 @@ def contact_sets(system: DiscSystem, thetas) -> list[tuple[ContactSet, list[str]
 
     missing = {key: float(theta) for key, theta in zip(keys, thetas) if not cached(key)}
     if missing:
-        pcs = pin_profile_contacts_many(system.geometry, list(missing.values()))
-        for (key, theta), pc in zip(missing.items(), pcs):
-            system.contact_sets[key] = (owner, _contact_set(system, theta, pc))
+        angles = list(missing.values())
+        pins = pin_contacts_many(system, pin_profile_contacts_many(system.geometry, angles))
+        bearings = bearing_contacts_many(system.bearings, system.interface, crank_centres(system.case), angles)
+        for key, p, b in zip(missing, pins, bearings):
+            system.contact_sets[key] = (owner, _contact_set(system, p, b))
     return [system.contact_sets[key][1] for key in keys]
 
 
-def _contact_set(system: DiscSystem, theta: float, pc=None) -> tuple[ContactSet, list[str]]:
-    pins = pin_contacts(system, theta, pc)
+def _contact_set(system: DiscSystem, pins, bearings) -> tuple[ContactSet, list[str]]:
+    """One angle's contact set from its pin and bearing contacts (:class:`rvfem.models.ContactGroup`)."""
     centres = crank_centres(system.case)
-    bearings = system.bearings.contacts(system.interface, centres, theta)
     zp = pins.size
-    W = sp.hstack([pins.W, bearings.W]).tocsc()
+    W = _hstack_csc(pins.W, bearings.W)
     W_load = None
     if pins.W_load is not None:
-        W_load = sp.hstack([pins.W_load, bearings.W]).tocsc()
+        W_load = _hstack_csc(pins.W_load, bearings.W)
     laws = [(idx, law) for idx, law in pins.laws] + [(zp + idx, law) for idx, law in bearings.laws]
     F = np.asarray(bearings.W.T @ system.interface.resultants[:, :2])     # force on the disc per unit λ
     cb = centres[bearings.bearing]
@@ -300,6 +317,14 @@ def _contact_set(system: DiscSystem, theta: float, pc=None) -> tuple[ContactSet,
                       np.concatenate([pins.offset, bearings.offset]), lever, laws, W_load,
                       np.concatenate([pins.bearing, bearings.bearing]))
     return cset, pins.names + bearings.names
+
+
+def _hstack_csc(a: sp.spmatrix, b: sp.spmatrix) -> sp.csc_matrix:
+    """[a b] of two CSC matrices with the same rows, by joining their arrays."""
+    a, b = sp.csc_matrix(a), sp.csc_matrix(b)
+    return sp.csc_matrix((np.concatenate([a.data, b.data]), np.concatenate([a.indices, b.indices]),
+                          np.concatenate([a.indptr, b.indptr[1:] + a.indptr[-1]])),
+                         shape=(a.shape[0], a.shape[1] + b.shape[1]))
 
 
 @dataclass(frozen=True)

@@ -37,6 +37,8 @@ __all__ = [
     "PalmgrenPins",
     "LinearPins",
     "roller_angles",
+    "bearing_contacts_many",
+    "contact_columns",
 ]
 
 
@@ -84,6 +86,29 @@ def _group(n_columns: int, rows, cols, vals, m: int, **kw) -> ContactGroup:
     return ContactGroup(W=W, **kw)
 
 
+def contact_columns(n_columns: int, columns: np.ndarray, weights: np.ndarray) -> sp.csc_matrix:
+    """W of m contacts that each load k distinct interface columns, built directly in CSC form.
+
+    Parameters
+    ----------
+    n_columns : int
+        Interface columns.
+    columns, weights : ndarray (m, k)
+        The columns of each contact and their weights (:meth:`rvfem.contact.FootprintGrid.columns_at`).
+
+    Returns
+    -------
+    scipy.sparse.csc_matrix (n_columns, m)
+        With sorted indices, as built from coordinates (zero weights kept as entries).
+    """
+    columns = np.asarray(columns)
+    m, k = columns.shape
+    order = np.argsort(columns, axis=1, kind="stable")
+    rows = np.take_along_axis(columns, order, axis=1).ravel()
+    data = np.take_along_axis(np.asarray(weights, dtype=float), order, axis=1).ravel()
+    return sp.csc_matrix((data, rows, np.arange(0, m * k + 1, k)), shape=(n_columns, m))
+
+
 class BearingModel(Protocol):
     """What a crank-bearing model provides (one instance per analysed case).
 
@@ -99,7 +124,11 @@ class BearingModel(Protocol):
         """One sentence for the report's assumptions."""
 
     def contacts(self, interface, centres: np.ndarray, theta: float) -> ContactGroup:
-        """The bearing contacts at crank angle θ (rad); ``centres`` are the bore centres (N, 2)."""
+        """The bearing contacts at crank angle θ (rad); ``centres`` are the bore centres (N, 2).
+
+        A model may also provide ``contacts_many(interface, centres, thetas)``, the list of the
+        contacts of many angles at once (faster, same result); :func:`bearing_contacts_many`
+        uses it when it is there."""
 
     def bearing_forces(self, vectors: np.ndarray, forces: np.ndarray, theta: float
                        ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
@@ -128,8 +157,19 @@ class PinModel(Protocol):
         """
 
 
+def bearing_contacts_many(bearings: BearingModel, interface, centres: np.ndarray, thetas
+                          ) -> list[ContactGroup]:
+    """The contacts of a bearing model at many crank angles: its ``contacts_many`` where it has
+    one, else its ``contacts`` angle by angle."""
+    many = getattr(bearings, "contacts_many", None)
+    if many is not None:
+        return many(interface, centres, thetas)
+    return [bearings.contacts(interface, centres, float(theta)) for theta in thetas]
+
+
 def roller_angles(case, theta: float) -> np.ndarray:
-    """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad.
+    """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad; for an
+    array of angles (n,), (n, N, Z).
 
     Measured about each bore centre from the disc's x axis. The eccentric turns by θ relative to
     the disc (the disc only translates relative to the carrier), so the cage turns by
@@ -148,8 +188,9 @@ def roller_angles(case, theta: float) -> np.ndarray:
     shift = alpha - alpha[0]
     # the revolution starts 1e-9 rad before θ = Δ_i, so that crank angles that are Δ_i up to
     # round-off (θ = 120° as 12·10° or as 210° − 90°) all fall on the same side of it
+    theta = np.asarray(theta, dtype=float)[..., None]
     cage = (np.mod(theta - shift + 1e-9, 2.0 * np.pi) - 1e-9) * (1.0 - gamma) / 2.0 + shift
-    return cage[:, None] + 2.0 * np.pi * np.arange(b.rollers)[None, :] / b.rollers
+    return cage[..., None] + 2.0 * np.pi * np.arange(b.rollers) / b.rollers
 
 
 @register_bearing_model
@@ -180,24 +221,31 @@ class RollerBearing:
                 f"each a compression-only spring ({law}), radial clearance {b.radial_clearance:g} mm")
 
     def contacts(self, interface, centres, theta):
+        return self.contacts_many(interface, centres, [theta])[0]
+
+    def contacts_many(self, interface, centres, thetas):
+        """:meth:`contacts` of many crank angles: the rollers of all of them located on each bore
+        at once."""
         b = self.case.crank_bearing
-        psi = roller_angles(self.case, theta)
-        rows, cols, vals, names, bearing = [], [], [], [], []
-        n = 0
+        psi = roller_angles(self.case, np.asarray(thetas, dtype=float))       # (n, N, Z)
+        n_angles, n_bearings, z = psi.shape
+        cols, wts = [], []
         for i, c in enumerate(centres):
             grid = interface.grids[f"bore_{i}"]
-            pts = c + b.bore_radius * np.stack([np.cos(psi[i]), np.sin(psi[i])], axis=1)
-            cc, ww = grid.columns_at(grid.arc_of(pts))
-            z = len(psi[i])
-            rows.append(cc.ravel())
-            cols.append(np.repeat(np.arange(n, n + z), 2))
-            vals.append(ww.ravel())
-            names += [f"bearing {i + 1} roller {k + 1}" for k in range(z)]
-            bearing += [i] * z
-            n += z
-        return _group(interface.n_columns, rows, cols, vals, n, signorini=np.zeros(n, dtype=bool),
-                      gap0=np.zeros(n), offset=np.full(n, -0.5 * b.radial_clearance),
-                      laws=[(np.arange(n), self._law)], names=names, bearing=np.asarray(bearing))
+            pts = c + b.bore_radius * np.stack([np.cos(psi[:, i]), np.sin(psi[:, i])], axis=-1)
+            cc, ww = grid.columns_at(grid.arc_of(pts.reshape(-1, 2)))
+            cols.append(cc.reshape(n_angles, z, 2))
+            wts.append(ww.reshape(n_angles, z, 2))
+        cols, wts = np.concatenate(cols, axis=1), np.concatenate(wts, axis=1)   # bearing after bearing
+        n = n_bearings * z
+        names = [f"bearing {i + 1} roller {k + 1}" for i in range(n_bearings) for k in range(z)]
+        bearing = np.repeat(np.arange(n_bearings), z)
+        laws = [(np.arange(n), self._law)]
+        return [ContactGroup(W=contact_columns(interface.n_columns, cols[a], wts[a]),
+                             signorini=np.zeros(n, dtype=bool), gap0=np.zeros(n),
+                             offset=np.full(n, -0.5 * b.radial_clearance), laws=laws, names=names,
+                             bearing=bearing)
+                for a in range(n_angles)]
 
     def bearing_forces(self, vectors, forces, theta):
         n, z = self.case.cranks.count, self.case.crank_bearing.rollers

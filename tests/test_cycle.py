@@ -235,3 +235,55 @@ def test_stress_envelope_is_the_maximum_over_all_angles(solid):
     # and every angle's field can be rebuilt exactly from the kept solutions
     u = cycle.displacement(system, result.solutions[2])
     assert np.allclose(u, result.fields[thetas[2]], rtol=0, atol=1e-14)
+
+
+def test_contacts_of_many_angles_are_those_built_one_by_one(fanholes):
+    """The batched pin and roller contacts (one closest-point search, W built in CSC form) equal
+    the contacts of each angle built on its own from coordinates, entry for entry."""
+    import scipy.sparse as sp
+
+    from rvfem.geometry import crank_centres, pin_centres, pin_profile_contacts, profile_curvature
+
+    case, mesh = fanholes
+    system = cycle.build_system(case, mesh)
+    thetas = np.radians([0.0, 7.0, 119.0, 359.0])
+    batched = cycle.contact_sets(system, thetas)
+    prof = system.interface.grids["profile"]
+    centres = crank_centres(case)
+    zp = case.pins.count
+    for theta, (cset, names) in zip(thetas, batched):
+        pc = pin_profile_contacts(system.geometry, theta)
+        cols, wts = prof.columns_at(prof.arc_of(pc.point), -np.asarray(pc.normal))
+        W_pins = sp.csc_matrix((wts.ravel(), (cols.ravel(), np.repeat(np.arange(zp), 4))),
+                               shape=(system.interface.n_columns, zp))
+        psi = cycle.roller_angles(case, theta)
+        rows, contacts, vals = [], [], []
+        for i, c in enumerate(centres):
+            grid = system.interface.grids[f"bore_{i}"]
+            pts = c + case.crank_bearing.bore_radius * np.stack([np.cos(psi[i]), np.sin(psi[i])], axis=1)
+            cc, ww = grid.columns_at(grid.arc_of(pts))
+            rows.append(cc.ravel())
+            contacts.append(np.repeat(zp + i * psi.shape[1] + np.arange(psi.shape[1]), 2))
+            vals.append(ww.ravel())
+        W = sp.hstack([W_pins, sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(contacts) - zp)),
+                                             shape=(system.interface.n_columns, psi.size))]).tocsc()
+        assert cset.W.has_sorted_indices
+        assert np.array_equal(cset.W.indptr, W.indptr) and np.array_equal(cset.W.indices, W.indices)
+        assert np.array_equal(cset.W.data, W.data)
+        mu = case.analysis.friction
+        assert mu > 0
+        inward = -np.asarray(pc.normal)
+        tangent = np.stack([-inward[:, 1], inward[:, 0]], axis=1)
+        h = 1e-6
+        vel = (pin_centres(case, theta + h) - pin_centres(case, theta - h)) / (2 * h)
+        slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
+        cols, wts = prof.columns_at(prof.arc_of(pc.point), inward + mu * slide[:, None] * tangent)
+        W_load = sp.csc_matrix((wts.ravel(), (cols.ravel(), np.repeat(np.arange(zp), 4))),
+                               shape=(system.interface.n_columns, zp))
+        assert np.array_equal(cset.W_load[:, :zp].toarray(), W_load.toarray())
+        assert np.array_equal(cset.W_load[:, zp:].toarray(), W[:, zp:].toarray())
+        hertz = system.pins.law(pc, profile_curvature(system.geometry.profile, pc.segment, pc.param))
+        delta = np.linspace(-1e-3, 5e-3, zp)
+        assert np.array_equal(cset.laws[0][1](delta)[0], hertz(delta)[0])
+        assert np.array_equal(cset.offset[:zp], -np.asarray(pc.gap))
+        assert names[0] == "pin 1" and names[zp] == "bearing 1 roller 1" and len(names) == zp + psi.size
