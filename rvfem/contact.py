@@ -415,20 +415,18 @@ class Compliance:
             self._back_substitute(masters[~self.known[masters]])
             mapped = need[~self.known[need]]
             ks = power[mapped]
-            slot = np.full(self.C.shape[1], -1)
             groups = [(k, part) for k in np.unique(ks) for cs_k in [mapped[ks == k]]
                       for part in np.array_split(cs_k, -(-cs_k.size // MAP_CHUNK))]
             for k, cs in groups:       # in chunks: the temporaries are (n_cols, chunk) arrays
-                J = np.unique(np.concatenate([root[c] for c in cs]))
-                # S = Qᵏ[cs, J]ᵀ from the images of J, then C[:, cs] = Qᵏ·C[:, J]·S
-                images, weights = self.rotation_image(k)
-                slot[cs] = np.arange(cs.size)
-                hit = slot[images[J]]
-                S = np.zeros((J.size, cs.size))
-                rows_j, m = np.nonzero(hit >= 0)
-                np.add.at(S, (rows_j, hit[rows_j, m]), weights[J][rows_j, m])
-                slot[cs] = -1
-                self.C[:, cs] = powers[k] @ (self.C[:, J] @ S)
+                # C[:, cs] = Qᵏ·C[:, J]·Qᵏ[cs, J]ᵀ: row c of Qᵏ holds the one or two columns of
+                # the root point (J) that turn into column c, so the middle product is a sum
+                # of at most two weighted columns of C
+                rows = powers[k][cs]
+                start, count = rows.indptr[:-1], np.diff(rows.indptr)
+                turned = self.C[:, rows.indices[start]] * rows.data[start]
+                two = np.flatnonzero(count == 2)
+                turned[:, two] += self.C[:, rows.indices[start[two] + 1]] * rows.data[start[two] + 1]
+                self.C[:, cs] = powers[k] @ turned
             self.known[mapped] = True
             self.columns_mapped += mapped.size
         self.version += 1
