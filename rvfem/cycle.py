@@ -18,6 +18,7 @@ angle reuses it through the lazily filled column compliance of :mod:`rvfem.conta
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 import time
@@ -403,12 +404,14 @@ def solve_angle(system: DiscSystem, theta: float, start: AngleResult | None = No
     return angle_result(system, theta, sol, cset)
 
 
-def angle_result(system: DiscSystem, theta: float, sol: AngleSolution, cset: ContactSet) -> AngleResult:
-    """Unpack a solved contact problem into pin and bearing loads (the bearing model's)."""
+def angle_result(system: DiscSystem, theta: float, sol: AngleSolution, cset: ContactSet,
+                 origin: tuple | None = None) -> AngleResult:
+    """Unpack a solved contact problem into pin and bearing loads (the bearing model's);
+    ``origin`` as in :class:`AngleResult`."""
     zp = system.case.pins.count
     bearing, rollers, angles = system.bearings.bearing_forces(sol.vectors[zp:], sol.force[zp:], theta)
     return AngleResult(theta, bearing, rollers, angles, sol.force[:zp], sol.vectors[:zp],
-                       sol.gap[:zp], sol.carrier_rotation, sol, cset)
+                       sol.gap[:zp], sol.carrier_rotation, sol, cset, origin)
 
 
 def turn_result(system: DiscSystem, result: AngleResult, k: int,
@@ -454,17 +457,20 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     key = ("map", id(old), id(cset), k, id(system.compliance))
     hit = system.contact_sets.get(key)
     if hit is None or hit[0][0] is not old or hit[0][1] is not cset or hit[0][2] is not system.compliance:
-        Qk = system.compliance.rotation_image(k)
         pairs = [(old.W, cset.W)]
         if old.W_load is not None or cset.W_load is not None:      # friction: the load weights map too
             pairs.append((old.load_weights, cset.load_weights))
-        hit = system.contact_sets[key] = ((old, cset, system.compliance), _contact_map(Qk, *pairs))
+        M = _permutation_map(system.compliance.rotation_power(k), *pairs)
+        if M is None:
+            M = _contact_map(system.compliance.rotation_image(k), *pairs)
+        hit = system.contact_sets[key] = ((old, cset, system.compliance), M)
     M = hit[1]
-    checks = [(M @ old.gap0, cset.gap0), (M @ old.offset, cset.offset), (M @ old.lever, cset.lever)]
-    for mapped, direct in checks:     # gaps, offsets and levers (mm; 1e-9 mm absolute)
-        if np.size(direct) and not np.allclose(mapped, direct, rtol=1e-8, atol=1e-9):
-            raise ValueError(f"the contacts at {math.degrees(theta):.3f}° are not the turned contacts of "
-                             f"{math.degrees(result.theta):.3f}°")
+    # gaps, offsets and levers (mm; 1e-9 mm absolute, 1e-8 relative)
+    mapped = M @ np.stack([old.gap0, old.offset, old.lever], axis=1)
+    direct = np.stack([cset.gap0, cset.offset, cset.lever], axis=1)
+    if np.any(np.abs(mapped - direct) > 1e-9 + 1e-8 * np.abs(direct)):
+        raise ValueError(f"the contacts at {math.degrees(theta):.3f}° are not the turned contacts of "
+                         f"{math.degrees(result.theta):.3f}°")
     sol = result.solution
     lam = M @ sol.force
     WL = cset.load_weights
@@ -475,7 +481,7 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     turned = AngleSolution(lam, vectors, M @ sol.gap, rigid, sol.carrier_rotation, sol.iterations,
                            dict(sol.residual))
     root, k0 = result.origin if result.origin is not None else (result, 0)
-    return dataclasses.replace(angle_result(system, theta, turned, cset), origin=(root, k0 + k))
+    return angle_result(system, theta, turned, cset, origin=(root, k0 + k))
 
 
 def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
@@ -492,6 +498,55 @@ def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
     if abs(out.theta - theta) > 1e-9:
         raise ValueError(f"turned angle {out.theta} does not land on {theta}")
     return out
+
+
+@functools.lru_cache(maxsize=8)
+def _probes(n_columns: int) -> np.ndarray:
+    """Two fixed random vectors over the interface columns (n_columns, 2), read-only."""
+    z = np.random.default_rng(20261123).standard_normal((n_columns, 2))
+    z.flags.writeable = False
+    return z
+
+
+def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix]) -> np.ndarray | None:
+    """M of :func:`_contact_map` when it is a permutation (pins and rollers turn into pins and
+    rollers), else None.
+
+    Found and checked with two random probes z over the columns: the turned weights of contact j
+    and the weights of its image σ(j) are the same column, Qk·W0[:, j] = W1[:, σ(j)], so
+    (W0ᵀ·Qkᵀ·z)[j] = (W1ᵀ·z)[σ(j)] for both probes, within 1e-8 of the weights' scale; σ pairs
+    each value with the nearest one. Two different columns give the same two values with
+    probability zero, so the check is that of the columns themselves (on every pair: the gap
+    weights and, with friction, the load weights), at the cost of a few sparse products.
+    """
+    def weighted(W, z):                                       # Wᵀ·z from the CSC arrays
+        contact = np.repeat(np.arange(W.shape[1]), np.diff(W.indptr))
+        values = W.data[:, None] * z[W.indices]
+        return np.stack([np.bincount(contact, values[:, i], W.shape[1]) for i in range(z.shape[1])], axis=1)
+
+    sigma = None
+    for W0, W1 in pairs:
+        W0, W1 = (W if sp.isspmatrix_csc(W) else sp.csc_matrix(W) for W in (W0, W1))
+        if W1.shape != W0.shape or W0.nnz == 0:
+            return None
+        z = _probes(W0.shape[0])
+        turned = weighted(W0, np.asarray(Qk.T @ z))           # (n_contacts, 2)
+        direct = weighted(W1, z)
+        tol = 1e-8 * float(np.abs(W0.data).max()) * float(np.abs(z).max()) * max(int(np.diff(W0.indptr).max()), 1)
+        if sigma is None:
+            order = np.argsort(direct[:, 0], kind="stable")
+            ranked = direct[order, 0]
+            pos = np.clip(np.searchsorted(ranked, turned[:, 0]), 1, len(ranked) - 1)
+            nearer = np.where(np.abs(ranked[pos - 1] - turned[:, 0]) <= np.abs(ranked[pos] - turned[:, 0]),
+                              pos - 1, pos) if len(ranked) > 1 else np.zeros(len(turned), dtype=int)
+            sigma = order[nearer]
+            if len(np.unique(sigma)) != len(sigma):
+                return None
+        if np.abs(direct[sigma] - turned).max() > tol:
+            return None
+    M = np.zeros((len(sigma), len(sigma)))
+    M[sigma, np.arange(len(sigma))] = 1.0
+    return M
 
 
 def _contact_map(Qk: tuple[np.ndarray, np.ndarray], *pairs: tuple[sp.spmatrix, sp.spmatrix]) -> np.ndarray:

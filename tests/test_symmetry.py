@@ -179,3 +179,27 @@ def test_turning_onto_contacts_that_are_not_the_turned_ones_is_refused(fan_syste
         cycle.turn_result(s, solved, 1, wrong)
     right, _ = cycle.contact_set(s, 0.3 + 2 * math.pi / 3)
     assert cycle.turn_result(s, solved, 1, right).origin == (solved, 1)
+
+
+def test_probe_map_is_the_column_by_column_map_of_the_turned_contacts(fan_system):
+    """The permutation of pins and rollers found with random probes is the map found by matching
+    the turned weight columns one by one; contacts that turn into combinations of contacts (the
+    x and y springs of a rigid bore) have none, and the least-squares map takes over."""
+    s = fan_system
+    for theta, k in ((0.3, 1), (1.1, 2)):
+        old, _ = cycle.contact_set(s, theta)
+        new, _ = cycle.contact_set(s, theta + k * 2 * math.pi / 3)
+        pairs = [(old.W, new.W), (old.load_weights, new.load_weights)]
+        probe = cycle._permutation_map(s.compliance.rotation_power(k), *pairs)
+        dense = cycle._contact_map(s.compliance.rotation_image(k), *pairs)
+        # the same permutation; the factors of the column-by-column map are 1 to round-off
+        assert probe is not None and np.array_equal(probe != 0, np.abs(dense) > 1e-9)
+        assert np.abs(probe - dense).max() <= 1e-10
+        assert np.array_equal(probe.sum(axis=0), np.ones(len(probe)))
+    bore = cycle.build_system(s.case, s.mesh, bearing_model="rigid_bore")
+    old, _ = cycle.contact_set(bore, 0.3)
+    new, _ = cycle.contact_set(bore, 0.3 + 2 * math.pi / 3)
+    assert cycle._permutation_map(bore.compliance.rotation_power(1), (old.W, new.W)) is None
+    turned = cycle.turn_result(bore, cycle.solve_angle(bore, 0.3), 1, new)
+    direct = cycle.solve_angle(bore, 0.3 + 2 * math.pi / 3)
+    assert np.abs(turned.bearing_forces - direct.bearing_forces).max() <= 1e-7 * direct.bearing_loads.max()
