@@ -32,7 +32,7 @@ from . import contact, registry
 from ._arrays import max_load_index
 from .case import Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
-from .errors import CaseError
+from .errors import CaseError, ContactError
 from .geometry import crank_centres
 from .models import bearing_contacts_many, roller_angles
 
@@ -484,6 +484,25 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     return angle_result(system, theta, turned, cset, origin=(root, k0 + k))
 
 
+def solve_from_last(solve, last: list):
+    """``solve(start)`` for the next of equally spaced angles, ``last`` the results of the (up to
+    two) angles before it: started from their linear extrapolation
+    (:func:`rvfem.contact.extrapolated_start`), or from the last result if that start does not
+    settle. Results are :class:`AngleResult` or :class:`rvfem.reducer.PairResult` (disc by disc)."""
+    if len(last) < 2:
+        return solve(last[-1] if last else None)
+
+    def extrapolated(before, after):
+        if isinstance(after, AngleResult):
+            return dataclasses.replace(after, solution=contact.extrapolated_start(before.solution, after.solution))
+        return dataclasses.replace(after, results=tuple(extrapolated(b, a) for b, a in zip(before.results, after.results)))
+
+    try:
+        return solve(extrapolated(*last))
+    except ContactError:
+        return solve(last[-1])
+
+
 def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
                   contacts: ContactSet | None = None) -> AngleResult:
     """:func:`turn_result` of ``source`` by k steps, checked to land on ``theta``; solved
@@ -931,7 +950,8 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
             solved: list[AngleResult] = []
             prev = None
             for i in solve_at:
-                prev = solve_angle(system, float(thetas[i]), prev, contacts=sets[i])
+                prev = solve_from_last(lambda start: solve_angle(system, float(thetas[i]), start, contacts=sets[i]),
+                                   solved[-2:])
                 solved.append(prev)
                 if progress is not None:
                     progress(len(solved) * len(thetas) // len(solve_at), len(thetas))

@@ -433,7 +433,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
         stage's description).
     """
-    from .cycle import contact_set, contact_sets, likely_columns, symmetry_plan, turn_result
+    from .cycle import solve_from_last, contact_set, contact_sets, likely_columns, symmetry_plan, turn_result
 
     thetas = np.asarray(thetas, dtype=float)
     n = len(thetas)
@@ -462,10 +462,8 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
                                                for i in solve_at for k in ks]))
     log.info("stage compliance prefetch %.2f s", time.perf_counter() - t0)
     pairs: list[PairResult] = []
-    prev = None
     for i in solve_at:
-        prev = solve_pair(stage, float(thetas[i]), prev)
-        pairs.append(prev)
+        pairs.append(solve_from_last(lambda start: solve_pair(stage, float(thetas[i]), start), pairs[-2:]))
         if progress is not None:
             progress(len(pairs) * n // len(solve_at), n)
     results, torque, forces, w = [], [], [], []
