@@ -287,3 +287,26 @@ def test_contacts_of_many_angles_are_those_built_one_by_one(fanholes):
         assert np.array_equal(cset.laws[0][1](delta)[0], hertz(delta)[0])
         assert np.array_equal(cset.offset[:zp], -np.asarray(pc.gap))
         assert names[0] == "pin 1" and names[zp] == "bearing 1 roller 1" and len(names) == zp + psi.size
+
+
+def test_extrapolated_start_gives_the_solution_of_the_last_angle_as_start(solid):
+    """An angle started from the extrapolation of the two before it converges to the solution
+    started from the last one (within the iteration's tolerance) in fewer iterations; a start
+    that does not settle falls back to the last solution."""
+    case, mesh = solid
+    system = cycle.build_system(case, mesh)
+    a, b = (cycle.solve_angle(system, t) for t in (0.0, STEP / 10))
+    theta = 2 * STEP / 10
+    plain = cycle.solve_angle(system, theta, b)
+    extrapolated = cycle.solve_from_last(lambda start: cycle.solve_angle(system, theta, start), [a, b])
+    scale = plain.bearing_loads.max()
+    assert np.abs(extrapolated.bearing_forces - plain.bearing_forces).max() <= 1e-8 * scale
+    assert extrapolated.solution.iterations < plain.solution.iterations
+
+    def refuses_extrapolation(start):
+        if start is not b:
+            raise ContactError("does not settle")
+        return cycle.solve_angle(system, theta, start)
+
+    fallback = cycle.solve_from_last(refuses_extrapolation, [a, b])
+    assert np.array_equal(fallback.bearing_forces, plain.bearing_forces)
