@@ -1057,12 +1057,23 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         for k in range(nb):
             for d in dropped:
                 Jm[nc + 3 * k + d, nc + 3 * k + d] = 1.0
-        cscale = colscale[:n]
+        # the rows of open springs (dq = 0) and of inactive rigid contacts read λ_i = q_i, λ_i = 0:
+        # their steps are known, and the rest is a smaller system (half the size: about half the
+        # contacts are open)
+        known = np.zeros(n, dtype=bool)
+        known[si[dq[si] == 0]] = True
+        known[ii] = True
+        fixed, free = np.flatnonzero(known), np.flatnonzero(~known)
+        step = np.zeros(n)
+        step[fixed] = -r[fixed]
+        cscale = colscale[free]
+        A = Jm[np.ix_(free, free)] * cscale[None, :]
+        rhs = -r[free] - Jm[np.ix_(free, fixed)] @ step[fixed]
         try:
-            y = np.linalg.solve(Jm * cscale[None, :], -r)
+            y = np.linalg.solve(A, rhs)
         except np.linalg.LinAlgError:
-            y = np.linalg.lstsq(Jm * cscale[None, :], -r, rcond=None)[0]
-        step = y * cscale
+            y = np.linalg.lstsq(A, rhs, rcond=None)[0]
+        step[free] = y * cscale
         lam = lam + step[:nc]
         lam[ii] = 0.0
         # an open spring's row reads λ = q = 0 exactly; the solve leaves round-off (1e-18 N),
