@@ -282,11 +282,14 @@ class Compliance:
         Column map of the disc's N-fold rotation symmetry (:func:`column_rotation`).
     order : int
         N, the order of ``rotation``.
+    free : (ndarray, callable), optional
+        The free DOFs of K_s and the solve on them alone (:meth:`rvfem.fem.Factorization.solve_free`):
+        the columns are then back-substituted on the free DOFs (faster, equal to round-off).
     """
 
     def __init__(self, solve, B: sp.csc_matrix, batch: int = 16, workers: int | None = None, *,
                  rigid_modes: np.ndarray | None = None, vertex_dofs: np.ndarray | None = None,
-                 rotation: sp.spmatrix | None = None, order: int = 1):
+                 rotation: sp.spmatrix | None = None, order: int = 1, free=None):
         self._solve = solve
         self.batch = batch  # right-hand sides per back-substitution call (measured optimum)
         self.workers = workers or min(4, os.cpu_count() or 1)
@@ -308,6 +311,14 @@ class Compliance:
             self._rigid = (R, Rv, H, np.asarray(B.T @ R))   # Bᵀ R: (n_cols, 3)
         elif rotation is not None:
             raise ValueError("a rotation map needs the floating compliance (give rigid_modes)")
+        self._free = None
+        if free is not None and self._rigid is not None:
+            dofs, solve_free = free
+            dofs = np.asarray(dofs)
+            B_f = sp.csc_matrix(B[dofs])
+            Rv_f = np.ascontiguousarray(Rv[dofs])
+            Z_f = solve_free(Rv_f @ H.T)                    # K_ff⁻¹ (R_v Hᵀ), (n_free, 3)
+            self._free = (solve_free, B_f, B_f.T.tocsr(), Rv_f, np.asarray(B_f.T @ Z_f), Rv_f.T @ Z_f)
         self.order = int(order) if rotation is not None else 1
         self._orbits = None if rotation is None else _column_orbits(sp.csr_matrix(rotation), self.order)
         self._images = {}
@@ -385,8 +396,16 @@ class Compliance:
         if self._rigid is None:
             return np.asarray(self.B.T @ self._solve(Bp.toarray()))
         R, Rv, H, BtR = self._rigid
-        X = self._solve(Bp.toarray() - Rv @ (H.T @ np.asarray(Bp.T @ R).T))   # K_s⁻¹ Πᵀ B_part
-        return np.asarray(self.B.T @ X) - BtR @ (H @ (Rv.T @ X))               # Bᵀ Π X
+        if self._free is None:
+            X = self._solve(Bp.toarray() - Rv @ (H.T @ np.asarray(Bp.T @ R).T))   # K_s⁻¹ Πᵀ B_part
+            return np.asarray(self.B.T @ X) - BtR @ (H @ (Rv.T @ X))               # Bᵀ Π X
+        # on the free DOFs, by superposition: K_s⁻¹ Πᵀ B_part = Y − Z·c with Y = K_ff⁻¹ B_part,
+        # Z = K_ff⁻¹ R_v Hᵀ and c = Rᵀ B_part; the right-hand sides stay sparse (the solve skips
+        # their zeros) and nothing is copied through the whole DOF numbering
+        solve_free, B_f, B_fT, Rv_f, BtZ, RvtZ = self._free
+        Y = solve_free(B_f[:, part].toarray())
+        c = BtR[part].T
+        return (np.asarray(B_fT @ Y) - BtZ @ c) - BtR @ (H @ (Rv_f.T @ Y - RvtZ @ c))
 
     def ensure(self, columns: np.ndarray) -> None:
         """Make sure ``C[:, columns]`` is available.

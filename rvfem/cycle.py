@@ -199,7 +199,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B, factor.batch, None if factor.concurrent else 1, rigid_modes=rigid,
                             vertex_dofs=model.node_dofs[:model.n_vertices].ravel(),
-                            rotation=rotation, order=symmetry)
+                            rotation=rotation, order=symmetry, free=(factor.free_dofs, factor.solve_free))
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
                       stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
                       pin_stiffness_N_per_mm, times, bearings, pins, symmetry, node_rotation)

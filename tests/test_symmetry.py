@@ -203,3 +203,21 @@ def test_probe_map_is_the_column_by_column_map_of_the_turned_contacts(fan_system
     turned = cycle.turn_result(bore, cycle.solve_angle(bore, 0.3), 1, new)
     direct = cycle.solve_angle(bore, 0.3 + 2 * math.pi / 3)
     assert np.abs(turned.bearing_forces - direct.bearing_forces).max() <= 1e-7 * direct.bearing_loads.max()
+
+
+def test_columns_on_the_free_dofs_equal_the_projected_back_substitution(fan_system):
+    """The columns back-substituted on the free DOFs by superposition (sparse right-hand sides,
+    the rigid-mode part solved once) against the balanced load solved through the whole DOF
+    numbering, the definition C = Bᵀ Π K_s⁻¹ Πᵀ B."""
+    s = fan_system
+    vertex_dofs = s.model.node_dofs[:s.model.n_vertices].ravel()
+    plain = contact.Compliance(s.solve, s.interface.B, rigid_modes=s.rigid_modes, vertex_dofs=vertex_dofs)
+    assert s.compliance._free is not None
+    cols = np.random.default_rng(2).choice(s.interface.n_columns, 40, replace=False)
+    plain.ensure(cols)
+    factor = s.solve.__self__              # the system's Factorization
+    fresh = contact.Compliance(s.solve, s.interface.B, rigid_modes=s.rigid_modes, vertex_dofs=vertex_dofs,
+                               free=(factor.free_dofs, factor.solve_free))
+    fresh.ensure(cols)
+    scale = np.abs(plain.C[:, cols]).max()
+    assert np.abs(fresh.C[:, cols] - plain.C[:, cols]).max() <= 1e-12 * scale
