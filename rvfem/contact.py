@@ -1054,7 +1054,6 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         Jm = np.zeros((n, n))
         r = np.zeros(n)
         si = np.flatnonzero(spring)
-        open_springs = si[(dq[si] == 0) & (q[si] == 0)]
         r[si] = lam[si] - q[si]
         Jm[si, si] = 1.0
         Jm[np.ix_(si, J)] += dq[si, None] * Gj[si]
@@ -1077,8 +1076,9 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
             for d in dropped:
                 Jm[nc + 3 * k + d, nc + 3 * k + d] = 1.0
         # the rows of open springs (dq = 0) and of inactive rigid contacts read λ_i = q_i, λ_i = 0:
-        # their steps are known, and the rest is a smaller system (half the size: about half the
-        # contacts are open)
+        # their steps are known, and the rest is a smaller system (about half the contacts are
+        # open). An open spring's force becomes exactly 0: a solve of the whole system would leave
+        # round-off (1e-18 N), which would mark it as loaded and fetch its compliance columns
         known = np.zeros(n, dtype=bool)
         known[si[dq[si] == 0]] = True
         known[ii] = True
@@ -1095,9 +1095,6 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         step[free] = y * cscale
         lam = lam + step[:nc]
         lam[ii] = 0.0
-        # an open spring's row reads λ = q = 0 exactly; the solve leaves round-off (1e-18 N),
-        # which would mark the contact as loaded and fetch its compliance columns for nothing
-        lam[open_springs] = 0.0
         a = a + step[eq]
         if carrier:
             phi = phi + step[nc + nr]
