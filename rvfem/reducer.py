@@ -416,7 +416,8 @@ def default_stage(system) -> ReducerStage | None:
 
 
 def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
-    """Solve the stage at every crank angle, warm-starting from the previous one.
+    """Solve the stage at every crank angle, each pair started from the ones before it
+    (:func:`rvfem.cycle.solve_from_last`).
 
     Only the angles that symmetry does not give are solved (:func:`rvfem.cycle.symmetry_plan`):
     with :attr:`ReducerStage.mirrored_pairs` the pair at θ + 180° is the pair at θ with the discs
@@ -433,7 +434,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
         stage's description).
     """
-    from .cycle import solve_from_last, contact_set, contact_sets, likely_columns, symmetry_plan, turn_result
+    from .cycle import contact_set, contact_sets, likely_columns, solve_from_last, symmetry_plan, turn_result
 
     thetas = np.asarray(thetas, dtype=float)
     n = len(thetas)
