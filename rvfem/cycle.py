@@ -322,7 +322,7 @@ def _contact_set(system: DiscSystem, pins, bearings) -> tuple[ContactSet, list[s
 
 def _hstack_csc(a: sp.spmatrix, b: sp.spmatrix) -> sp.csc_matrix:
     """[a b] of two CSC matrices with the same rows, by joining their arrays."""
-    a, b = sp.csc_matrix(a), sp.csc_matrix(b)
+    a, b = (m if sp.isspmatrix_csc(m) else sp.csc_matrix(m) for m in (a, b))
     return sp.csc_matrix((np.concatenate([a.data, b.data]), np.concatenate([a.indices, b.indices]),
                           np.concatenate([a.indptr, b.indptr[1:] + a.indptr[-1]])),
                          shape=(a.shape[0], a.shape[1] + b.shape[1]))

@@ -392,13 +392,25 @@ def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = Non
 
 def _pair(stage: ReducerStage, results: tuple) -> PairResult:
     """A PairResult from each disc's solution (disc A first)."""
-    phases = [0.0, stage.second_phase][:len(results)]
-    forces = np.stack([r.bearing_forces @ _rotation(beta).T for r, beta in zip(results, phases)])
-    torque = np.array([r.solution.residual["torque_Nmm"] for r in results])
+    return PairResult(results, *_stage_loads(stage, [r.bearing_forces for r in results],
+                                             [r.solution.residual["torque_Nmm"] for r in results]))
+
+
+def _stage_loads(stage: ReducerStage, bearing_forces: list, torques: list):
+    """The bearing forces of each disc in the carrier frame (discs, N, 2), the discs' torques and
+    the eccentric displacements, from each disc's bearing forces in its own frame (disc A first)."""
+    phases = [0.0, stage.second_phase][:len(bearing_forces)]
+    forces = np.stack([f @ _rotation(beta).T for f, beta in zip(bearing_forces, phases)])
     w = np.zeros_like(forces)
     if stage.influence is not None:
         w = -np.einsum("kl,lnj->knj", stage.influence, forces)
-    return PairResult(results, forces, torque, w)
+    return forces, np.array(torques), w
+
+
+def _turned_bearing_forces(result, k: int, order: int) -> np.ndarray:
+    """The bearing forces (N, 2) of ``result`` turned by k·2π/N: bearing i's force, turned, is
+    bearing i + k's (the same as :func:`rvfem.cycle.turn_result` gives, to round-off)."""
+    return np.roll(result.bearing_forces @ _rotation(2.0 * math.pi * k / order).T, k, axis=0)
 
 
 def default_stage(system) -> ReducerStage | None:
@@ -449,12 +461,16 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
     def cset(k, theta):
         return contact_set(systems[k], theta)[0]
 
-    # the contacts of every angle a disc is solved or turned to, built in one sweep per system
+    # the contacts of every angle a disc is solved at and of every angle disc A is turned to,
+    # built in one sweep per system
     wanted = [[] for _ in systems]
     for j, (i, swap, k) in enumerate(source):
         own = _disc_angles(stage, float(thetas[i]))
-        for d in range(len(systems)):
-            wanted[d].append(own[d] if (swap, k) == (0, 0) else own[d ^ swap] + k * step)
+        if (swap, k) == (0, 0):
+            for d in range(len(systems)):
+                wanted[d].append(own[d])
+        else:
+            wanted[0].append(own[swap] + k * step)
     for d, s in enumerate(systems):
         contact_sets(s, wanted[d])               # the solved angles are among them (source[i] = i)
     for s in {id(s): s for s in systems}.values():
@@ -474,21 +490,28 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
             src = src[::-1]                      # mirrored pair: disc B is disc A at θ + π
         if (swap, k) == (0, 0):
             p = pairs[i]
+            loads = (p.bearing_forces, p.torque_Nmm, p.eccentric_displacement)
+            first = p.results[0]
         else:
-            # each disc's solution turned by k steps; disc B may land at θ_j + π − 2π when the
-            # discs are swapped: the same state, the cycle being 2π-periodic (roller_angles)
+            # disc A's solution turned by k steps (its contacts checked against the turned ones);
+            # disc B, which may land at θ_j + π − 2π when the discs are swapped (the same state,
+            # the cycle being 2π-periodic: roller_angles), enters only through its bearing forces
+            # and torque, turned and unchanged
             try:
-                p = _pair(stage, tuple(turn_result(systems[d], r, k, cset(d, r.theta + k * step))
-                                       for d, r in enumerate(src)))
+                first = turn_result(systems[0], src[0], k, cset(0, src[0].theta + k * step))
+                loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
+                                     [r.solution.residual["torque_Nmm"] for r in (first,) + tuple(src[1:])])
             except ValueError as exc:
                 log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(thetas[j]))
                 p = solve_pair(stage, float(thetas[j]), pairs[i])
-            if abs(p.results[0].theta - thetas[j]) > 1e-9:
-                raise RuntimeError(f"symmetry plan lands at {p.results[0].theta} instead of {thetas[j]}")
-        results.append(p.results[0])
-        torque.append(p.torque_Nmm)
-        forces.append(p.bearing_forces)
-        w.append(p.eccentric_displacement)
+                loads = (p.bearing_forces, p.torque_Nmm, p.eccentric_displacement)
+                first = p.results[0]
+            if abs(first.theta - thetas[j]) > 1e-9:
+                raise RuntimeError(f"symmetry plan lands at {first.theta} instead of {thetas[j]}")
+        results.append(first)
+        forces.append(loads[0])
+        torque.append(loads[1])
+        w.append(loads[2])
     extras = {
         "disc_torque_Nmm": np.array(torque),
         "disc_bearing_forces": np.array(forces),

@@ -142,6 +142,10 @@ def test_turned_pairs_equal_directly_solved_pairs(fan_system):
         scale = np.abs(direct.bearing_forces).max()
         assert np.abs(direct.bearing_forces[0] - result.bearing_forces[j]).max() <= 1e-7 * scale
         assert np.abs(direct.torque_Nmm - result.disc_torque_Nmm[j]).max() <= 1e-7 * abs(stage.torque_Nmm)
+        # disc B's loads, turned without its contacts, in the carrier frame, and the eccentrics
+        assert np.abs(direct.bearing_forces - result.disc_bearing_forces[j]).max() <= 1e-7 * scale
+        w = np.abs(direct.eccentric_displacement).max()
+        assert w > 0 and np.abs(direct.eccentric_displacement - result.eccentric_displacement[j]).max() <= 1e-7 * w
 
 
 def test_symmetric_mesh_agrees_with_the_full_mesh_within_the_discretisation(fan_system, fan_full):
