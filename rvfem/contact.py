@@ -970,9 +970,14 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         # column j of G is valid once the load columns of contact j are known (C is filled
         # column-wise and symmetric, so the rows of every other contact come with it)
         touched = np.unique(np.concatenate([W.indices, WL.indices]))
-        WLsub = WL[touched, :]
+        # the weights on the touched columns alone: the same CSC arrays with the column indices
+        # renumbered (W's arrays read as CSR are Wᵀ)
+        Wsub_T = sp.csr_matrix((W.data, np.searchsorted(touched, W.indices), W.indptr),
+                               shape=(W.shape[1], len(touched)))
+        WLsub = sp.csc_matrix((WL.data, np.searchsorted(touched, WL.indices), WL.indptr),
+                              shape=(len(touched), WL.shape[1]))
         # sparse: each contact touches two to four columns, so Wᵀ·C·W_load costs O(touched²)
-        subs.append((touched, W[touched, :].T.tocsr(), WLsub.tocsc(), WLsub.toarray() != 0))
+        subs.append((touched, Wsub_T, WLsub, WLsub.toarray() != 0))
     moment = RL[:, 2::3].sum(axis=1)                 # Mz of each contact on its own body
     carrier = torque is not None                     # without a carrier: no φ unknown
     torque = 0.0 if torque is None else torque
