@@ -24,7 +24,9 @@ and prints the ratios the design asks for: cycle / (assembly + factorisation), n
 per angle, two-disc / single-disc cycle and symmetric / full, plus the peak memory of the
 process and of the ``rvfem run`` subprocess and each of its child processes.
 
-Run: ``python benchmarks/bench_cycle.py [CASE] [--naive-angles 5] [--step 1] [--no-run]``.
+Run: ``python benchmarks/bench_cycle.py [CASE] [--naive-angles 5] [--step 1] [--no-run] [--repeat 5]``
+(``--repeat`` reports the medians of several measurements: the column time varies by about 15 %
+from run to run on a shared machine).
 """
 
 from __future__ import annotations
@@ -112,6 +114,17 @@ def measure(case, mesh_dir: str, thetas: np.ndarray) -> dict:
     return out
 
 
+def measure_repeated(case, mesh_dir: str, thetas: np.ndarray, repeat: int) -> dict:
+    """:func:`measure` ``repeat`` times; every time is the median over the repeats, the rest is
+    from the last one (the counts and loads do not change)."""
+    runs = [measure(case, mesh_dir, thetas) for _ in range(max(1, repeat))]
+    out = dict(runs[-1])
+    for key, value in out.items():
+        if key.endswith("_s") and isinstance(value, float):
+            out[key] = float(np.median([r[key] for r in runs]))
+    return out
+
+
 def _high_water_mib(pid: int) -> float:
     """VmHWM of a live process (Linux), MiB; 0 when it cannot be read (gone, not Linux)."""
     try:
@@ -179,12 +192,18 @@ def main(argv=None) -> int:
     ap.add_argument("--step", type=float, default=1.0, help="crank-angle step of the cycle, deg")
     ap.add_argument("--mesh-dir", default="meshes")
     ap.add_argument("--no-run", action="store_true", help="skip the rvfem run subprocess")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="measure set-up and cycles this many times and report the medians (the column "
+                         "time varies by about 15 %% from run to run on a shared machine)")
     args = ap.parse_args(argv)
 
     case = load_case(args.case)
     full_case = dataclasses.replace(case, mesh=dataclasses.replace(case.mesh, symmetric=False))
     thetas = np.radians(np.arange(0.0, 360.0, args.step))
-    rows = {"symmetric": measure(case, args.mesh_dir, thetas), "full": measure(full_case, args.mesh_dir, thetas)}
+    rows = {"symmetric": measure_repeated(case, args.mesh_dir, thetas, args.repeat),
+            "full": measure_repeated(full_case, args.mesh_dir, thetas, args.repeat)}
+    if args.repeat > 1:
+        print(f"times are medians of {args.repeat} repeats (each from empty caches)")
     print(f"case {case.name}, {len(thetas)} crank angles at {args.step}°, solver {fem.available_solvers()[0]}")
     print(f"{'':34s}{'symmetric mesh':>16s}{'full mesh':>16s}")
 
