@@ -321,7 +321,6 @@ class Compliance:
             self._free = (solve_free, B_f, B_f.T.tocsr(), Rv_f, np.asarray(B_f.T @ Z_f), Rv_f.T @ Z_f)
         self.order = int(order) if rotation is not None else 1
         self._orbits = None if rotation is None else _column_orbits(sp.csr_matrix(rotation), self.order)
-        self._images = {}
         self._lock = threading.Lock()
 
     @property
@@ -334,26 +333,6 @@ class Compliance:
         if self._orbits is None:
             raise ValueError("this compliance has no rotation map")
         return self._orbits[2][int(k) % self.order]
-
-    def rotation_image(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """Qᵏ column by column: the (at most two) columns each column turns into and their
-        weights, (n_cols, 2) each (weight 0 pads a single image), so that
-        ``(Qᵏ·W)[images[c, m], j] += weights[c, m]·W[c, j]``."""
-        k = int(k) % self.order
-        if k not in self._images:
-            Q = self.rotation_power(k).tocsc()
-            counts = np.diff(Q.indptr)
-            if counts.max() > 2 or counts.min() < 1:
-                raise ValueError("a column turns into more than two columns")
-            n = Q.shape[1]
-            images = np.repeat(np.arange(n)[:, None], 2, axis=1)
-            weights = np.zeros((n, 2))
-            slot = np.arange(Q.nnz) - np.repeat(Q.indptr[:-1], counts)
-            cols = np.repeat(np.arange(n), counts)
-            images[cols, slot] = Q.indices
-            weights[cols, slot] = Q.data
-            self._images[k] = (images, weights)
-        return self._images[k]
 
     def field(self, load: np.ndarray) -> np.ndarray:
         """Displacement (n_dofs,) or (n_dofs, m) of the disc under nodal loads, mm, in the frame

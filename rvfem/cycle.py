@@ -462,7 +462,7 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
             pairs.append((old.load_weights, cset.load_weights))
         M = _permutation_map(system.compliance.rotation_power(k), *pairs)
         if M is None:
-            M = _contact_map(system.compliance.rotation_image(k), *pairs)
+            M = _contact_map(system.compliance.rotation_power(k), *pairs)
         hit = system.contact_sets[key] = ((old, cset, system.compliance), M)
     M = hit[1]
     # gaps, offsets and levers (mm; 1e-9 mm absolute, 1e-8 relative)
@@ -569,78 +569,36 @@ def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix]) -
     return M
 
 
-def _contact_map(Qk: tuple[np.ndarray, np.ndarray], *pairs: tuple[sp.spmatrix, sp.spmatrix]) -> np.ndarray:
+def _contact_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix]) -> np.ndarray:
     """M (n_contacts × n_contacts) with W1·M = Qk·W0 for the first pair (W0, W1) of contact
     weights, checked on every pair (the gap weights and, with friction, the load weights);
     ValueError if there is none.
 
-    ``Qk`` is the column map as images and weights (:meth:`rvfem.contact.Compliance.rotation_image`).
+    For contacts that do not turn one into one (a rigid bore's x and y springs turn into
+    combinations of the next bore's); pins and rollers are matched by :func:`_permutation_map`.
     The weights touch a few hundred of the interface columns: M is found on the dense rows of
     those columns only, (W1ᵀW1)·M = W1ᵀ(Qk·W0) in the least-squares sense, and each pair is
     checked to 1e-8 of its largest weight.
     """
-    images, weights = Qk
     blocks = []
     for W0, W1 in pairs:
         W0, W1 = sp.csc_matrix(W0), sp.csc_matrix(W1)
         if W1.shape != W0.shape:
             raise ValueError("the turned angle has a different number of contacts")
-        j0 = np.repeat(np.arange(W0.shape[1]), np.diff(W0.indptr))
-        turned = (images[W0.indices].ravel(), np.repeat(j0, 2), (weights[W0.indices] * W0.data[:, None]).ravel())
-        j1 = np.repeat(np.arange(W1.shape[1]), np.diff(W1.indptr))
-        blocks.append((W0, turned, (W1.indices, j1, W1.data)))
-    rows = np.unique(np.concatenate([t[0] for _, t, w in blocks] + [w[0] for _, t, w in blocks]))
-
-    def dense(entries, m):
-        r, j, v = entries
-        flat = np.searchsorted(rows, r) * m + j
-        return np.bincount(flat, weights=v, minlength=len(rows) * m).reshape(len(rows), m)
-
-    dense_blocks = [(W0, dense(t, W0.shape[1]), dense(w, W0.shape[1])) for W0, t, w in blocks]
+        blocks.append((W0, sp.csc_matrix(Qk @ W0), W1))
+    rows = np.unique(np.concatenate([m.indices for _, T, W1 in blocks for m in (T, W1)]))
+    dense_blocks = [(W0, T[rows].toarray(), W1[rows].toarray()) for W0, T, W1 in blocks]
     _, T, A = dense_blocks[0]
-    match = _matching(A, T)
-    if match is not None:
-        source, factor = match
-        M = np.zeros((A.shape[1], T.shape[1]))
-        M[source, np.arange(T.shape[1])] = factor
-
-        def apply(A):
-            return A[:, source] * factor
-    else:                     # contacts that share columns (a bore's x and y springs): least squares
-        try:
-            M = np.linalg.solve(A.T @ A, A.T @ T)
-        except np.linalg.LinAlgError:
-            raise ValueError("the turned contacts are not the solved ones (a contact without weights)") from None
-        M[np.abs(M) < 1e-12] = 0.0
-
-        def apply(A):
-            return A @ M
+    try:
+        M = np.linalg.solve(A.T @ A, A.T @ T)
+    except np.linalg.LinAlgError:
+        raise ValueError("the turned contacts are not the solved ones (a contact without weights)") from None
+    M[np.abs(M) < 1e-12] = 0.0
     for W0, T, A in dense_blocks:
         scale = max(float(np.abs(W0.data).max()) if W0.nnz else 0.0, 1e-30)
-        if T.size and np.abs(apply(A) - T).max() > 1e-8 * scale:
+        if T.size and np.abs(A @ M - T).max() > 1e-8 * scale:
             raise ValueError("the turned contacts are not the solved ones")
     return M
-
-
-def _matching(A: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """(source, factor) with T[:, j] = factor[j]·A[:, source[j]] when every column of T is one
-    column of A times a factor (pins and rollers turn into pins and rollers), found by the first
-    row each column touches; None when two columns of A or of T start at the same row (the
-    least-squares map then decides). Not checked here."""
-    if A.shape[1] == 0:
-        return np.zeros(0, dtype=int), np.zeros(0)
-    first_a = np.argmax(A != 0, axis=0)
-    first_t = np.argmax(T != 0, axis=0)
-    if (len(np.unique(first_a)) < A.shape[1] or len(np.unique(first_t)) < T.shape[1]
-            or not (A != 0).any(axis=0).all()):
-        return None
-    order = np.argsort(first_a)
-    pos = np.searchsorted(first_a[order], first_t)
-    if np.any(pos >= len(order)) or np.any(first_a[order][np.minimum(pos, len(order) - 1)] != first_t):
-        return None
-    source = order[pos]                                    # the solved contact of each turned one
-    a = A[:, source]
-    return source, np.einsum("ij,ij->j", a, T) / np.einsum("ij,ij->j", a, a)
 
 
 def symmetry_plan(thetas: np.ndarray, order: int = 1, mirror: bool = False):

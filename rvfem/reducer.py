@@ -407,6 +407,11 @@ def _stage_loads(stage: ReducerStage, bearing_forces: list, torques: list):
     return forces, np.array(torques), w
 
 
+def _first_and_loads(pair: PairResult) -> tuple:
+    """Disc A's result and (bearing forces, torques, eccentric displacements) of a pair."""
+    return pair.results[0], (pair.bearing_forces, pair.torque_Nmm, pair.eccentric_displacement)
+
+
 def _turned_bearing_forces(result, k: int, order: int) -> np.ndarray:
     """The bearing forces (N, 2) of ``result`` turned by k·2π/N: bearing i's force, turned, is
     bearing i + k's (the same as :func:`rvfem.cycle.turn_result` gives, to round-off)."""
@@ -489,9 +494,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
         if swap:
             src = src[::-1]                      # mirrored pair: disc B is disc A at θ + π
         if (swap, k) == (0, 0):
-            p = pairs[i]
-            loads = (p.bearing_forces, p.torque_Nmm, p.eccentric_displacement)
-            first = p.results[0]
+            first, loads = _first_and_loads(pairs[i])
         else:
             # disc A's solution turned by k steps (its contacts checked against the turned ones);
             # disc B, which may land at θ_j + π − 2π when the discs are swapped (the same state,
@@ -500,12 +503,10 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, progress=None):
             try:
                 first = turn_result(systems[0], src[0], k, cset(0, src[0].theta + k * step))
                 loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
-                                     [r.solution.residual["torque_Nmm"] for r in (first,) + tuple(src[1:])])
+                                     [r.solution.residual["torque_Nmm"] for r in src])     # turning keeps torques
             except ValueError as exc:
                 log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(thetas[j]))
-                p = solve_pair(stage, float(thetas[j]), pairs[i])
-                loads = (p.bearing_forces, p.torque_Nmm, p.eccentric_displacement)
-                first = p.results[0]
+                first, loads = _first_and_loads(solve_pair(stage, float(thetas[j]), pairs[i]))
             if abs(first.theta - thetas[j]) > 1e-9:
                 raise RuntimeError(f"symmetry plan lands at {first.theta} instead of {thetas[j]}")
         results.append(first)

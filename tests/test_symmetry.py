@@ -195,7 +195,7 @@ def test_probe_map_is_the_column_by_column_map_of_the_turned_contacts(fan_system
         new, _ = cycle.contact_set(s, theta + k * 2 * math.pi / 3)
         pairs = [(old.W, new.W), (old.load_weights, new.load_weights)]
         probe = cycle._permutation_map(s.compliance.rotation_power(k), *pairs)
-        dense = cycle._contact_map(s.compliance.rotation_image(k), *pairs)
+        dense = cycle._contact_map(s.compliance.rotation_power(k), *pairs)
         # the same permutation; the factors of the column-by-column map are 1 to round-off
         assert probe is not None and np.array_equal(probe != 0, np.abs(dense) > 1e-9)
         assert np.abs(probe - dense).max() <= 1e-10
