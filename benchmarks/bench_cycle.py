@@ -117,11 +117,13 @@ def measure(case, mesh_dir: str, thetas: np.ndarray) -> dict:
 def measure_repeated(case, mesh_dir: str, thetas: np.ndarray, repeat: int) -> dict:
     """:func:`measure` ``repeat`` times; every time is the median over the repeats, the rest is
     from the last one (the counts and loads do not change)."""
-    runs = [measure(case, mesh_dir, thetas) for _ in range(max(1, repeat))]
-    out = dict(runs[-1])
-    for key, value in out.items():
-        if key.endswith("_s") and isinstance(value, float):
-            out[key] = float(np.median([r[key] for r in runs]))
+    times: dict[str, list[float]] = {}
+    for _ in range(max(1, repeat)):
+        out = measure(case, mesh_dir, thetas)      # the run before is dropped (its system with it)
+        for key, value in out.items():
+            if key.endswith("_s") and isinstance(value, float):
+                times.setdefault(key, []).append(value)
+    out.update({key: float(np.median(values)) for key, values in times.items()})
     return out
 
 
@@ -180,7 +182,8 @@ def run_stages(case_path: str) -> tuple[float, dict, dict]:
         timings = json.loads((Path(tmp) / "out" / "summary.json").read_text())["timings_s"]
     memory = {"main process": peak.pop(proc.pid, 0.0)}
     for pid, mib in peak.items():
-        memory[roles.get(pid, "other")] = max(memory.get(roles.get(pid, "other"), 0.0), mib)
+        role = roles.get(pid, "other")
+        memory[role] = max(memory.get(role, 0.0), mib)
     memory["sum"] = sum(peak.values()) + memory["main process"]
     return wall, timings, memory
 

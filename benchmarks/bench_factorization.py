@@ -38,18 +38,21 @@ source against Debian's SuiteSparse 5.12, pypardiso 0.4.7 with MKL 2026.2; 15 35
     P2   factorized       121824   2786362     1.348    4.464   0.0629    6.872    79.206
 
 Later, with cholespy installed (CHOLMOD with METIS and a reference BLAS, from wheels: rvfem's
-dependency for this reason) and neither scikit-sparse nor pypardiso, same machine and mesh::
+dependency for this reason) and neither scikit-sparse nor pypardiso, same machine and mesh, each
+of rvfem's backends given what :func:`rvfem.fem.factorize_matrix` gives it (cholespy the lower
+triangle and C-ordered right-hand sides)::
 
     elem solver             DOFs    nnz(K)  assemble   factor    1 rhs  100 rhs  1000 rhs
-    P1   cholespy          30710    425876     0.113    0.166   0.0020    0.147     1.155
-    P1   superlu           30710    425876     0.113    0.170   0.0039    0.256     2.453
-    P2   cholespy         121824   2786708     0.272    1.397   0.0188    1.147    11.249
-    P2   superlu          121824   2786708     0.272    1.330   0.0354    1.407    17.035
+    P1   cholespy          30710    425876     0.106    0.168   0.0020    0.143     1.142
+    P1   superlu           30710    425876     0.106    0.173   0.0040    0.230     2.689
+    P2   cholespy         121824   2786708     0.276    1.419   0.0209    1.059    10.284
+    P2   superlu          121824   2786708     0.276    1.354   0.0339    1.313    15.951
 
 (blocks of 250 right-hand sides; cholespy is fastest at 8 per call, 0.8 ms a P1 column of the
 default disc, see :data:`rvfem.fem.solve._SOLVE_BATCH`). cholespy's solve holds the interpreter,
-so it gains nothing from threads; it still back-substitutes P1 columns 2.1x faster than SuperLU
-and its P2 factor takes 89 MB against SuperLU's 147 MB. Residuals up to 1.4e-12 (cholespy, P2).
+so it gains nothing from threads; it still back-substitutes P1 columns 2.4x faster than SuperLU
+(P2 1.6x) and its P2 factor takes 89 MB against SuperLU's 147 MB. Residuals up to 1.4e-12
+(cholespy, P2).
 
 In the first table all residuals were below 1e-12. Conclusions: CHOLMOD is the fastest for many right-hand sides
 (about 2x SuperLU for P1, 2.7x for P2) but scikit-sparse ships no wheels and needs SuiteSparse
@@ -79,7 +82,7 @@ import scipy.sparse.linalg as spla
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from rvfem import fem  # noqa: E402
-from rvfem.fem.solve import _FACTORIZERS  # noqa: E402
+from rvfem.fem.solve import _C_ORDER, _FACTORIZERS, _LOWER_TRIANGLE, _submatrix  # noqa: E402
 
 
 def annulus_mesh(n_vertices: int, r_in: float = 20.0, r_out: float = 90.0) -> tuple[np.ndarray, np.ndarray]:
@@ -152,8 +155,13 @@ def bench(order: int, points: np.ndarray, triangles: np.ndarray, repeat: int, bl
     rng = np.random.default_rng(0)
     rows = []
     for name, factory in solvers().items():
+        # rvfem's own backends get what rvfem gives them (fem.factorize_matrix): the lower
+        # triangle where the backend reads only that, right-hand sides in its own layout
+        own = name in _FACTORIZERS
+        k = _submatrix(model.stiffness, free, lower=name in _LOWER_TRIANGLE) if own else kff
+        layout = "C" if own and name in _C_ORDER else "F"
         t0 = time.perf_counter()
-        solve = factory(kff)
+        solve = factory(k)
         t_fac = time.perf_counter() - t0
         b1 = rng.standard_normal(n)
         t1 = math.inf
@@ -166,7 +174,7 @@ def bench(order: int, points: np.ndarray, triangles: np.ndarray, repeat: int, bl
         for m in (100, 1000):
             total = 0.0
             for lo in range(0, m, block):
-                b = np.asfortranarray(rng.standard_normal((n, min(block, m - lo))))
+                b = np.asarray(rng.standard_normal((n, min(block, m - lo))), order=layout)
                 t0 = time.perf_counter()
                 solve(b)
                 total += time.perf_counter() - t0

@@ -22,7 +22,8 @@ real run does; ``--warm`` renders the set once untimed beforehand to see the ste
 (a child process, started, checked and warmed up before the clock, as during a run's analysis),
 the stress images, the mesh picture and the plots; the CPU time then includes the child's whole
 life (its start and warm-up too), and the own times of the calls (made in the child) are not
-recorded.
+recorded. One difference: ``rvfem run`` has the mesh picture drawn during its load cycle
+(:func:`rvfem.outputs.start_mesh_picture`), here it is submitted with the images.
 
 Run from the repository root::
 

@@ -4,12 +4,13 @@ pickled results over its standard output.
 It is started with ``python -c`` (as the render worker is, :class:`rvfem.render.RenderWorker`), not
 with :mod:`multiprocessing`, whose "spawn" start method imports the parent's main module again in
 the child: a user's script without an ``if __name__ == "__main__"`` guard would run a second time.
-The framing helpers (:func:`send`, :func:`receive`, :func:`picklable`) are shared with the render
-worker.
+The framing helpers (:func:`frame`, :func:`send`, :func:`receive`, :func:`picklable`,
+:func:`write_quietly`, :func:`claim_stdout`) are shared with the render worker.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import pickle
@@ -28,16 +29,37 @@ HEADER = struct.Struct("<Q")
 """Length prefix of a message (little-endian unsigned 64-bit)."""
 
 
+def frame(message) -> bytes:
+    """One message pickled and prefixed with its length (what :func:`receive` reads)."""
+    data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    return HEADER.pack(len(data)) + data
+
+
 def send(stream, message, lock: threading.Lock | None = None) -> None:
     """Write one pickled, length-prefixed message to a binary stream and flush it."""
-    data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
-    if lock is None:
-        stream.write(HEADER.pack(len(data)) + data)
+    data = frame(message)
+    with lock if lock is not None else contextlib.nullcontext():
+        stream.write(data)
         stream.flush()
-        return
-    with lock:
-        stream.write(HEADER.pack(len(data)) + data)
+
+
+def write_quietly(stream, data: bytes) -> None:
+    """Write and flush ``data`` to a child's input; a child that is gone (or a closed pipe) is
+    left to the reader of its output, which reports how it ended."""
+    try:
+        stream.write(data)
         stream.flush()
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def claim_stdout():
+    """In a child process: its standard output as a binary stream for the messages to the
+    parent, with file descriptor 1 pointed at standard error, so that any other output (of a
+    library) cannot corrupt the messages."""
+    out = os.fdopen(os.dup(1), "wb")
+    os.dup2(2, 1)
+    return out
 
 
 def receive(stream):
@@ -52,13 +74,13 @@ def receive(stream):
     return pickle.loads(data)
 
 
-def picklable(exc: BaseException) -> BaseException:
-    """``exc`` if it survives pickling, else a RuntimeError with its type and message."""
+def picklable(exc: BaseException, fallback: type[Exception] = RuntimeError) -> BaseException:
+    """``exc`` if it survives pickling, else a ``fallback`` exception with its type and message."""
     try:
         pickle.loads(pickle.dumps(exc))
         return exc
     except Exception:
-        return RuntimeError(f"{type(exc).__name__}: {exc}")
+        return fallback(f"{type(exc).__name__}: {exc}")
 
 
 _PROGRAM = r"""
@@ -118,7 +140,7 @@ class ChildProcess:
         future: Future = Future()
         with self._lock:
             number = self._count
-            data = pickle.dumps((number, function, args), protocol=pickle.HIGHEST_PROTOCOL)  # may raise
+            data = frame((number, function, args))  # may raise
             if self._ended is not None:
                 future.set_exception(self._ended)
                 return future
@@ -128,11 +150,7 @@ class ChildProcess:
         return future
 
     def _write(self, data: bytes) -> None:
-        try:
-            self._proc.stdin.write(HEADER.pack(len(data)) + data)
-            self._proc.stdin.flush()
-        except (OSError, ValueError):   # the child is gone (or closed): the reader fails the calls
-            pass
+        write_quietly(self._proc.stdin, data)     # a child that is gone: the reader fails the calls
 
     def _read(self) -> None:
         stream = self._proc.stdout
@@ -191,8 +209,7 @@ def _serve(niceness: int = 0) -> None:
     parent closes the pipe."""
     if niceness and hasattr(os, "nice"):
         os.nice(niceness)
-    out = os.fdopen(os.dup(1), "wb")   # results to the parent; any other output goes to stderr
-    os.dup2(2, 1)
+    out = claim_stdout()
     stream = sys.stdin.buffer
     while (message := receive(stream)) is not None:
         number, function, args = message

@@ -14,7 +14,8 @@ design study uses :func:`analyse` directly::
 ISO 281 rating and life, Stribeck/Hertz pressures and the duty cycle, in milliseconds.
 
 Adding a result: give :class:`Analysis` a new field with a default (``None`` when it does not
-apply), compute it in :func:`analyse`, add a piece to :data:`rvfem.outputs.SUMMARY_PIECES` and its
+apply), compute it in :func:`analyse` (its stages after the model: ``_analyse_from_model`` and
+``_evaluate``), add a piece to :data:`rvfem.outputs.SUMMARY_PIECES` and its
 keys to docs/outputs.md (a test checks that the documented and the written keys agree). The
 physics and the sources of every formula are in docs/theory.md.
 """
@@ -618,10 +619,12 @@ class Analysis:
     duty_cycle : DutyCycleResult or None
         None if the case has no duty cycle.
     timings : dict
-        Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*`` and
-        ``cycle_per_angle``.
-    attribution : rvfem.reducer.Attribution
-        The flexibility effect step by step: handbook → equal share of the FE pin resultant →
+        Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*``,
+        ``cycle_per_angle`` and, with the attribution, ``attribution_compute`` (its own wall time;
+        the stage ``attribution`` is the wait for it).
+    attribution : rvfem.reducer.Attribution or None
+        None from ``analyse(..., attribute=False)`` until the caller adds it. The flexibility
+        effect step by step: handbook → equal share of the FE pin resultant →
         one disc with T/discs → two discs sharing the carrier → crankshafts (those that apply;
         without the handbook where it is not defined); ``attribution.final`` is the case's own
         model (``cycle``).
@@ -768,11 +771,11 @@ class _CycleLoads(NamedTuple):
 _CHILD_P2: list = []
 
 
-def _p2_child_build(case, mesh, bearing_model, pin_model) -> float:
+def _p2_child_build(case, mesh, bearing_model, pin_model, geometry) -> float:
     """In the child process of :class:`_P2Model`: build the P2 model; its wall time, s."""
-    t0 = time.perf_counter()
-    _CHILD_P2[:] = [_build_p2(case, mesh, bearing_model, pin_model)]
-    return time.perf_counter() - t0
+    system_p2, seconds = _timed(_build_p2, case, mesh, bearing_model, pin_model, geometry)
+    _CHILD_P2[:] = [system_p2]
+    return seconds
 
 
 def _p2_child_recover(cycle_loads, angles, points, boundaries, band, away, setup):
@@ -835,7 +838,8 @@ class _P2Model:
     def __init__(self, system, mesh, background, child=None):
         self._child = child
         if child is not None:
-            self._built = child.call(_p2_child_build, system.case, mesh, system.bearing_model, system.pin_model)
+            self._built = child.call(_p2_child_build, system.case, mesh, system.bearing_model, system.pin_model,
+                                     system.geometry)     # one message: the geometry's case is the case
         else:
             self._built = background.submit(_timed, _p2_system, system, mesh)
 
@@ -990,7 +994,6 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         stages.end("model", t)
         if on_model is not None:
             on_model(system)
-        # the attribution runs beside the stress stage (background thread)
         return _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
                                    recover_stress, duty_fe, attribute, child)
     finally:
@@ -1020,7 +1023,7 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
     t = stages.start("cycle", n)
 
     # the P2 model of the stress stage, built in a child process during the load cycle
-    p2 = [_P2Model(system, mesh, background, child)] if recover_stress and system.model.order == 1 else []
+    p2 = _P2Model(system, mesh, background, child) if recover_stress and system.model.order == 1 else None
 
     try:
         def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
@@ -1048,11 +1051,11 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
         pending = background.submit(_timed, attribution_of, system, thetas, cycle) if attribute else None
         stress, roller_hertz, stiffness, duty = _evaluate(
             case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
-            recover_stress, p2[0] if p2 else None)
+            recover_stress, p2)
     finally:
-        for model in p2:            # the P2 model (a few hundred MB) is not needed any more
-            model.close()
-        p2.clear()
+        if p2 is not None:          # the P2 model (a few hundred MB) is not needed any more
+            p2.close()
+            p2 = None
     attribution = None
     if pending is not None:
         t = stages.start("attribution")

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import fem
-from ._arrays import first_max, max_load_index, near_max
+from ._arrays import TIE_RTOL, first_max, max_load_index, near_max
 
 __all__ = [
     "FieldSnapshot",
@@ -43,6 +43,7 @@ __all__ = [
     "HotSpotHistory",
     "vertex_of",
     "hot_spot_history",
+    "p1_stress_at",
 ]
 
 
@@ -344,8 +345,8 @@ def _mask(points: np.ndarray, boundaries: dict[str, np.ndarray], exclude: dict[s
 
 
 def _first_peak(env: StressEnvelope, candidates: np.ndarray) -> int:
-    """Position in ``candidates`` of the largest envelope value; among values within 1e-9 of it
-    (on a symmetric disc the peak has rotated copies that differ by round-off) the one reached
+    """Position in ``candidates`` of the largest envelope value; among values within
+    :data:`rvfem._arrays.TIE_RTOL` of it (on a symmetric disc the peak has rotated copies that differ by round-off) the one reached
     at the smallest crank angle, then the lowest vertex."""
     tied = near_max(env.von_mises[candidates])
     theta = np.mod(env.theta[candidates][tied], 2.0 * np.pi)
@@ -387,11 +388,16 @@ def peak_angles(source, points: np.ndarray, boundaries: dict[str, np.ndarray], *
 def p1_stress_at(system_p1, cycle, peak: PeakStress) -> float:
     """The P1 vertex von Mises stress of the cycle at a peak's vertex and crank angle, MPa (what
     :attr:`RecoveredPeak.p1_at_peak_MPa` compares the P2 value with)."""
+    return _p1_stress(system_p1, cycle, nearest_index(cycle.theta, math.radians(peak.theta_deg)),
+                      vertex_of(system_p1.mesh.points, peak))
+
+
+def _p1_stress(system_p1, cycle, k: int, vertex: int) -> float:
+    """The P1 vertex von Mises stress of the cycle's angle k at a vertex, MPa."""
     from .cycle import displacement
 
-    k = nearest_index(cycle.theta, math.radians(peak.theta_deg))
     u1 = displacement(system_p1, cycle.solutions[k])
-    return float(fem.stress_fields(system_p1.model, u1).nodal.von_mises[vertex_of(system_p1.mesh.points, peak)])
+    return float(fem.stress_fields(system_p1.model, u1).nodal.von_mises[vertex])
 
 
 def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[str, np.ndarray], *,
@@ -434,7 +440,6 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     import time
 
     from .cycle import displacements
-    from .fem.stress import displacement_gradients
 
     t0 = time.perf_counter()
     model = system_p2.model
@@ -446,35 +451,29 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     candidates = np.flatnonzero(mask)
     best = None
     for k, u in zip(ks, displacements(system_p2, [cycle.solutions[k] for k in ks])):
-        g = displacement_gradients(model, u)
+        g = fem.displacement_gradients(model, u)
         vm = fem.stress_fields(model, u, gradients=g).nodal.von_mises
         v = int(candidates[first_max(vm[candidates])[0]])
-        if best is None or vm[v] > best[0] * (1.0 + 1e-9):       # the first of equal peaks
+        if best is None or vm[v] > best[0] * (1.0 + TIE_RTOL):   # the first of equal peaks
             best = (float(vm[v]), v, k, g)
     value, vertex, k, g = best
     # the spread of the P2 element stresses at the peak vertex around their average
     g = g[:, :, :, :3]                                           # (2, 2, n_elements, 3 vertices)
-    lam, mu = fem.plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
-    t = model.mesh.t
-    local, elems = np.nonzero(t == vertex)
-    gv = g[:, :, elems, local]
-    tr = gv[0, 0] + gv[1, 1]
-    sxx, syy = lam * tr + 2 * mu * gv[0, 0], lam * tr + 2 * mu * gv[1, 1]
-    sxy = mu * (gv[0, 1] + gv[1, 0])
+    local, elems = np.nonzero(model.mesh.t == vertex)
+    sxx, syy, sxy = fem.plane_stress_components(model, g[:, :, elems, local])
     vm_raw = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
     spread = float(np.max(np.abs(vm_raw - value)))
     envelope = np.full(len(points), -np.inf)
     envelope[vertex] = value
     peak = peak_von_mises(StressEnvelope(envelope, np.full(len(points), float(cycle.theta[k]))), points,
                           boundaries)
-    p1_here = p1_stress_at(system_p1, cycle, peak) if system_p1 is not None else math.nan
+    p1_here = _p1_stress(system_p1, cycle, k, vertex) if system_p1 is not None else math.nan
     return RecoveredPeak(
         peak=peak,
         p1_MPa=float(p1_peak.von_mises_MPa) if p1_peak is not None else math.nan,
         p1_at_peak_MPa=p1_here,
         estimated_error_MPa=spread,
-        angles_deg=tuple(round(math.degrees(float(cycle.theta[nearest_index(cycle.theta, float(a))])), 9)
-                         for a in angles),
+        angles_deg=tuple(round(math.degrees(float(cycle.theta[k])), 9) for k in ks),
         seconds=setup_seconds + time.perf_counter() - t0,
     )
 

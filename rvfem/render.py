@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._child import HEADER, picklable, receive, send
+from ._child import claim_stdout, frame, picklable, receive, send, write_quietly
 from .errors import RenderError
 
 log = logging.getLogger(__name__)
@@ -866,8 +866,7 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
     exit."""
     global _probe_result
     _probe_result = "checked by the parent"   # the check was this process's own first render
-    out = os.fdopen(os.dup(1), "wb")           # messages to the parent; any other output to stderr
-    os.dup2(2, 1)
+    out = claim_stdout()
     lock = threading.Lock()
     logger = logging.getLogger("rvfem")
     logger.addHandler(_ForwardLog(out, lock))
@@ -907,9 +906,14 @@ def _serve(window_size: tuple[int, int], compress_level: int, anti_aliasing: str
         if renderer is not None:
             renderer.close(raise_errors=False)
         try:
-            send(out, ("error", picklable(exc)), lock)
+            send(out, ("error", picklable(exc, RenderError)), lock)
         except OSError:  # pragma: no cover - the parent is gone
             pass
+
+
+def _copied_calls(calls: Sequence[Call]) -> list:
+    """The calls with their keyword arguments as plain dictionaries (any mapping is accepted)."""
+    return [(function, dict(kwargs)) for function, kwargs in calls]
 
 
 class RenderWorker:
@@ -1121,15 +1125,12 @@ class RenderWorker:
         self.check()
         if self._jobs is not None:
             raise RenderError("calls are started before the images are submitted")
-        return self._send_calls(("call", self._picklable_calls(calls)))
-
-    def _picklable_calls(self, calls: Sequence[Call]) -> list:
-        return [(function, dict(kwargs)) for function, kwargs in calls]
+        return self._send_calls(("call", _copied_calls(calls)))
 
     def _send_calls(self, message) -> list[int]:
         """Write ``message`` (whose last item is its calls) to the child; the calls' numbers."""
         try:
-            data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+            data = frame(message)
         except (pickle.PicklingError, AttributeError, TypeError) as exc:
             raise TypeError(f"the images and calls cannot be handed to the render process "
                             f"(functions must be importable by name): {exc}") from exc
@@ -1138,15 +1139,11 @@ class RenderWorker:
         self._used = True
         if self._writer is None:   # one thread writes, in order: the child reads only once it is ready
             self._writer = ThreadPoolExecutor(1, thread_name_prefix="rvfem-render-writer")
-        self._writer.submit(self._write, HEADER.pack(len(data)) + data)
+        self._writer.submit(self._write, data)
         return list(range(first, self._n_calls))
 
     def _write(self, data: bytes) -> None:
-        try:
-            self._proc.stdin.write(data)
-            self._proc.stdin.flush()
-        except (OSError, ValueError, AttributeError):
-            pass   # the child is gone (or closed): wait() reports how it ended
+        write_quietly(getattr(self._proc, "stdin", None), data)   # a child that is gone: wait() says how it ended
 
     def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> list[int]:
         """Hand a series of stress images over to the child process, which starts drawing them
@@ -1177,7 +1174,7 @@ class RenderWorker:
         if self._jobs is not None:
             raise RenderError("a render worker draws one series of images")
         jobs = [(Path(path), scene, dict(options)) for path, scene, options in jobs]
-        numbers = self._send_calls(("draw", jobs, self._picklable_calls(calls)))
+        numbers = self._send_calls(("draw", jobs, _copied_calls(calls)))
         self._jobs = jobs
         return numbers
 

@@ -68,7 +68,7 @@ STAGES: dict[str, str] = {
     "images": "rendering stress images",
     "report": "writing the report",
 }
-"""Stages of a run in order, with a one-line description (what the progress callback reports):
+"""Stages of a run in the order of a run without images, with a one-line description (what the progress callback reports):
 those of :func:`rvfem.analysis.analyse`, then one per writer. With images, the stress images and
 the plots are drawn by a child process (:class:`rvfem.render.RenderWorker`) from the start of the
 writers on (the mesh picture from the end of the ``model`` stage on, during the load cycle), while

@@ -4,7 +4,8 @@ One module per stage, every public name re-exported here (``from rvfem.fem impor
 
 :mod:`rvfem.fem.model`
     :class:`FEModel` and :func:`build_model` (scikit-fem P1/P2 triangles, plane stress,
-    :func:`plane_stress_constants`), edge lookup and outward normals.
+    :func:`plane_stress_constants`, :func:`plane_stress_stiffness`), edge lookup and outward
+    normals.
 :mod:`rvfem.fem.loads`
     :class:`BoundaryChain` and :func:`boundary_chains` (boundary edges ordered by arc length),
     :func:`footprint_weights` (consistent nodal weights of Hertz-like footprints) and
@@ -13,7 +14,8 @@ One module per stage, every public name re-exported here (``from rvfem.fem impor
     :func:`factorize` on a minimal statically determinate support (choice of sparse solver by
     measurement), :func:`rigid_body_modes` and :func:`remove_rigid_motion`.
 :mod:`rvfem.fem.stress`
-    :func:`stress_fields` (element and vertex stresses, von Mises, principal) and
+    :func:`stress_fields` (element and vertex stresses, von Mises, principal), its parts
+    :func:`displacement_gradients` and :func:`plane_stress_components`, and
     :func:`nodal_stress_operator` (the same vertex stresses as a linear operator).
 
 Units: lengths mm, forces N, moduli and stresses MPa; ``K @ u`` is a force in N. The theory
@@ -24,7 +26,14 @@ docs/theory.md.
 from __future__ import annotations
 
 from .loads import BoundaryChain, boundary_chains, footprint_weights, load_operator
-from .model import FEModel, build_model, edge_indices, edge_outward_normals, plane_stress_constants
+from .model import (
+    FEModel,
+    build_model,
+    edge_indices,
+    edge_outward_normals,
+    plane_stress_constants,
+    plane_stress_stiffness,
+)
 from .solve import (
     SOLVER_PREFERENCE,
     Factorization,
@@ -35,12 +44,20 @@ from .solve import (
     remove_rigid_motion,
     rigid_body_modes,
 )
-from .stress import StressFields, StressState, nodal_stress_operator, stress_fields
+from .stress import (
+    StressFields,
+    StressState,
+    displacement_gradients,
+    nodal_stress_operator,
+    plane_stress_components,
+    stress_fields,
+)
 
 __all__ = [
     "FEModel",
     "build_model",
     "plane_stress_constants",
+    "plane_stress_stiffness",
     "edge_indices",
     "edge_outward_normals",
     "BoundaryChain",
@@ -58,5 +75,7 @@ __all__ = [
     "StressState",
     "StressFields",
     "stress_fields",
+    "displacement_gradients",
+    "plane_stress_components",
     "nodal_stress_operator",
 ]

@@ -57,6 +57,11 @@ __all__ = [
 ]
 
 
+def _scalar_element(order: int):
+    """The scalar Lagrange triangle of the element order (1: P1, 2: P2)."""
+    return ElementTriP1() if order == 1 else ElementTriP2()
+
+
 @dataclass(frozen=True, eq=False)
 class FEModel:
     """Assembled plane-stress finite-element model of one disc.
@@ -106,8 +111,7 @@ class FEModel:
     @cached_property
     def basis(self) -> Any:
         """Vector Lagrange basis (P1 or P2) with the DOF numbering of ``stiffness``."""
-        scalar = ElementTriP1() if self.order == 1 else ElementTriP2()
-        return Basis(self.mesh, ElementVector(scalar))
+        return Basis(self.mesh, ElementVector(_scalar_element(self.order)))
 
     @property
     def n_vertices(self) -> int:
@@ -319,7 +323,7 @@ def build_model(
         np.ascontiguousarray(points.T),
         np.ascontiguousarray(triangles.T.astype(np.int64)),
     )
-    scalar = ElementTriP1() if order == 1 else ElementTriP2()
+    scalar = _scalar_element(order)
     dofs = Dofs(mesh, ElementVector(scalar))
     lam, mu = plane_stress_constants(youngs_modulus, poissons_ratio)
     stiffness = plane_stress_stiffness(Basis(mesh, scalar), dofs.element_dofs, lam * thickness, mu * thickness)

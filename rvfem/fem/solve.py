@@ -187,7 +187,7 @@ class Factorization:
     Attributes
     ----------
     solver : str
-        Backend used ("cholmod", "pardiso" or "superlu").
+        Backend used ("cholmod", "cholespy", "pardiso" or "superlu").
     support_dofs : numpy.ndarray
         ``(3,)`` (or user-given) DOFs held at zero displacement.
     free_dofs : numpy.ndarray
@@ -243,7 +243,7 @@ class Factorization:
         free = np.empty((len(self.free_dofs),) + b.shape[1:], order=order)
         for (lo, hi), at in runs:
             free[at:at + hi - lo] = b[lo:hi]
-        x = np.asarray(self._solve(free)).reshape(free.shape)
+        x = self.solve_free(free)
         for (lo, hi), at in runs:
             u[lo:hi] = x[at:at + hi - lo]
         return u

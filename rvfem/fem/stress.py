@@ -8,7 +8,7 @@ values at the vertex over the triangles sharing it: for P1 (constant element str
 lumped-mass L2 projection onto continuous P1 ([1]_ § 14.3); for P2 the element stress is linear and
 its vertex values are averaged. :func:`stress_fields` and :func:`nodal_stress_operator` share one
 implementation of that average (:func:`_vertex_weights`) and of the constitutive law
-(:func:`_plane_stress`), so the envelope over a load cycle and the saved fields agree to round-off.
+(:func:`plane_stress_components`), so the envelope over a load cycle and the saved fields agree to round-off.
 
 References
 ----------
@@ -33,6 +33,7 @@ __all__ = [
     "StressFields",
     "stress_fields",
     "displacement_gradients",
+    "plane_stress_components",
     "nodal_stress_operator",
 ]
 
@@ -93,7 +94,7 @@ class StressFields:
     element: StressState
 
 
-def _plane_stress(model: FEModel, g: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def plane_stress_components(model: FEModel, g: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(σxx, σyy, σxy), MPa, from displacement gradients ``g[i, j] = ∂u_i/∂x_j`` (any trailing
     shape)."""
     lam, mu = plane_stress_constants(model.youngs_modulus, model.poissons_ratio)
@@ -167,7 +168,7 @@ def nodal_stress_operator(model: FEModel, vertices: np.ndarray | None = None) ->
         for i in range(2):                                   # the vector function (a, component i)
             g = np.zeros((2,) + dphi.shape)
             g[i] = dphi
-            comps = _plane_stress(model, g)                  # each (n_elements, 3 vertices)
+            comps = plane_stress_components(model, g)                  # each (n_elements, 3 vertices)
             dof = model.node_dofs[basis.element_dofs[a][elements], i]
             for c, sc in enumerate(comps):
                 for k in range(3):
@@ -227,7 +228,7 @@ def stress_fields(model: FEModel, u: np.ndarray, *, gradients: np.ndarray | None
         MPa.
     """
     g = displacement_gradients(model, u) if gradients is None else gradients   # (2, 2, n_elements, 4)
-    sxx, syy, sxy = _plane_stress(model, g)
+    sxx, syy, sxy = plane_stress_components(model, g)
 
     element = StressState.from_components(sxx[:, 3].copy(), syy[:, 3].copy(), sxy[:, 3].copy())
 

@@ -207,30 +207,29 @@ def pin_profile_contacts_many(geom_or_case, thetas) -> list[PinContacts]:
     cxy_all = np.concatenate([pin_centres(case, t) for t in thetas])
     c_all = cxy_all[:, 0] + 1j * cxy_all[:, 1]
     seg_all, s_all, P_all, P1_all = _closest_points(profile, c_all)
+    # every operation below is point by point: done for all angles at once, then split
+    n = -1j * P1_all / np.abs(P1_all)
+    diff = c_all - P_all
+    dist = np.abs(diff)
+    # signed distance: positive on the outward side. At a d > 1 corner the normal is undefined;
+    # use the direction to the pin there.
+    sd = np.real(np.conj(diff) * n)
+    if profile.tooth_difference > 1:
+        corner = np.abs(np.abs(s_all) - profile.half_range) < 1e-12
+        if np.any(corner):
+            inside = _MplPath(profile.points).contains_points(_c2xy(c_all[corner]))
+            sgn = np.where(inside, -1.0, 1.0)
+            u = diff[corner] / np.where(dist[corner] > 0, dist[corner], 1.0)
+            n[corner] = sgn * u
+            sd[corner] = sgn * dist[corner]
+    gap, point, normal = sd - case.pins.radius, _c2xy(P_all), _c2xy(n)
     zp = case.pins.count
     out = []
     for a, theta in enumerate(thetas):
         rows = slice(a * zp, (a + 1) * zp)
-        cxy, c, seg, s, P, P1 = cxy_all[rows], c_all[rows], seg_all[rows], s_all[rows], P_all[rows], P1_all[rows]
-        n = -1j * P1 / np.abs(P1)
-        diff = c - P
-        dist = np.abs(diff)
-        # signed distance: positive on the outward side. At a d > 1 corner the normal is undefined;
-        # use the direction to the pin there.
-        sd = np.real(np.conj(diff) * n)
-        if profile.tooth_difference > 1:
-            corner = np.abs(np.abs(s) - profile.half_range) < 1e-12
-            if np.any(corner):
-                inside = _MplPath(profile.points).contains_points(_c2xy(c[corner]))
-                sgn = np.where(inside, -1.0, 1.0)
-                u = diff[corner] / np.where(dist[corner] > 0, dist[corner], 1.0)
-                n = n.copy()
-                n[corner] = sgn * u
-                sd = sd.copy()
-                sd[corner] = sgn * dist[corner]
         out.append(PinContacts(
-            theta=theta, centres=_readonly(cxy), gap=_readonly(sd - case.pins.radius),
-            point=_readonly(_c2xy(P)), normal=_readonly(_c2xy(n)), segment=_readonly(seg),
-            param=_readonly(s),
+            theta=theta, centres=_readonly(cxy_all[rows]), gap=_readonly(gap[rows]),
+            point=_readonly(point[rows]), normal=_readonly(normal[rows]), segment=_readonly(seg_all[rows]),
+            param=_readonly(s_all[rows]),
         ))
     return out
