@@ -226,7 +226,7 @@ def pin_contacts_many(system: DiscSystem, pcs) -> list:
     """:func:`pin_contacts` of many crank angles from their :class:`rvfem.geometry.PinContacts`:
     the closest points of all of them located on the footprint grid at once."""
     from .geometry import pin_centres, profile_curvature
-    from .models import ContactGroup, contact_columns
+    from .models import ContactGroup, contact_columns_many
 
     case = system.case
     prof = system.interface.grids["profile"]
@@ -251,14 +251,18 @@ def pin_contacts_many(system: DiscSystem, pcs) -> list:
         slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
         load_cols, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
     names = [f"pin {j + 1}" for j in range(zp)]
+    n = len(pcs)
+    Ws = contact_columns_many(n_columns, cols.reshape(n, zp, -1), wts.reshape(n, zp, -1))
+    W_loads = [None] * n if mu == 0 else contact_columns_many(n_columns, load_cols.reshape(n, zp, -1),
+                                                               pin_load.reshape(n, zp, -1))
     out = []
     for a, pc in enumerate(pcs):
         rows = slice(a * zp, (a + 1) * zp)
-        W_load = None if mu == 0 else contact_columns(n_columns, load_cols[rows], pin_load[rows])
+        W_load = W_loads[a]
         law = system.pins.law(pc, curvature[rows])
         rigid = law is None
         out.append(ContactGroup(
-            W=contact_columns(n_columns, cols[rows], wts[rows]), signorini=np.full(zp, rigid),
+            W=Ws[a], signorini=np.full(zp, rigid),
             gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
             offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
             laws=[] if rigid else [(np.arange(zp), law)], names=names,
@@ -460,7 +464,7 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
         pairs = [(old.W, cset.W)]
         if old.W_load is not None or cset.W_load is not None:      # friction: the load weights map too
             pairs.append((old.load_weights, cset.load_weights))
-        M = _permutation_map(system.compliance.rotation_power(k), *pairs)
+        M = _permutation_map(system.compliance.rotation_power(k), *pairs, turned=_turned_probes(system, k))
         if M is None:
             M = _contact_map(system.compliance.rotation_power(k), *pairs)
         hit = system.contact_sets[key] = ((old, cset, system.compliance), M)
@@ -527,9 +531,21 @@ def _probes(n_columns: int) -> np.ndarray:
     return z
 
 
-def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix]) -> np.ndarray | None:
+def _turned_probes(system: DiscSystem, k: int) -> np.ndarray:
+    """Qᵏᵀ·z of the probes z (:func:`_probes`), once per system and k (kept with the contact sets)."""
+    compliance = system.compliance
+    key = ("probes", int(k) % compliance.order, id(compliance))
+    hit = system.contact_sets.get(key)
+    if hit is None or hit[0] is not compliance:
+        Qk = compliance.rotation_power(k)
+        hit = system.contact_sets[key] = (compliance, np.asarray(Qk.T @ _probes(Qk.shape[0])))
+    return hit[1]
+
+
+def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix],
+                     turned: np.ndarray | None = None) -> np.ndarray | None:
     """M of :func:`_contact_map` when it is a permutation (pins and rollers turn into pins and
-    rollers), else None.
+    rollers), else None; ``turned`` is Qkᵀ·z of the probes z, when known (:func:`_turned_probes`).
 
     Found and checked with two random probes z over the columns: the turned weights of contact j
     and the weights of its image σ(j) are the same column, Qk·W0[:, j] = W1[:, σ(j)], so
@@ -549,7 +565,8 @@ def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix]) -
         if W1.shape != W0.shape or W0.nnz == 0:
             return None
         z = _probes(W0.shape[0])
-        turned = weighted(W0, np.asarray(Qk.T @ z))           # (n_contacts, 2)
+        Qz = turned if turned is not None else np.asarray(Qk.T @ z)
+        mapped = weighted(W0, Qz)                             # (n_contacts, 2)
         direct = weighted(W1, z)
         tol = 1e-8 * float(np.abs(W0.data).max()) * float(np.abs(z).max()) * max(int(np.diff(W0.indptr).max()), 1)
         if sigma is None and len(direct) == 1:
@@ -557,12 +574,12 @@ def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix]) -
         elif sigma is None:
             order = np.argsort(direct[:, 0], kind="stable")
             ranked = direct[order, 0]
-            pos = np.clip(np.searchsorted(ranked, turned[:, 0]), 1, len(ranked) - 1)
-            nearer = np.where(np.abs(ranked[pos - 1] - turned[:, 0]) <= np.abs(ranked[pos] - turned[:, 0]), pos - 1, pos)
+            pos = np.clip(np.searchsorted(ranked, mapped[:, 0]), 1, len(ranked) - 1)
+            nearer = np.where(np.abs(ranked[pos - 1] - mapped[:, 0]) <= np.abs(ranked[pos] - mapped[:, 0]), pos - 1, pos)
             sigma = order[nearer]
             if len(np.unique(sigma)) != len(sigma):
                 return None
-        if np.abs(direct[sigma] - turned).max() > tol:
+        if np.abs(direct[sigma] - mapped).max() > tol:
             return None
     M = np.zeros((len(sigma), len(sigma)))
     M[sigma, np.arange(len(sigma))] = 1.0

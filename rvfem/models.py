@@ -39,6 +39,7 @@ __all__ = [
     "roller_angles",
     "bearing_contacts_many",
     "contact_columns",
+    "contact_columns_many",
 ]
 
 
@@ -101,12 +102,20 @@ def contact_columns(n_columns: int, columns: np.ndarray, weights: np.ndarray) ->
     scipy.sparse.csc_matrix (n_columns, m)
         With sorted indices, as built from coordinates (zero weights kept as entries).
     """
+    return contact_columns_many(n_columns, np.asarray(columns)[None], np.asarray(weights)[None])[0]
+
+
+def contact_columns_many(n_columns: int, columns: np.ndarray, weights: np.ndarray) -> list[sp.csc_matrix]:
+    """:func:`contact_columns` of many crank angles, ``columns`` and ``weights`` (n, m, k): sorted
+    all at once, each angle's W a view of the joint arrays."""
     columns = np.asarray(columns)
-    m, k = columns.shape
-    order = np.argsort(columns, axis=1, kind="stable")
-    rows = np.take_along_axis(columns, order, axis=1).ravel()
-    data = np.take_along_axis(np.asarray(weights, dtype=float), order, axis=1).ravel()
-    return sp.csc_matrix((data, rows, np.arange(0, m * k + 1, k)), shape=(n_columns, m))
+    n, m, k = columns.shape
+    order = np.argsort(columns, axis=2, kind="stable")
+    # 32-bit indices, as SciPy would choose for them anyway (it checks 64-bit ones value by value)
+    rows = np.take_along_axis(columns, order, axis=2).reshape(n, m * k).astype(np.int32)
+    data = np.take_along_axis(np.asarray(weights, dtype=float), order, axis=2).reshape(n, m * k)
+    indptr = np.arange(0, m * k + 1, k, dtype=np.int32)
+    return [sp.csc_matrix((data[a], rows[a], indptr), shape=(n_columns, m)) for a in range(n)]
 
 
 class BearingModel(Protocol):
@@ -241,11 +250,10 @@ class RollerBearing:
         names = [f"bearing {i + 1} roller {k + 1}" for i in range(n_bearings) for k in range(z)]
         bearing = np.repeat(np.arange(n_bearings), z)
         laws = [(np.arange(n), self._law)]
-        return [ContactGroup(W=contact_columns(interface.n_columns, cols[a], wts[a]),
-                             signorini=np.zeros(n, dtype=bool), gap0=np.zeros(n),
-                             offset=np.full(n, -0.5 * b.radial_clearance), laws=laws, names=names,
+        signorini, gap0, offset = np.zeros(n, dtype=bool), np.zeros(n), np.full(n, -0.5 * b.radial_clearance)
+        return [ContactGroup(W=W, signorini=signorini, gap0=gap0, offset=offset, laws=laws, names=names,
                              bearing=bearing)
-                for a in range(n_angles)]
+                for W in contact_columns_many(interface.n_columns, cols, wts)]
 
     def bearing_forces(self, vectors, forces, theta):
         n, z = self.case.cranks.count, self.case.crank_bearing.rollers
