@@ -23,6 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import contact
+from ._arrays import readonly as _readonly
 from .errors import CaseError
 from .registry import register_bearing_model, register_pin_model
 
@@ -250,7 +251,9 @@ class RollerBearing:
         names = [f"bearing {i + 1} roller {k + 1}" for i in range(n_bearings) for k in range(z)]
         bearing = np.repeat(np.arange(n_bearings), z)
         laws = [(np.arange(n), self._law)]
-        signorini, gap0, offset = np.zeros(n, dtype=bool), np.zeros(n), np.full(n, -0.5 * b.radial_clearance)
+        # shared by the groups of all angles, hence read-only
+        signorini, gap0, offset = (_readonly(a) for a in (np.zeros(n, dtype=bool), np.zeros(n),
+                                                          np.full(n, -0.5 * b.radial_clearance)))
         return [ContactGroup(W=W, signorini=signorini, gap0=gap0, offset=offset, laws=laws, names=names,
                              bearing=bearing)
                 for W in contact_columns_many(interface.n_columns, cols, wts)]

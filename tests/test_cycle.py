@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from rvfem import compare, cycle, rigid
+from rvfem import compare, contact, cycle, rigid
 from rvfem.case import case_from_dict, case_to_dict
 from rvfem.errors import ContactError
 from rvfem.mesh import mesh_case
@@ -310,3 +310,41 @@ def test_extrapolated_start_gives_the_solution_of_the_last_angle_as_start(solid)
 
     fallback = cycle.solve_from_last(refuses_extrapolation, [a, b])
     assert np.array_equal(fallback.bearing_forces, plain.bearing_forces)
+
+
+def test_cold_start_on_the_torque_side_gives_the_solution_of_all_springs_engaged(fanholes, monkeypatch):
+    """The first, linearised solve of a cycle engages only the bearings and the pins that resist
+    the torque: it converges to the solution that every spring engaged gives (the start is only a
+    start; a flexible disc may still load a pin of the other side, which the Newton steps engage),
+    with fewer compliance columns; and when that start does not settle, every spring is engaged."""
+    case, mesh = fanholes
+    theta = 0.3
+    torque_side = cycle.build_system(case, mesh)
+    reduced = cycle.solve_angle(torque_side, theta)
+    engaged = contact._torque_side(contact.Body(reduced.contacts, torque_side.interface, None),
+                                   case.loads.disc_torque_Nmm)
+    zp = case.pins.count
+    assert engaged[zp:].all() and 0 < engaged[:zp].sum() < zp
+
+    everything = cycle.build_system(case, mesh)
+    with monkeypatch.context() as m:
+        m.setattr(contact, "_torque_side", lambda body, torque: np.ones(body.cset.W.shape[1], dtype=bool))
+        full = cycle.solve_angle(everything, theta)
+    scale = full.bearing_loads.max()
+    assert np.abs(reduced.bearing_forces - full.bearing_forces).max() <= 1e-8 * scale
+    assert np.abs(reduced.pin_forces - full.pin_forces).max() <= 1e-8 * scale
+    assert torque_side.compliance.columns_solved < everything.compliance.columns_solved
+
+    calls = []
+    original = contact._newton
+
+    def refuses_the_torque_side(*args, engaged=None, **kw):
+        calls.append(None if engaged is None else bool(engaged.all()))
+        if engaged is not None and not engaged.all():
+            raise ContactError("does not settle")
+        return original(*args, engaged=engaged, **kw)
+
+    monkeypatch.setattr(contact, "_newton", refuses_the_torque_side)
+    fallback = cycle.solve_angle(cycle.build_system(case, mesh), theta)
+    assert calls[:2] == [False, True]
+    assert np.abs(fallback.bearing_forces - full.bearing_forces).max() <= 1e-8 * scale
