@@ -184,7 +184,7 @@ def run_stages(case_path: str) -> tuple[float, dict, dict]:
     memory = {"main process": peak.pop(proc.pid, 0.0)}
     for pid, mib in peak.items():
         role = roles.get(pid, "other")
-        if mib > 0 or role != "other":           # a short-lived helper process read as gone
+        if mib >= 1 or role != "other":          # short-lived helpers (a library lookup) left out
             memory[role] = max(memory.get(role, 0.0), mib)
     memory["sum"] = sum(peak.values()) + memory["main process"]
     return wall, timings, memory
