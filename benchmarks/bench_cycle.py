@@ -175,18 +175,23 @@ def run_stages(case_path: str) -> tuple[float, dict, dict]:
             for pid in [proc.pid] + _children(proc.pid):
                 peak[pid] = max(peak.get(pid, 0.0), _high_water_mib(pid))
                 if pid != proc.pid and roles.get(pid, "other") == "other":
-                    roles[pid] = _role(pid)      # again until known: a forked child shows its parent's until it executes
+                    # again until known: a forked child shows its parent's command line (and peak
+                    # memory) until it executes, so its peak restarts once its role is known
+                    roles[pid] = _role(pid)
+                    if roles[pid] != "other":
+                        peak[pid] = _high_water_mib(pid)
             time.sleep(0.02)
         wall = time.perf_counter() - t0
         if proc.returncode:
             raise subprocess.CalledProcessError(proc.returncode, cmd)
         timings = json.loads((Path(tmp) / "out" / "summary.json").read_text())["timings_s"]
     memory = {"main process": peak.pop(proc.pid, 0.0)}
-    for pid, mib in peak.items():
+    counted = {pid: mib for pid, mib in peak.items()
+               if mib >= 1 or roles.get(pid, "other") != "other"}    # short-lived helpers left out
+    for pid, mib in counted.items():
         role = roles.get(pid, "other")
-        if mib >= 1 or role != "other":          # short-lived helpers (a library lookup) left out
-            memory[role] = max(memory.get(role, 0.0), mib)
-    memory["sum"] = sum(peak.values()) + memory["main process"]
+        memory[role] = max(memory.get(role, 0.0), mib)
+    memory["sum"] = sum(counted.values()) + memory["main process"]
     return wall, timings, memory
 
 

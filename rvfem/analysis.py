@@ -621,7 +621,8 @@ class Analysis:
     timings : dict
         Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*``,
         ``cycle_per_angle`` and, with the attribution, ``attribution_compute`` (its own wall time;
-        the stage ``attribution`` is the wait for it).
+        the stage ``attribution`` is the wait for it when :func:`analyse` computes it beside other
+        stages, the computation itself when ``rvfem run`` does, after the VTK files).
     attribution : rvfem.reducer.Attribution or None
         None from ``analyse(..., attribute=False)`` until the caller adds it. The flexibility
         effect step by step: handbook → equal share of the FE pin resultant →
@@ -832,15 +833,26 @@ class _P2Model:
     factorisation would otherwise take turns with the load cycle in this interpreter (CHOLMOD
     through cholespy holds it), and its few hundred MB stay out of this process. The angles to
     re-solve go there as :class:`rvfem.cycle.AngleLoads`, the recovered peak comes back. Without a
-    ``child`` (none could be started), the model is built on the ``background`` thread and used here.
+    ``child`` (none could be started), the model is built on the ``background`` thread from
+    :meth:`start` and used here.
     """
 
     def __init__(self, system, mesh, background, child=None):
         self._child = child
+        self._pending = None
         if child is not None:
             self._built = child.call(_p2_child_build, system.case, mesh, system.bearing_model, system.pin_model,
                                      system.geometry)     # one message: the geometry's case is the case
         else:
+            self._built, self._pending = None, (background, system, mesh)
+
+    def start(self) -> None:
+        """Start the build on the background thread (without a child; once). Called when the cycle
+        has solved its first angle: its compliance columns are computed by then, and the two would
+        only take turns in this interpreter (cholespy holds it)."""
+        if self._pending is not None:
+            background, system, mesh = self._pending
+            self._pending = None
             self._built = background.submit(_timed, _p2_system, system, mesh)
 
     def recover_in_child(self, system, cycle, angles, mesh, band, away):
@@ -862,6 +874,7 @@ class _P2Model:
                                          away, setup).result()
         except ChildProcessEnded as exc:
             log.warning("%s; the P2 model is built here instead", exc)
+            self._child.close()             # its pipes and reader now (closing again is harmless)
             self._child, self._built = None, None
             return None
         return dataclasses.replace(recovered, p1_at_peak_MPa=postprocess.p1_stress_at(system, cycle, recovered.peak))
@@ -1027,6 +1040,8 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
 
     try:
         def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
+            if p2 is not None:
+                p2.start()
             if i < total:
                 stages.tick("cycle", i, total)
 

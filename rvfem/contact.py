@@ -831,6 +831,10 @@ class Body:
     interface: Interface
     compliance: Compliance
 
+    def moments(self) -> np.ndarray:
+        """Moment about the disc centre of each contact's load per unit force, N·mm/N."""
+        return np.asarray(self.cset.load_weights.T @ self.interface.resultants[:, 2])
+
 
 def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, torque: float, *,
                   start: AngleSolution | None = None, max_iterations: int = 50, label: str = "",
@@ -1177,8 +1181,7 @@ def _torque_side(body: Body, torque: float) -> np.ndarray:
     n = cset.W.shape[1]
     if cset.bearing is None or not torque:
         return np.ones(n, dtype=bool)
-    moment = np.asarray(cset.load_weights.T @ body.interface.resultants[:, 2])
-    return (np.asarray(cset.bearing) >= 0) | (moment * torque <= 0) | (cset.offset > 0)
+    return (np.asarray(cset.bearing) >= 0) | (body.moments() * torque <= 0) | (cset.offset > 0)
 
 
 def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, float, bool]]:
@@ -1193,8 +1196,7 @@ def _secant_stiffnesses(body: Body, torque: float) -> list[tuple[np.ndarray, flo
     oscillate between contact states without settling.
     """
     cset = body.cset
-    WL = cset.load_weights
-    moments = np.abs(np.asarray(WL.T @ body.interface.resultants[:, 2]))
+    moments = np.abs(body.moments())
     out = []
     for idx, law in cset.laws:
         lever = np.abs(cset.lever[idx]).max() if np.size(idx) else 0.0

@@ -305,7 +305,8 @@ class RecoveredPeak:
     angles_deg : tuple of float
         Crank angles re-solved on P2, degrees.
     seconds : float
-        Wall time of the recovery (P2 assembly, factorisation and the solves), s.
+        Wall time of the recovery (P2 assembly, factorisation and the solves), s; made in the P2
+        model's child process, it leaves out the P1 value at the peak, computed in the parent.
     method : str
         One line describing the method.
     """
@@ -411,7 +412,9 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
         The P2 model of the same mesh (``build_system(case, mesh, order=2)``): its footprint
         interface has the same columns as the P1 cycle's.
     cycle : rvfem.cycle.CycleResult
-        The P1 cycle (its ``solutions`` hold the converged contact and roller forces).
+        The P1 cycle (its ``solutions`` hold the converged contact and roller forces); or, in the
+        P2 model's child process, its angles and the :class:`rvfem.cycle.AngleLoads` of the
+        angles to re-solve (``theta`` and ``solutions``, a dict by angle index).
     angles : iterable of float
         Crank angles to re-solve, rad (nearest of ``cycle.theta``).
     points, boundaries, exclude
