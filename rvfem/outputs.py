@@ -49,6 +49,8 @@ __all__ = [
     "SCHEMA_VERSION",
     "RIGID_SCHEMA_VERSION",
     "VERSIONED_PACKAGES",
+    "CLI_MODULES",
+    "CLI_SCRIPTS",
     "command_line",
     "environment",
     "IMAGE_SIZE",
@@ -309,17 +311,36 @@ VERSIONED_PACKAGES = ("numpy", "scipy", "scikit-fem", "gmsh", "vtk", "pyvista", 
 """Packages whose installed versions ``summary.json`` records (``environment.versions``)."""
 
 
+CLI_MODULES = ("rvfem", "rvfem.__main__", "rvfem.cli")
+"""Modules whose ``python -m`` run is the ``rvfem`` command (``__main__.__spec__.name``)."""
+
+CLI_SCRIPTS = ("rvfem", "rvfem.exe", "rvfem-script.py")
+"""File names of the ``rvfem`` console script (``sys.argv[0]``) on POSIX and Windows."""
+
+
 def command_line() -> str | None:
-    """The command line of this process if it is the ``rvfem`` command (None from Python or a
-    notebook), shell-quoted."""
+    """The command line of this process if it is the ``rvfem`` command (None from Python, a
+    notebook or a test runner), shell-quoted.
+
+    Decided from the entry point, not from where the files lie: the process is the ``rvfem``
+    command if its ``__main__`` module is :mod:`rvfem` run with ``python -m rvfem`` (or
+    ``-m rvfem.cli``; the name of ``__main__.__spec__`` is one of :data:`CLI_MODULES`), or if
+    it is a plain script (no module spec) named ``rvfem``, the console script the installation
+    writes (:data:`CLI_SCRIPTS`). ``python -m pytest`` started in a folder named ``rvfem`` is
+    not the command.
+    """
     import shlex
     import sys
 
     argv = list(sys.argv)
     if not argv:
         return None
-    name = Path(argv[0]).name
-    if name == "rvfem" or (name in ("cli.py", "__main__.py") and "rvfem" in Path(argv[0]).parts):
+    main = sys.modules.get("__main__")
+    spec = getattr(main, "__spec__", None)
+    name = getattr(spec, "name", None)
+    if name in CLI_MODULES:
+        return shlex.join(["rvfem", *argv[1:]])
+    if name in (None, "__main__") and Path(argv[0]).name in CLI_SCRIPTS:
         return shlex.join(["rvfem", *argv[1:]])
     return None
 

@@ -8,8 +8,11 @@ run adds a duty cycle, ``--field-step`` and ``--set``.
 from __future__ import annotations
 
 import csv
+import importlib.machinery
 import json
 import math
+import sys
+import types
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -711,8 +714,35 @@ def test_summary_records_date_versions_and_command(summary, monkeypatch):
 
     assert env["versions"]["numpy"] == numpy.__version__
     assert env["command_line"] is None                 # run from Python (pytest), not the command
+    script = types.ModuleType("__main__")              # the console script: a plain script, no module spec
+    script.__spec__ = None
+    monkeypatch.setitem(sys.modules, "__main__", script)
     monkeypatch.setattr("sys.argv", ["/somewhere/bin/rvfem", "run", "a b.toml", "-o", "x"])
     assert outputs.command_line() == "rvfem run 'a b.toml' -o x"
+
+
+def _main_module(spec_name):
+    """A ``__main__`` module as ``python -m spec_name`` leaves it (``None``: a plain script)."""
+    module = types.ModuleType("__main__")
+    module.__spec__ = None if spec_name is None else importlib.machinery.ModuleSpec(spec_name, None)
+    return module
+
+
+@pytest.mark.parametrize("spec_name, argv0, expected", [
+    # python -m pytest in a clone named rvfem: the path holds "rvfem" and ends in __main__.py
+    ("pytest.__main__", "/tmp/x/rvfem/.venv/lib/python3.11/site-packages/pytest/__main__.py", None),
+    ("pytest.__main__", "/tmp/x/rvfem/rvfem/__main__.py", None),
+    (None, "/tmp/x/rvfem/.venv/bin/pytest", None),                # the pytest console script
+    (None, "/tmp/x/rvfem/rvfem/cli.py", None),                    # a file of the package, not the command
+    ("ipykernel_launcher", "/tmp/x/rvfem/ipykernel_launcher.py", None),
+    (None, "/tmp/x/rvfem/.venv/bin/rvfem", "rvfem rigid c.toml"),  # the console script
+    ("rvfem.__main__", "/tmp/x/site-packages/rvfem/__main__.py", "rvfem rigid c.toml"),   # python -m rvfem
+    ("rvfem.cli", "/tmp/x/site-packages/rvfem/cli.py", "rvfem rigid c.toml"),             # python -m rvfem.cli
+])
+def test_command_line_is_decided_by_the_entry_point(spec_name, argv0, expected, monkeypatch):
+    monkeypatch.setitem(sys.modules, "__main__", _main_module(spec_name))
+    monkeypatch.setattr("sys.argv", [argv0, "rigid", "c.toml"])
+    assert outputs.command_line() == expected
 
 
 def test_duty_cycle_at_every_torque_is_palmgren_miner_of_the_fe_loads(duty_run):
