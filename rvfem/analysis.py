@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
 
 import numpy as np
 
-from . import hertz, iso281, registry, rigid
+from . import hertz, iso281, registry, rigid, validity
 from .case import Case, apply_overrides, case_to_dict, file_sha256, load_case, parse_override
 from .errors import CaseError
 
@@ -362,6 +362,9 @@ class RigidAnalysis:
         Which rigid references are defined for the case and why (:func:`rvfem.rigid.references`,
         as for the rigid evaluation alone: the equal share of the FE pin resultant is not part of
         it).
+    warnings : tuple of rvfem.validity.ResultWarning
+        Results outside their model's range (:func:`rvfem.validity.rigid_warnings`: P/C, lives
+        under 1 h, Hertz pressures); empty when all hold.
     """
 
     case: Case
@@ -373,6 +376,7 @@ class RigidAnalysis:
     stribeck_factor: float
     duty_cycle: iso281.DutyCycleLife | None
     references: rigid.References | None = None
+    warnings: tuple = ()
 
     @property
     def angle_step_deg(self) -> float:
@@ -429,8 +433,10 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
             hertz_outer=outer,
         ))
     duty = iso281.case_duty_cycle_life(case, [b.loads.L10h for b in bearings])
-    return RigidAnalysis(case=case, loads=loads, bearings=tuple(bearings), rating_N=rating, bearing_speed_rpm=speed,
-                         exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR, duty_cycle=duty, references=refs)
+    result = RigidAnalysis(case=case, loads=loads, bearings=tuple(bearings), rating_N=rating, bearing_speed_rpm=speed,
+                           exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR, duty_cycle=duty,
+                           references=refs)
+    return dataclasses.replace(result, warnings=validity.rigid_warnings(result))
 
 
 # --------------------------------------------------------------------------------------------
@@ -631,6 +637,10 @@ class Analysis:
         model (``cycle``).
     references : rvfem.rigid.References or None
         The rigid references the run is compared with, and why (:func:`rvfem.rigid.references`).
+    warnings : tuple of rvfem.validity.ResultWarning
+        Results outside their model's range (:func:`rvfem.validity.analysis_warnings`: P/C,
+        lives under 1 h, Hertz pressures, disc stress against the yield strength, deformation
+        against the element size); empty when all hold.
     """
 
     case: Case
@@ -650,6 +660,7 @@ class Analysis:
     timings: dict = field(default_factory=dict)
     attribution: Any = None
     references: rigid.References | None = None
+    warnings: tuple = ()
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -1087,11 +1098,12 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
         timings["attribution_compute"] = attribution_seconds
     timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
     timings["cycle_per_angle"] = stages.seconds["cycle"] / n
-    return Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
-                    theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
-                    comparison=comparison, stress=stress, hertz=roller_hertz,
-                    torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
-                    attribution=attribution, references=references)
+    result = Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
+                      theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
+                      comparison=comparison, stress=stress, hertz=roller_hertz,
+                      torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
+                      attribution=attribution, references=references)
+    return dataclasses.replace(result, warnings=validity.analysis_warnings(result))
 
 
 def attribution_of(system, thetas, cycle):

@@ -70,9 +70,14 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_check(args: argparse.Namespace) -> int:
+    from .geometry import disc_geometry
+    from .geometry.features import feature_text
+
     case = _load(args)
+    wall = disc_geometry(case).walls[0]   # the geometry checks meshing does first (cheap, no Gmsh)
     given = f" with {', '.join(case.overrides)}" if case.overrides else ""
-    print(f"OK: case '{case.name}' ({args.case}){given} is valid")
+    print(f"OK: case '{case.name}' ({args.case}){given} is valid; thinnest wall {wall.thickness:.3f} mm "
+          f"between {feature_text(wall.first)} and {feature_text(wall.second)}")
     return EXIT_OK
 
 
@@ -94,6 +99,8 @@ def _run_rigid(args: argparse.Namespace) -> int:
     report = rigid_summary(analyse_rigid(_load(args)))
     if args.json:
         print(json.dumps(report, indent=2, allow_nan=False))
+        for w in report["warnings"]:     # stdout is the JSON: the warnings for the eye on stderr
+            print(f"rvfem rigid: warning: {w['message']}", file=sys.stderr)
     else:
         print(rigid_text(report))
     return EXIT_OK

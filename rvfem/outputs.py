@@ -65,6 +65,7 @@ __all__ = [
     "summary_text",
     "stress_lines",
     "reference_lines",
+    "warning_lines",
     "rigid_summary",
     "rigid_text",
     "write_case_json",
@@ -387,6 +388,10 @@ def _piece_header(a, ctx: SummaryContext) -> dict:
     }
 
 
+def _piece_warnings(a, ctx: SummaryContext) -> dict:
+    return {"warnings": [w.as_dict() for w in a.warnings]}
+
+
 def _piece_model(a, ctx: SummaryContext) -> dict:
     case, model, c = a.case, a.system.model, a.comparison
     return {"model": {
@@ -612,6 +617,7 @@ def _piece_files(a, ctx: SummaryContext) -> dict:
 
 SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_header,
+    _piece_warnings,
     _piece_model,
     _piece_references,
     _piece_bearings,
@@ -722,8 +728,11 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
     out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
     cy = analysis.cycle
     if cy.von_mises_envelope is not None:
-        out.append(vtkio.write_envelope_vtu(vtk / vtkio.ENVELOPE_FILE, points, triangles, cy.von_mises_envelope,
-                                            cy.von_mises_envelope_theta, mesh=mesh))
+        structural, recovered = analysis.stress.structural, analysis.stress.recovered
+        out.append(vtkio.write_envelope_vtu(
+            vtk / vtkio.ENVELOPE_FILE, points, triangles, cy.von_mises_envelope, cy.von_mises_envelope_theta,
+            element_order=model.order, structural_peak_MPa=None if structural is None else structural.von_mises_MPa,
+            structural_peak_order=2 if recovered is not None else model.order, mesh=mesh))
     return out
 
 
@@ -1128,7 +1137,16 @@ def summary_text(summary: dict) -> str:
     t = summary["timings_s"]
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")
+    lines += warning_lines(summary.get("warnings", []))
     return "\n".join(lines)
+
+
+def warning_lines(warnings: list[dict], prefix: str = "  warning: ") -> list[str]:
+    """The ``warnings`` of ``summary.json`` or ``rvfem rigid --json`` as screen lines, one each
+    (:mod:`rvfem.validity`), preceded by an empty line; none when there are none."""
+    if not warnings:
+        return []
+    return [""] + [prefix + w["message"] for w in warnings]
 
 
 def reference_lines(references: dict) -> list[str]:
@@ -1227,6 +1245,7 @@ def rigid_summary(result) -> dict:
         "dynamic_load_rating_N": result.rating_N,
         "stribeck_factor": result.stribeck_factor,
         "references": _references_dict(result.references or references(case, fe=False)),
+        "warnings": [w.as_dict() for w in result.warnings],
         "bearings": bearings,
     }
     if case.loads.duty_cycle:
@@ -1279,4 +1298,5 @@ def rigid_text(report: dict) -> str:
             f"  duty cycle: equivalent torque {duty['equivalent_torque_Nm']:.1f} N·m, equivalent speed "
             f"{duty['equivalent_speed_rpm']:.2f} rpm, service life {_num(duty['service_life_h'], '.0f')} h "
             f"(from the shortest rated life {_num(duty['rated_life_h'], '.0f')} h)")
+    lines += warning_lines(report.get("warnings", []))
     return "\n".join(lines)

@@ -34,6 +34,8 @@ figcaption { font-size: 0.9em; color: #444; }
 .grid { display: grid; grid-template-columns: repeat(auto-fit, minmax(520px, 1fr)); gap: 1em; }
 ul li { margin: 0.2em 0; }
 code { background: #f4f4f4; padding: 0 0.2em; }
+.warnings { border: 2px solid #c0392b; background: #fdf0ee; padding: 0.4em 1em; margin: 1em 0; }
+.warnings h2 { margin-top: 0.3em; border: none; color: #a93226; }
 """
 
 
@@ -255,6 +257,16 @@ def _symmetry_sentence(m: dict) -> str:
     return f"{mesh}; every crank angle solved;"
 
 
+def _warnings_html(warnings: list[dict]) -> str:
+    """The results outside their model's range (``summary["warnings"]``, :mod:`rvfem.validity`),
+    one line each in a box at the top of the report; nothing when there are none."""
+    if not warnings:
+        return ""
+    return ("<div class='warnings'><h2>Warnings: results outside their model's range</h2><ul>"
+            + "".join(f"<li><code>{_e(w['code'])}</code>: {_e(w['message'])}</li>" for w in warnings)
+            + "</ul><p class='meta'>Limits and their sources: docs/outputs.md, \"Warnings\".</p></div>")
+
+
 def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str | os.PathLike) -> Path:
     """Write ``report.html``.
 
@@ -291,6 +303,8 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
                  f"elements, {m['nodes']} nodes, {m['dofs']} dofs, {m['elements']} elements; {m['angles']} crank "
                  f"angles (step {m['angle_step_deg']:g}°); {_symmetry_sentence(m)} wall time "
                  f"{summary['timings_s']['total']:.1f} s.</p>")
+
+    parts.append(_warnings_html(summary.get("warnings", [])))
 
     # -- results ---------------------------------------------------------------------------------
     refs = summary["references"]

@@ -277,6 +277,8 @@ def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
         assert report["case_digest"] == load_case(path).digest()
         assert report["environment"]["versions"]["numpy"]
         written |= written_keys(report, {"environment"})
+    assert cli.main(["rigid", CRV80E, "--json", "--set", "loads.torque_Nm=40000.0"]) == 0   # with warnings
+    written |= written_keys(json.loads(capsys.readouterr().out), {"environment"})
     documented = documented_keys("## `rvfem rigid --json`")
     assert written - documented == set(), "keys written but not documented"
     assert documented - written == set(), "keys documented but not written"

@@ -125,6 +125,7 @@ def test_summary_has_the_documented_keys(summary, coarse_case_file):
     assert summary["timings_s"]["total"] > summary["timings_s"]["cycle"] > 0
     # case file defaults are listed (the coarse file does not set e.g. the element order)
     assert summary["case"]["defaults_used"]["analysis.element_order"] == 1
+    assert summary["warnings"] == []                    # the default case is inside every model's range
 
 
 def test_summary_numbers_equal_the_python_api(summary, api):
@@ -573,8 +574,12 @@ OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timin
 
 
 def test_summary_keys_are_the_documented_ones(summary, duty_run, two_teeth_run):
+    from rvfem.validity import check_limits
+
+    # no shipped case warns: the keys of a warning come from one made here
+    warning = check_limits(load_ratios=[("bearing 1, flexible", 0.6)])[0].as_dict()
     written = (written_keys(summary, OPAQUE_KEYS) | written_keys(duty_run[1], OPAQUE_KEYS)
-               | written_keys(two_teeth_run[1], OPAQUE_KEYS))
+               | written_keys(two_teeth_run[1], OPAQUE_KEYS) | written_keys({"warnings": [warning]}))
     documented = documented_keys()
     assert written - documented == set(), "keys written but not in docs/outputs.md"
     assert documented - written == set(), "keys in docs/outputs.md that no run writes"
