@@ -934,6 +934,9 @@ def solve_bodies(bodies: list[Body], torque: float | None, *, coupling: np.ndarr
         # the carrier's rotation free, the next Newton matrix is singular and the iteration
         # cycles. Open springs that keep a weak stiffness never leave a mechanism; their small
         # tensile forces are only a start, which the solve below removes
+        # A start that settles but from which the solve itself does not (a radial clearance larger
+        # than the first step's approaches can leave every roller open at the start) is followed
+        # by the next way of starting.
         torque_side = np.concatenate([_torque_side(b, torque) for b in bodies])
         everything = np.ones(torque_side.size, dtype=bool)
         attempts = [(0.0, everything), (OPEN_SPRING_FRACTION, everything)]
@@ -941,9 +944,10 @@ def solve_bodies(bodies: list[Body], torque: float | None, *, coupling: np.ndarr
             attempts.insert(0, (0.0, torque_side))
         for i, (open_fraction, engaged) in enumerate(attempts):
             try:
-                start = _newton(linearised(open_fraction), torque, coupling, None, max_iterations, label,
+                first = _newton(linearised(open_fraction), torque, coupling, None, max_iterations, label,
                                 tol_gap, names, rigid_dofs, engaged=engaged)
-                break
+                return _newton(bodies, torque, coupling, first, max_iterations, label, tol_gap, names,
+                               rigid_dofs)
             except ContactError:
                 if i == len(attempts) - 1:
                     raise
@@ -1055,20 +1059,15 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
     eq = slice(nc, nc + nr)
     row_scale = np.tile([1.0, 1.0, 1.0 / r_typ], nb)
 
-    v, delta, q, dq = state(lam, a, phi)
-    for it in range(1, max_iterations + 1):
-        if engaged is not None and it == 1:
-            # first linear solve: the ``engaged`` springs acting both ways, so that the system is
-            # stable; the others open
-            for idx, law in laws:
-                on = engaged[idx]
-                q[idx] = np.where(on, law(np.abs(delta[idx]))[0] * np.sign(delta[idx]), 0.0)
-                dq[idx] = np.where(on, law(np.ones(np.size(delta[idx])))[1], 0.0)
+    si = np.flatnonzero(spring)
+
+    def assemble(dq):
+        """The Newton matrix and residual at the current iterate with the spring tangents ``dq``,
+        and the contacts whose forces enter the approaches."""
         J = np.flatnonzero(active | (spring & (dq > 0)) | (lam != 0))
         Gj = G_cols(J)
         Jm = np.zeros((n, n))
         r = np.zeros(n)
-        si = np.flatnonzero(spring)
         r[si] = lam[si] - q[si]
         Jm[si, si] = 1.0
         Jm[np.ix_(si, J)] += dq[si, None] * Gj[si]
@@ -1090,24 +1089,65 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         for k in range(nb):
             for d in dropped:
                 Jm[nc + 3 * k + d, nc + 3 * k + d] = 1.0
+        return Jm, r, J
+
+    def known_rows(dq):
+        """Rows whose step is known: open springs (dq = 0: λ = q) and inactive rigid contacts (λ = 0)."""
+        known = np.zeros(n, dtype=bool)
+        known[si[dq[si] == 0]] = True
+        known[np.flatnonzero(sig & ~active)] = True
+        return known
+
+    tangents = []
+
+    def open_tangent():
+        """Secant stiffness of every spring at the force it is expected to carry (computed once)."""
+        if not tangents:
+            k = np.zeros(nc)
+            t_ref = torque if torque else r_typ     # no torque: the secant at about 1 N
+            for b, (lo, hi) in zip(bodies, zip(offs[:-1], offs[1:])):
+                for idx, ks, _ in _secant_stiffnesses(b, t_ref / nb):
+                    k[lo + np.arange(hi - lo)[idx]] = ks
+            tangents.append(k)
+        return tangents[0]
+
+    v, delta, q, dq = state(lam, a, phi)
+    for it in range(1, max_iterations + 1):
+        if engaged is not None and it == 1:
+            # first linear solve: the ``engaged`` springs acting both ways, so that the system is
+            # stable; the others open
+            for idx, law in laws:
+                on = engaged[idx]
+                q[idx] = np.where(on, law(np.abs(delta[idx]))[0] * np.sign(delta[idx]), 0.0)
+                dq[idx] = np.where(on, law(np.ones(np.size(delta[idx])))[1], 0.0)
+        Jm, r, J = assemble(dq)
+        ii = np.flatnonzero(sig & ~active)
         # the rows of open springs (dq = 0) and of inactive rigid contacts read λ_i = q_i, λ_i = 0:
         # their steps are known, and the rest is a smaller system (about half the contacts are
         # open). An open spring's force becomes exactly 0: a solve of the whole system would leave
         # round-off (1e-18 N), which would mark it as loaded and fetch its compliance columns
-        known = np.zeros(n, dtype=bool)
-        known[si[dq[si] == 0]] = True
-        known[ii] = True
-        fixed, free = np.flatnonzero(known), np.flatnonzero(~known)
-        step = np.zeros(n)
-        step[fixed] = -r[fixed]
-        cscale = colscale[free]
-        A = Jm[np.ix_(free, free)] * cscale[None, :]
-        rhs = -r[free] - Jm[np.ix_(free, fixed)] @ step[fixed]
-        try:
-            y = np.linalg.solve(A, rhs)
-        except np.linalg.LinAlgError:
-            y = np.linalg.lstsq(A, rhs, rcond=None)[0]
-        step[free] = y * cscale
+        step = _reduced_step(Jm, r, colscale, known_rows(dq))
+        if step is None:
+            # the linearised system is a mechanism: every spring that could hold a rigid motion
+            # of a disc or of the carrier is open (zero tangent: Palmgren's law at δ ≤ 0, e.g. a
+            # radial clearance wider than the approaches of the current iterate). This step is
+            # the Newton step of the regularised law the cold start uses (an open spring keeps
+            # OPEN_SPRING_FRACTION of its secant stiffness as a weak tension spring): it moves
+            # the disc through the clearance onto its rollers. The next steps are the true law's
+            # again, so the solution is unchanged
+            opened = spring & (dq == 0)
+            k_open = OPEN_SPRING_FRACTION * open_tangent()
+            q_true = q.copy()
+            q[opened] = k_open[opened] * np.minimum(delta[opened], 0.0)
+            dq_open = np.where(opened, k_open, dq)
+            Jm, r, J = assemble(dq_open)
+            q[:] = q_true
+            step = _reduced_step(Jm, r, colscale, known_rows(dq_open))
+            if step is None:
+                raise ContactError(
+                    f"the contact problem {label}is a mechanism: no contact holds the disc or the carrier "
+                    "(every pin and roller is open). Check the radial clearance, the profile "
+                    "modifications and the torque.")
         lam = lam + step[:nc]
         lam[ii] = 0.0
         a = a + step[eq]
@@ -1121,9 +1161,16 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         spring_history.append(spring & (dq > 0))
         spring_res = float(np.abs(lam[spring] - q[spring]).max()) if spring.any() else 0.0
         gap_res = float(np.abs(gap[active]).max()) if active.any() else 0.0
+        # equilibrium of every body and of the carrier: met by every solved step (the equations are
+        # linear), missed only where a step could not be solved
+        unbalanced = float(np.abs((RL.T @ lam) * row_scale).max())
+        if carrier:
+            unbalanced = max(unbalanced, abs(lever @ lam - torque) / r_typ)
+        balanced = unbalanced <= 1e-9 * max(scale_f, float(np.abs(lam).sum()))
         settled = np.array_equal(new_active, active)
         active = new_active
-        if settled and spring_res <= 1e-8 * scale_f and gap_res <= tol_gap and not (engaged is not None and it == 1):
+        if (settled and balanced and spring_res <= 1e-8 * scale_f and gap_res <= tol_gap
+                and not (engaged is not None and it == 1)):
             break
     else:
         changes = np.zeros(nc, dtype=int)
@@ -1138,8 +1185,9 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
             f"contact active set did not settle {label}within {max_iterations} iterations"
             + (f"; contacts that keep flipping: {', '.join(flipping)}" if flipping else "")
             + (f"; springs whose force law is not met: {', '.join(unsettled)}" if unsettled else "")
-            + ". Check the profile modifications and clearances or refine the angle step "
-            "(analysis.max_active_set_iterations raises the bound)."
+            + ". Check the profile modifications, the clearances and the pin friction (analysis.friction), "
+            "or refine the angle step; a set that has not settled by now keeps cycling, so raising "
+            "analysis.max_active_set_iterations rarely helps."
         )
 
     # λ from the last Newton step satisfies the (linear) equilibrium equations to round-off and
@@ -1163,6 +1211,26 @@ def _newton(bodies, torque, coupling, start, max_iterations, label, tol_gap, nam
         out.append(AngleSolution(lk, Rk[:, :2] * lk[:, None], gap_out[rows], a[3 * k:3 * k + 3], float(phi),
                                  it, residual))
     return out
+
+
+def _reduced_step(Jm: np.ndarray, r: np.ndarray, colscale: np.ndarray, known: np.ndarray) -> np.ndarray | None:
+    """The Newton step of the system ``Jm·step = −r``: the ``known`` rows' steps are −r (their
+    rows are identity rows), the rest solved with the columns scaled by ``colscale``. None if that
+    system is singular and inconsistent (a mechanism: a rigid motion no contact resists)."""
+    fixed, free = np.flatnonzero(known), np.flatnonzero(~known)
+    step = np.zeros(r.size)
+    step[fixed] = -r[fixed]
+    cscale = colscale[free]
+    A = Jm[np.ix_(free, free)] * cscale[None, :]
+    rhs = -r[free] - Jm[np.ix_(free, fixed)] @ step[fixed]
+    try:
+        y = np.linalg.solve(A, rhs)
+    except np.linalg.LinAlgError:
+        y = np.linalg.lstsq(A, rhs, rcond=None)[0]
+        if np.abs(A @ y - rhs).max() > 1e-8 * max(float(np.abs(rhs).max()), 1e-30):
+            return None
+    step[free] = y * cscale
+    return step
 
 
 def _submatrix(C: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
