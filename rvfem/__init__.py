@@ -8,10 +8,17 @@ mm, N, MPa, rpm and hours throughout; angles are radians inside the code and deg
 from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
+from types import MappingProxyType
 
 try:
     __version__ = version("rvfem")
 except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
     __version__ = "0+unknown"
 
-__all__ = ["__version__"]
+NOTICE = MappingProxyType({"notice": True})
+"""``extra`` of an INFO log record meant for the user even without ``-v``: something rvfem chose
+for them that changes the run, e.g. a crank-angle step adjusted to divide 360° or a whole-disc mesh
+where a sector was possible, and why (``log.info("...", extra=NOTICE)``). Library code logs, it
+never prints; the command line shows these records as one "note" line each."""
+
+__all__ = ["__version__", "NOTICE"]

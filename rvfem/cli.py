@@ -180,23 +180,28 @@ def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
 
 class _RunProgress:
     """Progress of ``rvfem run`` on stderr: a tqdm bar for the load cycle and the images on a
-    terminal, plain lines otherwise (one per stage, and every tenth of the cycle)."""
+    terminal, plain lines otherwise (one per stage, and every tenth of the cycle).
+
+    Stages are numbered in the order they start, out of the stages the run reports
+    (``stages``, :func:`rvfem.run.run_stages`; default every stage of :data:`rvfem.run.STAGES`)."""
 
     BAR_STAGES = ("cycle", "vtk", "images")
 
-    def __init__(self, stream: TextIO, tty: bool):
+    def __init__(self, stream: TextIO, tty: bool, stages: tuple[str, ...] | None = None):
         from .run import STAGES
 
         self.stream, self.tty = stream, tty
-        self.names, self.descriptions = list(STAGES), STAGES
+        self.descriptions = STAGES
+        self.expected = len(stages if stages is not None else STAGES)
+        self.numbers: dict[str, int] = {}   # stage → its number, in the order the stages started
         self.started: dict[str, float] = {}
         self.bar = None
         self.pending = ""  # a status line drawn on a terminal, not yet ended
         self.last_tenth = -1
 
     def _head(self, stage: str) -> str:
-        index = self.names.index(stage) + 1 if stage in self.names else 0
-        return f"rvfem run [{index}/{len(self.names)}] {self.descriptions.get(stage, stage)}"
+        index = self.numbers.setdefault(stage, len(self.numbers) + 1)
+        return f"rvfem run [{index}/{max(self.expected, len(self.numbers))}] {self.descriptions.get(stage, stage)}"
 
     def __call__(self, stage: str, done: int, total: int) -> None:
         import time
@@ -235,7 +240,8 @@ class _RunProgress:
             if tenth > self.last_tenth:
                 self.last_tenth = tenth
                 if tenth > 0:
-                    self.stream.write(f"rvfem run: cycle {done}/{total} angles ({10 * tenth} %), {elapsed:.1f} s\n")
+                    self.stream.write(f"rvfem run: cycle {done}/{total} angles ({100 * done // total} %), "
+                                      f"{elapsed:.1f} s\n")
                     self.stream.flush()
 
     def close(self) -> None:
@@ -264,7 +270,11 @@ def _run_run(args: argparse.Namespace) -> int:
         check_output_folder(out_dir, args.overwrite)
     except OutputError as exc:  # the command line's wording: the option, not the keyword argument
         raise OutputError(str(exc).replace("overwrite=True", "--overwrite")) from None
-    progress = _RunProgress(sys.stderr, sys.stderr.isatty())
+    from .run import run_stages
+
+    progress = _RunProgress(sys.stderr, sys.stderr.isatty(), run_stages(case, images=not args.no_images))
+    if _notices is not None:
+        _notices.before = progress.close    # a note ends a status line or a bar first
     try:
         result = run_case(case, out_dir, angle_step_deg=args.step, bearing_model=args.bearing_model,
                           order=args.order, overwrite=args.overwrite, progress=progress,
@@ -302,18 +312,76 @@ def build_parser(subcommands: tuple[Subcommand, ...] | None = None) -> argparse.
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("-v", "--verbose", action="count", default=0,
-                        help="more log output on stderr (-v info, -vv debug)")
+                        help="more log output on stderr (-v info, -vv debug); also after the subcommand")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for command in subcommands:
         p = sub.add_parser(command.name, help=command.help, description=command.help)
         command.add_arguments(p)
+        # -v after the subcommand too (its own dest: a subparser's value would replace the main one's)
+        p.add_argument("-v", "--verbose", action="count", default=0, dest="verbose_after",
+                       help="more log output on stderr (-v info, -vv debug)")
         p.set_defaults(run=command.run)
     return parser
 
 
-def _setup_logging(verbosity: int) -> None:
+class _Notices(logging.Handler):
+    """Shows the library's notices (INFO records logged with ``extra=rvfem.NOTICE``) without
+    ``-v``: one line ``rvfem COMMAND: note: …`` on stderr each, a message once.
+
+    Attributes
+    ----------
+    before : callable or None
+        Called before a note is written (``rvfem run`` ends its progress status line or bar).
+    """
+
+    def __init__(self, command: str, stream: TextIO):
+        super().__init__(logging.INFO)
+        self.command, self.stream = command, stream
+        self.seen: set[str] = set()
+        self.before: Callable[[], None] | None = None
+        self.addFilter(lambda record: getattr(record, "notice", False))
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            message = record.getMessage()
+            if message in self.seen:
+                return
+            self.seen.add(message)
+            if self.before is not None:
+                self.before()
+            self.stream.write(f"rvfem {self.command}: note: {message}\n")
+            self.stream.flush()
+        except Exception:  # pragma: no cover - logging must not raise
+            self.handleError(record)
+
+
+#: The notice handler of the running command (None with -v: the log lines show the notices).
+_notices: _Notices | None = None
+
+
+def _setup_logging(verbosity: int, command: str = "") -> Callable[[], None]:
+    """Log to stderr at WARNING (INFO with -v, DEBUG with -vv); without -v the notices of rvfem
+    (:class:`_Notices`) are shown as well. Returns the function that removes the notice handler."""
+    global _notices
     level = logging.WARNING if verbosity <= 0 else logging.INFO if verbosity == 1 else logging.DEBUG
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr, force=True)
+    for handler in logging.getLogger().handlers:
+        handler.setLevel(level)     # rvfem's logger may pass INFO records (the notices) below
+    if verbosity > 0:
+        return lambda: None
+    package = logging.getLogger(__package__)
+    previous = package.level
+    _notices = _Notices(command, sys.stderr)
+    package.addHandler(_notices)
+    package.setLevel(logging.INFO)
+
+    def remove(handler: _Notices = _notices) -> None:
+        global _notices
+        package.removeHandler(handler)
+        package.setLevel(previous)
+        _notices = None
+
+    return remove
 
 
 def _write_crash_log(command: str, argv: list[str] | None) -> str:
@@ -337,7 +405,8 @@ def main(argv: list[str] | None = None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # --help, --version, usage errors (argparse exits with 2)
         return exc.code if isinstance(exc.code, int) else (EXIT_OK if exc.code is None else EXIT_USER_ERROR)
-    _setup_logging(args.verbose)
+    args.verbose += getattr(args, "verbose_after", 0)
+    remove_notices = _setup_logging(args.verbose, args.command)
     try:
         return args.run(args)
     except RvfemError as exc:
@@ -358,6 +427,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"rvfem {args.command}: internal error ({type(exc).__name__}{': ' + reason if reason else ''}); "
               f"this is a bug in rvfem, please report it with the log file {log_path}", file=sys.stderr)
         return EXIT_INTERNAL_ERROR
+    finally:
+        remove_notices()
 
 
 if __name__ == "__main__":  # pragma: no cover

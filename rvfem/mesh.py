@@ -58,6 +58,7 @@ import gmsh
 import numpy as np
 from scipy.spatial import cKDTree
 
+from . import NOTICE
 from ._arrays import chain_edges
 from .case import Case, case_to_dict
 from .errors import MeshError
@@ -438,8 +439,8 @@ def _hole_size(ms) -> float:
 def _sector_cut(geom: DiscGeometry) -> _Cut | None:
     """The cut of the sector mesh, or None (and why, logged) if the whole disc must be meshed."""
     order, why = _symmetry_reason(geom)
-    if order == 1:
-        log.info("meshing the whole disc: %s", why)
+    if order == 1:   # a notice (shown without -v) unless the case asks for the whole disc
+        log.info("meshing the whole disc: %s", why, extra=NOTICE if geom.case.mesh.symmetric else {})
         return None
     spl = geom.profile.spline_points
     rc = geom.central_hole.radius
@@ -459,7 +460,7 @@ def _sector_cut(geom: DiscGeometry) -> _Cut | None:
     if margin < CUT_CLEARANCE:
         log.info("meshing the whole disc: it is %d-fold symmetric, but the best sector cut (to tip %d "
                  "at %.3f°) passes %.3g mm from a feature, %.2f element sizes (needs %.2f)",
-                 order, j, math.degrees(a), clearance, margin, CUT_CLEARANCE)
+                 order, j, math.degrees(a), clearance, margin, CUT_CLEARANCE, extra=NOTICE)
         return None
     return _Cut(order=order, tip=j, angle=a, clearance=clearance, margin=margin,
                 images=_feature_images(geom, order))
@@ -938,7 +939,10 @@ def mesh_case(case: Case, cache_dir: str | os.PathLike = "meshes", *, use_cache:
     path = mesh_path(case, cache_dir)
     if use_cache and path.is_file():
         try:
-            return read_msh(path, from_cache=True)
+            mesh = read_msh(path, from_cache=True)
+            if mesh.symmetry == 1:
+                _sector_cut(geom)    # says why the whole disc is meshed (a notice), as when it was meshed
+            return mesh
         except MeshError:
             pass     # unreadable cache entry: re-mesh; the new file replaces it atomically
     return mesh_geometry(geom, path)

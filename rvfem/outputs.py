@@ -285,8 +285,9 @@ def _hertz_dict(h) -> dict:
 
 
 ANGLE_DECIMALS = 6
-"""Crank angles in ``summary.json`` are rounded to this many decimals (no float noise such as
-255.00000000000003; every step rvfem accepts is a whole multiple of 1e-6°)."""
+"""Crank angles in ``summary.json`` and ``rvfem rigid --json`` are rounded to this many decimals
+(no float noise such as 255.00000000000003; every step rvfem accepts is a whole multiple of
+1e-6°)."""
 
 
 def _angle(deg):
@@ -1058,12 +1059,51 @@ def _num(value: float | None, fmt: str) -> str:
     return format(value, fmt)
 
 
+SCREEN_DIGITS = 4
+"""Fewest significant figures a number of the screen tables shows (:func:`_sig`)."""
+
+
+def _sig(value: float | None, fmt: str) -> str:
+    """A load, pressure or stress for a screen table: ``format(value, fmt)`` (a fixed-point format
+    such as ``"8.0f"``) where that shows at least :data:`SCREEN_DIGITS` significant figures and fits
+    the width, else the value with that many significant figures (``0.007113``, ``3.813e+08``);
+    a dash for None. A 1e-3 N·m torque gives loads in mN, not "0"."""
+    if value is None:
+        return _num(value, fmt)
+    v = float(value)
+    spec = fmt.rstrip("f")
+    width_text, _, decimals_text = spec.partition(".")
+    width = int("".join(c for c in width_text if c.isdigit()) or 0)
+    decimals = int(decimals_text or 0)
+    fixed = format(v, fmt)
+    fits = len(fixed) <= (width or 12)          # a free-width number up to 12 characters
+    if v == 0 or not math.isfinite(v) or (abs(v) >= 10.0 ** (SCREEN_DIGITS - 1 - decimals) and fits):
+        return fixed
+    return f"{v:.{SCREEN_DIGITS}g}".rjust(width)
+
+
+def _life(value: float | None, width: int = 0) -> str:
+    """A life in hours for the screen: whole hours from 1 h to 10⁷ h, three significant figures
+    outside (``0.0497``, ``1.23e+24``), ``inf`` at zero load, a dash for None."""
+    if value is None:
+        return _num(value, f"{width}.0f")
+    v = float(value)
+    if not math.isfinite(v) or v == 0:
+        return f"{v:{width}.0f}"
+    if 1.0 <= abs(v) < 1e7:
+        return f"{v:{width}.0f}"
+    return f"{v:{width}.3g}"
+
+
 def summary_text(summary: dict) -> str:
     """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints)."""
+    from .report import toml_text
+
     c, m = summary["case"], summary["model"]
     lines = [
         f"Case {c['name']}" + (f" ({c['file']})" if c.get("file") else "") +
-        (f", overrides: {', '.join(f'{k} = {v}' for k, v in c['overrides'].items())}" if c["overrides"] else ""),
+        (f", overrides: {', '.join(f'{k} = {toml_text(v)}' for k, v in c['overrides'].items())}"
+         if c["overrides"] else ""),
         f"  model: bearings '{m['bearing_model']}', P{m['element_order']}, {m['nodes']} nodes, {m['dofs']} dofs, "
         f"{m['elements']} elements; {m['angles']} crank angles (step {m['angle_step_deg']:g}°)",
         f"  torque {m['output_torque_Nm']:g} N·m on {m['discs']} discs = {m['disc_torque_Nmm'] / 1000:g} N·m per disc "
@@ -1083,9 +1123,9 @@ def summary_text(summary: dict) -> str:
             if s is None:
                 lines.append(head + "not defined for Zp − Zc ≠ 1")
                 continue
-            lines.append(head + f"{_num(s['max_load_N'], '8.0f')} "
-                         f"{_num(s['max_at_deg'], '6.1f')} {_num(s['min_load_N'], '8.0f')} {_num(s['min_at_deg'], '6.1f')} "
-                         f"{_num(s['equivalent_load_N'], '8.0f')} {_num(s['L10h_h'], '9.0f')}")
+            lines.append(head + f"{_sig(s['max_load_N'], '8.0f')} "
+                         f"{_num(s['max_at_deg'], '6.1f')} {_sig(s['min_load_N'], '8.0f')} {_num(s['min_at_deg'], '6.1f')} "
+                         f"{_sig(s['equivalent_load_N'], '8.0f')} {_life(s['L10h_h'], 9)}")
         lines.append(f"  {'':>7} {'delta':<9} {_num(b['delta_max_percent'], '+7.1f')}% {'':>6} "
                      f"{_num(b['delta_min_percent'], '+7.1f')}% {'':>6} {_num(b['delta_equivalent_percent'], '+7.1f')}%  "
                      f"life ratio {_num(b['life_ratio'], '.2f')}" + ("" if handbook else "  (vs equal share)"))
@@ -1110,20 +1150,22 @@ def summary_text(summary: dict) -> str:
     ]
     sr = h["stribeck_rigid"]
     hertz = ("  Hertz, most loaded roller: " + (
-        f"rigid Stribeck Q = {sr['roller_load_N']:.0f} N, p_in {sr['inner']['peak_pressure_MPa']:.0f} / p_out "
-        f"{sr['outer']['peak_pressure_MPa']:.0f} MPa" if sr else "rigid Stribeck not defined for Zp − Zc ≠ 1"))
+        f"rigid Stribeck Q = {_sig(sr['roller_load_N'], '.0f')} N, p_in {_sig(sr['inner']['peak_pressure_MPa'], '.0f')}"
+        f" / p_out {_sig(sr['outer']['peak_pressure_MPa'], '.0f')} MPa" if sr else
+        "rigid Stribeck not defined for Zp − Zc ≠ 1"))
     if fe:
-        hertz += (f"; FE Q = {fe['roller_load_N']:.0f} N, p_in {fe['inner']['peak_pressure_MPa']:.0f} / p_out "
-                  f"{fe['outer']['peak_pressure_MPa']:.0f} MPa")
+        hertz += (f"; FE Q = {_sig(fe['roller_load_N'], '.0f')} N, p_in {_sig(fe['inner']['peak_pressure_MPa'], '.0f')}"
+                  f" / p_out {_sig(fe['outer']['peak_pressure_MPa'], '.0f')} MPa")
     else:
         sf = h["stribeck_flexible"]
-        hertz += (f"; FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N, p_in "
-                  f"{sf['inner']['peak_pressure_MPa']:.0f} / p_out {sf['outer']['peak_pressure_MPa']:.0f} MPa")
+        hertz += (f"; FE bearing load with Stribeck Q = {_sig(sf['roller_load_N'], '.0f')} N, p_in "
+                  f"{_sig(sf['inner']['peak_pressure_MPa'], '.0f')} / p_out "
+                  f"{_sig(sf['outer']['peak_pressure_MPa'], '.0f')} MPa")
     lines.append(hertz)
     duty = summary.get("duty_cycle")
     if duty:
         lines.append("  duty cycle: service life " + ", ".join(
-            f"{key} {_num(duty[key]['service_life_h'], '.0f')} h" if duty[key] else f"{key} not defined"
+            f"{key} {_life(duty[key]['service_life_h'])} h" if duty[key] else f"{key} not defined"
             for key in ("rigid", "flexible"))
             + f" (equivalent torque {duty['flexible']['equivalent_torque_Nm']:.1f} N·m, "
               f"speed {duty['flexible']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
@@ -1131,7 +1173,7 @@ def summary_text(summary: dict) -> str:
         if fe:
             lines.append(
                 "    flexible FE at every duty torque (" + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): "
-                f"service life {_num(fe['service_life_h'], '.0f')} h ({_num(fe['life_difference_percent'], '+.1f')} % "
+                f"service life {_life(fe['service_life_h'])} h ({_num(fe['life_difference_percent'], '+.1f')} % "
                 "against the linear scaling); F_m off linear scaling by "
                 + ", ".join(f"{e:+.1f} %" for e in fe["linear_scaling_error_percent"]))
     t = summary["timings_s"]
@@ -1175,20 +1217,21 @@ def stress_lines(stress: dict) -> list[str]:
     if sp:
         at = sp["at"]
         lines += [
-            f"  structural stress peak (away from contacts) {sp['von_mises_MPa']:.0f} MPa von Mises ± "
+            f"  structural stress peak (away from contacts) {_sig(sp['von_mises_MPa'], '.0f')} MPa von Mises ± "
             f"{sp['estimated_error_MPa']:.1f} MPa (estimated), {at['feature_label']} at ({at['x_mm']:.1f}, "
             f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°",
             f"    P2 re-solve at θ = {', '.join(f'{x:g}' for x in sp['angles_deg'])}° with the cycle's forces "
-            f"({sp['seconds']:.1f} s); the P{away['element_order']} cycle alone gives {sp['p1_MPa']:.0f} MPa "
+            f"({sp['seconds']:.1f} s); the P{away['element_order']} cycle alone gives {_sig(sp['p1_MPa'], '.0f')} MPa "
             f"({sp['p1_error_percent']:+.0f} %)",
         ]
     elif away:
         at = away["at"]
-        lines.append(f"  structural stress peak (away from contacts) {away['peak_von_mises_MPa']:.0f} MPa von Mises "
+        lines.append(f"  structural stress peak (away from contacts) {_sig(away['peak_von_mises_MPa'], '.0f')} MPa "
+                     "von Mises "
                      f"(P{away['element_order']}, not re-solved on P2), {at['feature_label']} at ({at['x_mm']:.1f}, "
                      f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°")
     at = cz["at"]
-    lines.append(f"  contact-zone peak {cz['peak_von_mises_MPa']:.0f} MPa (under a pin or roller footprint, "
+    lines.append(f"  contact-zone peak {_sig(cz['peak_von_mises_MPa'], '.0f')} MPa (under a pin or roller footprint, "
                  f"mesh-dependent; not a Hertz stress), {at['feature_label']}, {at['distance_to_feature_mm']:.2f} mm "
                  f"from it, θ = {at['theta_deg']:g}°")
     return lines
@@ -1203,9 +1246,9 @@ def rigid_summary(result) -> dict:
         "bearing": b.loads.bearing + 1,
         "crank_angle_deg": b.crank_angle_deg,
         "max_load_N": b.loads.max_N,
-        "max_at_deg": b.loads.max_at_deg,
+        "max_at_deg": _angle(b.loads.max_at_deg),
         "min_load_N": b.loads.min_N,
-        "min_at_deg": b.loads.min_at_deg,
+        "min_at_deg": _angle(b.loads.min_at_deg),
         "equivalent_load_N": b.loads.equivalent_N,
         "L10h_h": b.loads.L10h,
         "max_roller_load_N": b.max_roller_load_N,
@@ -1263,8 +1306,8 @@ def rigid_text(report: dict) -> str:
         f"Case {report['case']} ({report['source']}): {report['model']}",
         f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {report['disc_torque_Nmm'] / 1000:g} N·m, "
         f"output speed {report['output_speed_rpm']:g} rpm, bearing speed {report['bearing_speed_rpm']:g} rpm",
-        f"  k = {report['k']:.4f}, k_y = {_num(report['k_y'], '.4f')}, ΣPx = {_num(report['sum_px_N'], '.1f')} N, "
-        f"ΣPy = {_num(report['sum_py_N'], '.1f')} N, crank-angle step {report['angle_step_deg']:g}°",
+        f"  k = {report['k']:.4f}, k_y = {_num(report['k_y'], '.4f')}, ΣPx = {_sig(report['sum_px_N'], '.1f')} N, "
+        f"ΣPy = {_sig(report['sum_py_N'], '.1f')} N, crank-angle step {report['angle_step_deg']:g}°",
         f"  dynamic load rating C = {report['dynamic_load_rating_N']:.1f} N; equivalent load exponent p = {p_text}",
     ]
     if report.get("overrides"):
@@ -1280,10 +1323,10 @@ def rigid_text(report: dict) -> str:
                          "equal share)")
             continue
         lines.append(
-            f"{b['bearing']:>7d} {b['max_load_N']:9.1f} {b['max_at_deg']:6.1f} {b['min_load_N']:9.1f} "
-            f"{b['min_at_deg']:6.1f} {b['equivalent_load_N']:9.1f} {_num(b['L10h_h'], '9.0f')} "
-            f"{b['max_roller_load_N']:8.1f} {b['hertz_inner']['peak_pressure_MPa']:9.1f} "
-            f"{b['hertz_outer']['peak_pressure_MPa']:9.1f}")
+            f"{b['bearing']:>7d} {_sig(b['max_load_N'], '9.1f')} {b['max_at_deg']:6.1f} {_sig(b['min_load_N'], '9.1f')} "
+            f"{b['min_at_deg']:6.1f} {_sig(b['equivalent_load_N'], '9.1f')} {_life(b['L10h_h'], 9)} "
+            f"{_sig(b['max_roller_load_N'], '8.1f')} {_sig(b['hertz_inner']['peak_pressure_MPa'], '9.1f')} "
+            f"{_sig(b['hertz_outer']['peak_pressure_MPa'], '9.1f')}")
     lines += [
         "",
         "  at °: crank angle θ of the eccentric relative to the carrier; F_m = (mean F^p)^(1/p) over a turn",
@@ -1296,7 +1339,7 @@ def rigid_text(report: dict) -> str:
     if duty:
         lines.append(
             f"  duty cycle: equivalent torque {duty['equivalent_torque_Nm']:.1f} N·m, equivalent speed "
-            f"{duty['equivalent_speed_rpm']:.2f} rpm, service life {_num(duty['service_life_h'], '.0f')} h "
-            f"(from the shortest rated life {_num(duty['rated_life_h'], '.0f')} h)")
+            f"{duty['equivalent_speed_rpm']:.2f} rpm, service life {_life(duty['service_life_h'])} h "
+            f"(from the shortest rated life {_life(duty['rated_life_h'])} h)")
     lines += warning_lines(report.get("warnings", []))
     return "\n".join(lines)

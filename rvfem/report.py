@@ -10,14 +10,16 @@ from __future__ import annotations
 
 import base64
 import html
+import json
 import math
+import re
 import os
 from pathlib import Path
 from typing import Any
 
 from .case import Case
 
-__all__ = ["assumptions", "key_field_angles", "write_report"]
+__all__ = ["assumptions", "key_field_angles", "toml_text", "write_report"]
 
 _CSS = """
 body { font-family: system-ui, -apple-system, 'Segoe UI', Roboto, sans-serif; margin: 2em auto; max-width: 1200px;
@@ -41,6 +43,39 @@ code { background: #f4f4f4; padding: 0 0.2em; }
 
 def _e(x: Any) -> str:
     return html.escape(str(x))
+
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def toml_text(value: Any) -> str:
+    """A case value as it is written in a case file (TOML): ``true``, ``0.0``, ``"text"``,
+    ``[1.0, 2.0]``, ``{equidistant = 0.0, shift = 0.0}`` (no Python ``True`` or dicts in what users
+    read).
+
+    Examples
+    --------
+    >>> toml_text({"symmetric": True, "values": [0.5, 1]})
+    '{symmetric = true, values = [0.5, 1]}'
+    """
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_text(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k if _BARE_KEY.match(str(k)) else json.dumps(str(k))} = {toml_text(v)}"
+                               for k, v in value.items()) + "}"
+    return str(value)
 
 
 def _num(v: Any, fmt: str = ".1f") -> str:
@@ -99,7 +134,8 @@ def assumptions(summary: dict, case: Case) -> list[str]:
     rs = summary["reducer_stage"]
     overrides = summary["case"].get("overrides") or {}
     stated = ([f"Values set on top of the case file (overrides): "
-               f"{', '.join(f'{_e(k)} = {_e(v)}' for k, v in overrides.items())}; case.json holds every value used."]
+               f"{', '.join(f'{_e(k)} = {_e(toml_text(v))}' for k, v in overrides.items())}; case.json holds every "
+               "value used."]
               if overrides else [])
     return stated + [
         f"2D plane-stress finite-element model of one cycloid disc (thickness {case.cycloid.thickness:g} mm, "
@@ -295,7 +331,8 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
         meta.append(f"case file <code>{_e(c['file'])}</code> (sha256 {_e(c['sha256'][:16])}…"
                     f"{'' if c['matches_file'] else ', modified'})")
     if c["overrides"]:
-        meta.append("overrides: " + ", ".join(f"<code>{_e(k)} = {_e(v)}</code>" for k, v in c["overrides"].items()))
+        meta.append("overrides: " + ", ".join(f"<code>{_e(k)} = {_e(toml_text(v))}</code>"
+                                              for k, v in c["overrides"].items()))
     parts.append(f"<p class='meta'>{' · '.join(meta)}</p>")
     if c.get("description"):
         parts.append(f"<p>{_e(c['description'])}</p>")
@@ -469,7 +506,8 @@ def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str |
     defaults = c.get("defaults_used") or {}
     if defaults:
         parts.append("<h3>Where the case file is silent (defaults used)</h3>" + _table(
-            ["key", "value"], [[f"<code>{_e(k)}</code>", _e(v)] for k, v in defaults.items()], left=2))
+            ["key", "value"], [[f"<code>{_e(k)}</code>", f"<code>{_e(toml_text(v))}</code>"]
+                               for k, v in defaults.items()], left=2))
     elif not c.get("matches_file"):
         parts.append("<p class='meta'>The case was built or modified in code; case.json holds every value used.</p>")
 

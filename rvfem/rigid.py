@@ -64,6 +64,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import NOTICE
 from .case import Case
 from ._arrays import readonly
 from .errors import CaseError
@@ -255,7 +256,8 @@ def load_cycle_angles(step_deg: float) -> np.ndarray:
     ----------
     step_deg : float
         Requested step, degrees. The number of samples is n = round(360/step_deg), so the actual step
-        is 360°/n (equal to the request whenever it divides 360°; otherwise a warning is logged).
+        is 360°/n (equal to the request whenever it divides 360°; otherwise a notice is logged,
+        :data:`rvfem.NOTICE`).
 
     Returns
     -------
@@ -266,7 +268,8 @@ def load_cycle_angles(step_deg: float) -> np.ndarray:
         raise ValueError(f"step_deg must be positive, got {step_deg!r}")
     n = max(1, int(round(360.0 / step_deg)))
     if not math.isclose(n * step_deg, 360.0, rel_tol=1e-9):
-        logger.warning("angle step %g° does not divide 360°: using %d angles (step %.6g°)", step_deg, n, 360.0 / n)
+        logger.info("the crank-angle step %g° does not divide 360°: it is adjusted to %.6g° (%d angles)", step_deg,
+                    360.0 / n, n, extra=NOTICE)
     return np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
 
 

@@ -55,6 +55,7 @@ __all__ = [
     "IMAGE_SIZE",
     "RunSummary",
     "ProgressCallback",
+    "run_stages",
     "run_case",
     "summary_text",
 ]
@@ -75,6 +76,33 @@ writers on (the mesh picture from the end of the ``model`` stage on, during the 
 this process writes the tables and the VTK files and then computes the attribution (it enters only
 the summary and the report; stage ``attribution``, reported after ``vtk``); the ``plots`` and
 ``images`` stages are then the waits for the child process."""
+
+
+def run_stages(case: Case, *, images: bool = True) -> tuple[str, ...]:
+    """The stages a run of ``case`` reports, in the order it reports them (each once; a subset of
+    :data:`STAGES`).
+
+    With images the attribution is computed after the VTK files, while the render worker draws,
+    and the ``images`` stage is the wait for the images; without images it is computed beside the
+    stress stage. The ``duty_cycle`` stage is there only when the case has a duty cycle.
+
+    Parameters
+    ----------
+    case : Case
+    images : bool
+        As :func:`run_case`'s ``images``.
+
+    Returns
+    -------
+    tuple of str
+    """
+    analysis = ["mesh", "model", "rigid", "cycle", "evaluation", "stress"]
+    duty = ["duty_cycle"] if case.loads.duty_cycle else []
+    if images:
+        order = ["check", *analysis, *duty, "tables", "vtk", "attribution", "plots", "images", "report"]
+    else:
+        order = ["check", *analysis, "attribution", *duty, "tables", "vtk", "plots", "report"]
+    return tuple(order)
 
 
 @dataclass(frozen=True, eq=False)

@@ -243,6 +243,10 @@ def write_pvd(path: str | os.PathLike, entries: list[tuple[float, str]]) -> Path
     return path
 
 
+ANGLE_DECIMALS = 9
+"""Crank angles computed from radians (``envelope_theta_deg``) are rounded to this many decimals:
+no float noise such as 255.00000000000003."""
+
 ENVELOPE_FILE = "disc_envelope.vtu"
 """File name of the stress envelope in ``vtk/`` (not part of the ``.pvd`` time series)."""
 
@@ -275,5 +279,5 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
     if mesh is None:
         mesh = vtu_mesh(points, triangles)
     point_data = {"von_mises_envelope_MPa": np.asarray(von_mises, dtype=float),
-                  "envelope_theta_deg": np.degrees(np.asarray(theta, dtype=float))}
+                  "envelope_theta_deg": np.round(np.degrees(np.asarray(theta, dtype=float)), ANGLE_DECIMALS)}
     return _write_unstructured_grid(Path(path), mesh, point_data, {}, level, strategy)

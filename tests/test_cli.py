@@ -282,3 +282,141 @@ def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
     documented = documented_keys("## `rvfem rigid --json`")
     assert written - documented == set(), "keys written but not documented"
     assert documented - written == set(), "keys documented but not written"
+
+
+# --------------------------------------------------------------------------------------------
+# Presentation: stage order, progress, notes, -v anywhere, numbers for the screen
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("images, duty", [(True, False), (False, False), (True, True)])
+def test_run_stages_are_numbered_in_the_order_they_start(images, duty):
+    """The stages of a run with images start in another order than STAGES lists them (the
+    attribution after the VTK files) and some do not occur (no duty cycle): numbered as they start,
+    out of the run's own count, nothing skipped."""
+    import io
+    import re
+
+    from rvfem.case import load_case
+    from rvfem.run import STAGES, run_stages
+
+    case = load_case(CASES_DIR / ("crv80e_duty.toml" if duty else "rv40e_fanholes.toml"))
+    stages = run_stages(case, images=images)
+    assert set(stages) <= set(STAGES) and len(set(stages)) == len(stages)
+    assert ("duty_cycle" in stages) == duty and ("images" in stages) == images
+    assert stages.index("attribution") > stages.index("vtk") if images else stages.index("attribution") < stages.index("tables")
+    stream = io.StringIO()
+    progress = cli._RunProgress(stream, False, stages)
+    for stage in stages:
+        progress(stage, 0, 1)
+        progress(stage, 1, 1)
+    progress.close()
+    numbers = [(int(a), int(b)) for a, b in re.findall(r"\[(\d+)/(\d+)\] .*: done in", stream.getvalue())]
+    assert [a for a, _ in numbers] == list(range(1, len(stages) + 1))
+    assert {b for _, b in numbers} == {len(stages)}
+
+
+def test_cycle_progress_gives_the_true_percentage():
+    import io
+    import re
+
+    stream = io.StringIO()
+    progress = cli._RunProgress(stream, False)
+    progress("cycle", 0, 72)
+    for done in range(1, 73):
+        progress("cycle", done, 72)
+    lines = re.findall(r"cycle (\d+)/72 angles \((\d+) %\)", stream.getvalue())
+    assert len(lines) == 9
+    for done, percent in lines:
+        assert int(percent) == 100 * int(done) // 72
+
+
+@pytest.mark.parametrize("argv", [["-v", "rigid", CRV80E], ["rigid", CRV80E, "-v"], ["rigid", "-v", CRV80E]])
+def test_verbose_before_or_after_the_subcommand(argv, capsys):
+    assert cli.main(argv) == 0
+    assert "INFO rvfem.rigid" in capsys.readouterr().err
+
+
+def test_verbose_counts_on_both_sides(monkeypatch):
+    seen = []
+    monkeypatch.setattr(cli, "_setup_logging", lambda verbosity, command="": seen.append(verbosity) or (lambda: None))
+    monkeypatch.setattr(cli, "_run_check", lambda args: 0)
+    parser = cli.build_parser()
+    monkeypatch.setattr(cli, "build_parser", lambda subcommands=None: parser)
+    for p in parser._subparsers._group_actions[0].choices.values():
+        p.set_defaults(run=lambda args: 0)
+    assert cli.main(["-v", "check", CRV80E, "-v"]) == 0 and cli.main(["check", CRV80E, "-vv"]) == 0
+    assert cli.main(["check", CRV80E]) == 0
+    assert seen == [2, 2, 0]
+
+
+def test_an_adjusted_angle_step_is_one_note_and_logging_is_left_as_found(capsys):
+    import logging
+
+    package = logging.getLogger("rvfem")
+    level, handlers = package.level, list(package.handlers)
+    assert cli.main(["rigid", CRV80E, "--set", "analysis.angle_step_deg=7"]) == 0
+    out, err = capsys.readouterr()
+    assert err == ("rvfem rigid: note: the crank-angle step 7° does not divide 360°: it is adjusted to 7.05882° "
+                   "(51 angles)\n")
+    assert "crank-angle step 7.05882°" in out
+    assert package.level == level and package.handlers == handlers and cli._notices is None
+    assert cli.main(["rigid", CRV80E]) == 0 and capsys.readouterr().err == ""
+
+
+def test_notes_are_shown_once_and_end_a_status_line_first():
+    import io
+    import logging
+
+    from rvfem import NOTICE
+
+    stream = io.StringIO()
+    handler = cli._Notices("run", stream)
+    ended = []
+    handler.before = lambda: ended.append(True)
+    log = logging.getLogger("rvfem.test_notes")
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    try:
+        log.info("meshing the whole disc: why", extra=NOTICE)
+        log.info("meshing the whole disc: why", extra=NOTICE)
+        log.info("an ordinary info line")
+    finally:
+        log.removeHandler(handler)
+    assert stream.getvalue() == "rvfem run: note: meshing the whole disc: why\n" and ended == [True]
+
+
+@pytest.mark.slow
+def test_whole_disc_mesh_says_why_without_verbose(tmp_path, capsys):
+    """The fan-hole disc with its ligament at min_wall is 3-fold symmetric, but no sector cut clears
+    the holes: the note says so, when meshing and when the mesh comes from the cache."""
+    from conftest import CaseText
+
+    path = (CaseText.shipped("rv40e_fanholes").set("mesh", "size_flank", "0.8").set("mesh", "size_bore", "0.8")
+            .set("mesh", "size_interior", "5.0").set("fan_holes", "ligament", "2.0").write(tmp_path))
+    for _ in range(2):
+        assert cli.main(["mesh", str(path), "--cache-dir", str(tmp_path / "meshes")]) == 0
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1
+        assert err.startswith("rvfem mesh: note: meshing the whole disc: it is 3-fold symmetric, but the best "
+                              "sector cut")
+
+
+def test_rigid_json_angles_carry_no_float_noise(capsys):
+    assert cli.main(["rigid", CRV80E, "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["bearings"][0]["min_at_deg"] == 250.0          # not 250.00000000000003
+    for b in report["bearings"]:
+        for key in ("max_at_deg", "min_at_deg", "crank_angle_deg"):
+            assert b[key] == round(b[key], 6)
+
+
+def test_a_tiny_torque_shows_significant_figures(capsys):
+    """1e-3 N·m: loads in mN, not "0"; a life of 10^23 hours in exponent form, not 24 digits."""
+    assert cli.main(["rigid", CRV80E, "--set", "loads.torque_Nm=0.001"]) == 0
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if line.strip().startswith("1 "))
+    cells = row.split()
+    assert cells[1] == "0.007113" and cells[5] == "0.005579"
+    assert "e+23" in cells[6] and len(cells[6]) <= 9
+    assert " 0.0 " not in row

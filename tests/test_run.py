@@ -256,6 +256,19 @@ def test_report_embeds_the_images(cli_run, summary):
     assert f"{summary['bearings'][0]['flexible']['max_load_N']:.0f}" in html
 
 
+def test_report_writes_case_values_as_in_a_case_file(cli_run, summary):
+    """The defaults table (and the overrides) read like TOML: true, {key = value}, not Python."""
+    import html as html_module
+
+    text = html_module.unescape((cli_run / "report.html").read_text(encoding="utf-8"))
+    table = text[text.index("defaults used"):]
+    table = table[: table.index("</table>")]
+    assert summary["case"]["defaults_used"]["mesh.symmetric"] is True
+    assert "<code>true</code>" in table and "True" not in table
+    assert "{equidistant = 0.0, shift = 0.0, rotation_deg = 0.0}" in table and "{'" not in table
+    assert "class='warnings'" not in text                # the default case warns of nothing
+
+
 def test_report_states_the_reducer_stage_and_what_the_delta_depends_on(cli_run, summary):
     import html as html_module
 

@@ -94,7 +94,16 @@ def test_a_shared_mesh_gives_the_same_files(disc, tmp_path):
     assert env.read_bytes() == vtkio.write_envelope_vtu(tmp_path / "env2.vtu", points, triangles, vm, theta).read_bytes()
     back = meshio.read(env)
     np.testing.assert_array_equal(back.point_data["von_mises_envelope_MPa"], vm)
-    np.testing.assert_array_equal(back.point_data["envelope_theta_deg"], np.degrees(theta))
+    np.testing.assert_array_equal(back.point_data["envelope_theta_deg"], np.round(np.degrees(theta), vtkio.ANGLE_DECIMALS))
+
+
+def test_envelope_angles_carry_no_float_noise(disc, tmp_path):
+    """Angles computed from radians are rounded: 255°, not 255.00000000000003°."""
+    points, triangles, snapshot = disc
+    theta = np.full(len(points), np.radians(255.0))
+    assert np.degrees(theta[0]) != 255.0                   # the noise this removes
+    env = vtkio.write_envelope_vtu(tmp_path / "env.vtu", points, triangles, snapshot.stress.nodal.von_mises, theta)
+    assert np.all(meshio.read(env).point_data["envelope_theta_deg"] == 255.0)
 
 
 def test_a_long_array_spans_several_blocks(tmp_path):
