@@ -583,7 +583,8 @@ def duty_cycle_fe(system, thetas: np.ndarray, cycle, comparison, linear_life_h: 
                 continue
             n_b = iso281.bearing_speed_rpm(r.speed_rpm, case.pins.count, case.cycloid.teeth)
             life = iso281.rating_life_hours(rating, fm[float(r.torque_Nm)][i], n_b)
-            damage += (r.time_share / total) / life
+            # a life that underflows to 0 h is infinite damage, not a division by zero
+            damage += (r.time_share / total) / life if life > 0 else math.inf
         lives.append(math.inf if damage == 0 else 1.0 / damage)
     return DutyCycleFE(torques_Nm=tuple(torques), equivalent_load_N=tuple(tuple(fm[t]) for t in torques),
                        linear_scaling_error_percent=errors, service_life_h=min(lives),

@@ -69,6 +69,7 @@ __all__ = [
     "MeshSettings",
     "MAX_MESH_NODES",
     "estimated_mesh_nodes",
+    "max_element_sizes",
     "load_case",
     "parse_override",
     "apply_overrides",
@@ -221,6 +222,20 @@ class Cranks:
                                           doc="angular positions α_i of the cranks (N distinct values)")
 
 
+B_M_RANGE = (1.0, 1.3)
+"""Allowed ``crank_bearing.b_m``: ISO 281:2007 (Table 1) tabulates b_m from 1.0 to 1.3 by bearing
+type (1.1 for radial roller bearings, the crank bearing's type); 1.0 reproduces the ratings of the
+standard's editions before 2007, which had no such factor."""
+
+LAMBDA_NU_RANGE = (0.4, 1.0)
+"""Allowed ``crank_bearing.lambda_nu``: λ·ν is the reduction of f_c (ISO 281 and ISO/TR 1281-1) for
+the edge stresses and the non-uniform load along a real roller and for manufacturing accuracy; 0.83
+for radial roller bearings (the ISO 281 tables; Gao et al. and Li et al. use it). It is at most 1
+(no reduction: ideally uniform line contact). The rating C is proportional to λ·ν and the life to
+its 10/3 power: at 0.4 the life is already (0.4/0.83)^(10/3) ≈ 9 % of the standard's; a value far
+below says the bearing is not one ISO 281 rates, and near 0 the life underflows to 0 h."""
+
+
 @dataclass(frozen=True)
 class CrankBearing:
     """The crank (turning-arm) bearing: rollers between the eccentric and the disc bore.
@@ -264,10 +279,12 @@ class CrankBearing:
     bore_radius: float = param(unit="mm", low=0.5, high=1000.0,
                                doc="radius of the disc bore, at least (D_m + D_we)/2 (the outer raceway)")
     radial_clearance: float = param(0.0, unit="mm", low=0.0, high=1.0, doc="radial clearance of the bearing")
-    b_m: float = param(1.1, low=0.0, low_open=True, high=2.0,
-                       doc="ISO 281 rating factor for material and manufacturing quality")
-    lambda_nu: float = param(0.83, low=0.0, low_open=True, high=1.0,
-                             doc="ISO 281 reduction factor λ·ν (edge stress, accuracy)")
+    b_m: float = param(1.1, low=B_M_RANGE[0], high=B_M_RANGE[1],
+                       doc="ISO 281 rating factor for material and manufacturing quality (1.1 for radial roller "
+                           "bearings; ISO 281 tabulates 1.0–1.3)")
+    lambda_nu: float = param(0.83, low=LAMBDA_NU_RANGE[0], high=LAMBDA_NU_RANGE[1],
+                             doc="ISO 281 reduction factor λ·ν of f_c (edge stress, accuracy; 0.83 for radial roller "
+                                 "bearings, 1 = no reduction)")
     model: str = param("rollers", choices=bearing_model_names,
                        doc="discrete compression-only roller springs, or the bore tied to a rigid ring with one "
                            "isotropic spring (registered bearing models)")
@@ -399,6 +416,17 @@ class Loads:
         return self.torque_Nm * 1000.0 / self.discs
 
 
+MAX_FRICTION = 0.3
+"""Largest ``analysis.friction``. Lubricated steel pins on a hardened disc have a Coulomb coefficient
+of about 0.01–0.1 (0.05 in the published 3D model), boundary lubrication up to about 0.15; 0.3 is a
+nearly dry contact. Beyond it the model leaves its range: friction along the known sliding direction
+tilts the pin forces, and the pin and bearing loads needed for the same torque grow steeply and
+without bound as μ nears the value at which the drive locks. On the RV-40E fan-hole case (10°
+steps) the largest bearing load over the friction-free handbook is +11 % at μ = 0.05, +26 % at 0.2,
++43 % at 0.3, +120 % at 0.5 and +908 % at 0.7; at 0.85 and 1.0 the contact problem has no settled
+solution even at the first crank angle (no iteration bound helps)."""
+
+
 @dataclass(frozen=True)
 class Analysis:
     """Analysis options.
@@ -415,7 +443,7 @@ class Analysis:
     friction : float
         Coulomb friction coefficient at the pins (force μ·λ along the known sliding direction,
         the pin centre's velocity relative to the disc); 0.05 in the published 3D model, 0 by
-        default (see docs/theory.md, "Pin contact").
+        default (see docs/theory.md, "Pin contact"). At most :data:`MAX_FRICTION`.
     max_active_set_iterations : int
         Bound of the contact active-set loop.
     saved_angles_deg : tuple of float
@@ -428,9 +456,9 @@ class Analysis:
     angle_step_deg: float = param(1.0, unit="deg", low=0.05, high=30.0,
                                   doc="crank-angle step of the load cycle; the cycle has round(360/step) equal steps")
     element_order: int = param(1, choices=(1, 2), labels={1: "P1", 2: "P2"}, doc="P1 or P2 triangles")
-    friction: float = param(0.0, low=0.0, high=1.0,
+    friction: float = param(0.0, low=0.0, high=MAX_FRICTION,
                             doc="Coulomb friction coefficient at the pins (along the pins' known sliding "
-                                "direction; 0.05 in Zhang et al.)")
+                                "direction; 0.05 in Zhang et al.; lubricated steel 0.01–0.1)")
     max_active_set_iterations: int = param(50, low=1, high=1000, doc="bound of the contact active-set loop")
     saved_angles_deg: tuple[float, ...] = param((0.0, 90.0, 180.0, 270.0), **_ANGLE, max_length=360,
                                                 doc="crank angles at which fields are written")
@@ -756,6 +784,69 @@ def _check_mesh(case: Case) -> None:
                      f"{MAX_MESH_NODES:.0e}; make it larger")
 
 
+FOOTPRINT_ELEMENTS = 1.5
+"""Half-width of the pin and roller load footprints in element sizes; the same number as
+:data:`rvfem.cycle.FOOTPRINT_ELEMENTS`, which spreads the loads (a test keeps them equal; here so
+that reading a case does not import the solver)."""
+
+BORE_FOOTPRINT_FRACTION = 0.25
+"""Largest part of a bore's circumference a roller footprint (2·FOOTPRINT_ELEMENTS·size_bore wide)
+may cover."""
+
+FLANK_FOOTPRINT_FRACTION = 0.5
+"""Largest part of a lobe a pin footprint (2·FOOTPRINT_ELEMENTS·size_flank wide) may cover: one
+flank. The lobe is measured on the root circle, 2π·r_root/Zc, a lower bound of its length."""
+
+
+def max_element_sizes(case: Case) -> dict[str, float]:
+    """Largest ``mesh.size_flank`` and ``mesh.size_bore`` whose load footprints still act locally, mm.
+
+    A pin's and a roller's force enter the disc spread over ±FOOTPRINT_ELEMENTS element sizes along
+    the profile and the bore (the Hertz half-widths, about 0.1 mm, are below one element). That
+    footprint is a contact patch only while it is small against the feature it loads: a pin's
+    footprint may cover at most one flank (half a lobe, measured on the root circle: π·r_root/Zc),
+    a roller's at most a quarter of the bore circumference (π·bore_radius/2). Beyond that the load
+    is smeared over the neighbouring lobe or most of the bore, and at half the bore circumference
+    the load operator cannot be built at all.
+
+    Returns
+    -------
+    dict
+        ``{"mesh.size_flank": h_flank_max, "mesh.size_bore": h_bore_max}``, mm.
+    """
+    cyc, pins = case.cycloid, case.pins
+    mod = cyc.modification
+    root = (pins.circle_radius + mod.shift) - cyc.eccentricity - (pins.radius + mod.equidistant)
+    lobe = 2.0 * math.pi * max(root, 0.0) / cyc.teeth
+    bore = 2.0 * math.pi * case.crank_bearing.bore_radius
+    return {"mesh.size_flank": FLANK_FOOTPRINT_FRACTION * lobe / (2.0 * FOOTPRINT_ELEMENTS),
+            "mesh.size_bore": BORE_FOOTPRINT_FRACTION * bore / (2.0 * FOOTPRINT_ELEMENTS)}
+
+
+def _floor3(x: float) -> float:
+    """x rounded down to three significant digits (a limit to quote that the quoted value meets)."""
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    return math.floor(x / step + 1e-9) * step
+
+
+def _check_mesh_sizes(case: Case) -> None:
+    limits = max_element_sizes(case)
+    ms = case.mesh
+    if limits["mesh.size_flank"] > 0 and ms.size_flank > limits["mesh.size_flank"]:
+        raise _error(case, "mesh.size_flank",
+                     f"({ms.size_flank:g} mm) is too coarse for the teeth: a pin load is spread over "
+                     f"±{FOOTPRINT_ELEMENTS:g} element sizes, which must stay within one flank (half a lobe, "
+                     f"π·r_root/Zc = {2.0 * FOOTPRINT_ELEMENTS * limits['mesh.size_flank']:.3g} mm); "
+                     f"use at most {_floor3(limits['mesh.size_flank']):g} mm")
+    if ms.size_bore > limits["mesh.size_bore"]:
+        raise _error(case, "mesh.size_bore",
+                     f"({ms.size_bore:g} mm) is too coarse for the bores: a roller load is spread over "
+                     f"±{FOOTPRINT_ELEMENTS:g} element sizes, which must stay within a quarter of the bore "
+                     f"circumference ({2.0 * FOOTPRINT_ELEMENTS * limits['mesh.size_bore']:.3g} mm for "
+                     f"crank_bearing.bore_radius = {case.crank_bearing.bore_radius:g} mm); use at most "
+                     f"{_floor3(limits['mesh.size_bore']):g} mm")
+
+
 def _check_crank_support(case: Case) -> None:
     s = case.crank_support
     if s is None:
@@ -829,7 +920,7 @@ def _positive_definite(matrix: tuple[tuple[float, ...], ...]) -> bool:
 
 
 _CROSS_CHECKS = (_check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_holes, _check_loads,
-                 _check_mesh, _check_crank_support)
+                 _check_mesh, _check_mesh_sizes, _check_crank_support)
 
 
 # --------------------------------------------------------------------------------------------

@@ -15,7 +15,9 @@ hole and the lightening holes, each held over a band and then growing linearly (
 ``size_interior``.
 
 Physical groups: curves ``profile``, ``central_hole``, ``bore_0`` …, ``hole_0`` … (fan holes
-first, then round holes) and the surface ``disc``.
+first, then round holes) and the surface ``disc``. Bores and holes are numbered from 0 (Python
+indexing; ``bore_0`` is the bore of bearing 1), in the file as in :attr:`DiscMesh.boundaries`; what
+users read is numbered from 1 (:func:`rvfem.postprocess.user_feature_name`).
 
 Symmetric discs: when the disc maps onto itself under a rotation by 2π/N about its centre (N the
 number of cranks; :func:`symmetry_order`) and ``mesh.symmetric`` is true, only one 360°/N sector is

@@ -448,6 +448,13 @@ def test_every_number_rejects_non_finite_and_huge_values(dotted, value, pattern)
     ("cycloid", "eccentricity", "5e-324", "must be at least 0.01 mm"),
     ("", "name", '"' + "x" * 201 + '"', "at most 200 characters"),
     ("crank_bearing", "b_m", "0.0", "must be positive"),
+    ("crank_bearing", "b_m", "0.9", "must be at least 1"),
+    ("crank_bearing", "b_m", "2.0", "must be at most 1.3"),
+    ("crank_bearing", "lambda_nu", "1e-100", "must be at least 0.4"),
+    ("crank_bearing", "lambda_nu", "5e-324", "must be at least 0.4"),
+    ("crank_bearing", "lambda_nu", "1.2", "must be at most 1"),
+    ("analysis", "friction", "1.0", "must be at most 0.3"),
+    ("analysis", "friction", "0.31", "must be at most 0.3"),
 ])
 def test_ranges(case_text, tmp_path, table, key, value, fragment):
     case_text.set(table, key, value)
@@ -688,3 +695,43 @@ def test_two_tooth_difference_case_is_valid_and_outside_the_handbook(case_text, 
     assert case.pins.count - case.cycloid.teeth == 2
     ok, reason = handbook_applicable(case)
     assert not ok and "not defined for Zp − Zc ≠ 1" in reason
+
+
+def test_iso281_factors_and_friction_accept_their_documented_ranges(case_text, tmp_path):
+    """b_m 1.0–1.3 (ISO 281:2007), λ·ν 0.4–1, friction up to 0.3: the ends are valid."""
+    for b_m, lambda_nu, friction in ((1.0, 0.4, 0.0), (1.3, 1.0, 0.3)):
+        case_text.set("crank_bearing", "b_m", repr(b_m)).set("crank_bearing", "lambda_nu", repr(lambda_nu))
+        case = load_case(case_text.set("analysis", "friction", repr(friction)).write(tmp_path))
+        assert (case.crank_bearing.b_m, case.crank_bearing.lambda_nu, case.analysis.friction) == (b_m, lambda_nu,
+                                                                                                  friction)
+    assert case_module.MAX_FRICTION == 0.3 and case_module.LAMBDA_NU_RANGE == (0.4, 1.0)
+
+
+@pytest.mark.parametrize("key, value, limit", [("size_bore", "45", "9.42 mm"), ("size_bore", "9.5", "9.42 mm"),
+                                               ("size_flank", "5", "1.6 mm"), ("size_flank", "1.7", "1.6 mm")])
+def test_boundary_sizes_too_coarse_for_the_contact_footprints(tmp_path, key, value, limit):
+    """mesh.size_bore = 45 used to end in an internal error of the contact interface ("footprint
+    half-width must be less than half the loop length"); now the case is refused, naming the key
+    and the largest size whose footprint stays local (a quarter of the bore, one flank)."""
+    from conftest import CaseText
+
+    text = CaseText.shipped("rv40e_fanholes").set("mesh", key, value)
+    message = expect_error(tmp_path, text, f"mesh.{key}", "too coarse", f"use at most {limit}")
+    assert "±1.5 element sizes" in message
+
+
+def test_largest_allowed_boundary_sizes_follow_the_geometry(tmp_path):
+    from conftest import CaseText
+    from rvfem import cycle
+
+    case_text = CaseText.shipped("rv40e_fanholes")
+
+    assert case_module.FOOTPRINT_ELEMENTS == cycle.FOOTPRINT_ELEMENTS   # the footprint the solver spreads
+    case = load_case(case_text.write(tmp_path))
+    limits = case_module.max_element_sizes(case)
+    root = 64.0 - 1.3 - 3.0                                              # Rp − e − r_rp, RV-40E
+    assert limits["mesh.size_bore"] == pytest.approx(math.pi * 18.0 / 6.0, rel=1e-12)
+    assert limits["mesh.size_flank"] == pytest.approx(math.pi * root / (3.0 * 39), rel=1e-12)
+    # the limits themselves are accepted
+    case_text.set("mesh", "size_bore", "9.42").set("mesh", "size_flank", "1.6")
+    assert load_case(case_text.write(tmp_path)).mesh.size_bore == 9.42

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -436,14 +437,14 @@ def test_solid_disc_area_and_walls(solid):
 
 def test_error_hole_cuts_a_bore(fan):
     case = fan.replace(fan_holes=dataclasses.replace(fan.fan_holes, ligament=None, span_deg=90.0))
-    with pytest.raises(GeometryError, match=r"hole_\d overlaps bore_\d \(overlap \d+\.\d+ mm\)"):
+    with pytest.raises(GeometryError, match=r"hole [1-3] overlaps bore [1-3] by \d+\.\d{3} mm .*'fan_holes\.span_deg'"):
         disc_geometry(case)
 
 
 def test_error_round_hole_cuts_the_profile(solid):
     from rvfem.case import RoundHoles
     case = solid.replace(round_holes=RoundHoles(radius=3.0, circle_radius=58.0, count=3))
-    with pytest.raises(GeometryError, match="cuts the cycloid profile"):
+    with pytest.raises(GeometryError, match=r"hole [1-3] cuts into the teeth by 0\.\d{3} mm .*'round_holes\.radius'"):
         disc_geometry(case)
 
 
@@ -452,7 +453,7 @@ def test_error_rim_too_thin(solid):
     message names the thinnest wall, its value and the two features."""
     case = solid.replace(crank_bearing=dataclasses.replace(solid.crank_bearing, bore_radius=22.0),
                          cycloid=dataclasses.replace(solid.cycloid, central_hole_radius=8.0))
-    with pytest.raises(GeometryError, match=r"between profile and bore_\d is only 1\.7\d\d mm thick "
+    with pytest.raises(GeometryError, match=r"between the tooth profile and bore [1-3] is only 1\.7\d\d mm thick "
                                             r"\(mesh\.min_wall = 2\.0 mm\)"):
         disc_geometry(case)
     # the same disc passes when thinner walls are allowed
@@ -476,5 +477,59 @@ def test_error_ligament_unreachable_and_fillet_too_large(fan):
 
 def test_error_central_hole_into_bores(solid):
     case = with_cycloid(solid, central_hole_radius=19.0)
-    with pytest.raises(GeometryError, match=r"bore_\d overlaps central_hole \(overlap 1\.000 mm\)"):
+    with pytest.raises(GeometryError, match=r"bore [1-3] overlaps the central hole by 1\.000 mm"):
         disc_geometry(case)
+
+
+def with_fan(case, **changes):
+    return case.replace(fan_holes=dataclasses.replace(case.fan_holes, **changes))
+
+
+def test_feature_names_in_messages_are_numbered_from_1():
+    from rvfem.geometry import feature_text
+
+    assert [feature_text(n) for n in ("bore_0", "bore_2", "hole_0", "hole_11", "central_hole", "profile")] == [
+        "bore 1", "bore 3", "hole 1", "hole 12", "the central hole", "the tooth profile"]
+
+
+def test_geometry_errors_name_the_source_and_a_key(fan):
+    """Every geometry error starts with the case's source and quotes the keys to change (the command
+    line's one-line errors name a key or a cause)."""
+    with pytest.raises(GeometryError) as info:
+        disc_geometry(with_fan(fan, ligament=0.5))
+    message = str(info.value)
+    assert message.startswith(f"{fan.source}: the wall between bore ") and "and hole " in message
+    assert "is only 0.500 mm thick" in message and "'fan_holes.ligament'" in message
+    assert not re.search(r"\b(bore|hole)_\d", message)      # no 0-based feature names
+
+
+def test_fan_holes_beyond_the_teeth_are_blamed_on_the_teeth(fan):
+    """Fan holes at radii 100–120 mm (with a ligament) used to be reported as holes that 'would meet
+    each other'; they lie in (beyond) the teeth."""
+    with pytest.raises(GeometryError, match=r"fan holes at radii 100–120 mm cut the teeth \(root radius 59\.700 mm\)"
+                                            r": 'fan_holes\.outer_radius' must stay below 57\.700 mm") as info:
+        disc_geometry(with_fan(fan, inner_radius=100.0, outer_radius=120.0))
+    assert "meet" not in str(info.value)
+    with pytest.raises(GeometryError, match="fan holes at radii 5–10 mm overlap the central hole"):
+        disc_geometry(with_fan(fan, inner_radius=5.0, outer_radius=10.0, fillet_radius=1.0))
+    # with a span instead of a ligament, the overlap check names the hole and the teeth
+    with pytest.raises(GeometryError, match=r"hole 1 (lies entirely outside the cycloid profile|cuts into the teeth)"):
+        disc_geometry(with_fan(fan, inner_radius=100.0, outer_radius=120.0, ligament=None, span_deg=30.0))
+
+
+def test_a_ligament_the_holes_never_reach_says_so(fan):
+    """Holes at radii 14–16 mm stay about 2 mm from the bores (36 − 18 − 16) even at their widest, so a
+    1 mm ligament cannot set their span."""
+    with pytest.raises(GeometryError, match=r"hole 1: even at its widest \(a span of 120°, where neighbouring fan "
+                                            r"holes meet\) it stays 2\.0\d\d mm from the bores, more than "
+                                            r"'fan_holes\.ligament' = 1 mm.*give 'fan_holes\.span_deg'"):
+        disc_geometry(with_fan(fan, inner_radius=14.0, outer_radius=16.0, fillet_radius=0.5, ligament=1.0))
+
+
+def test_a_near_touch_is_given_in_micrometres(solid):
+    """An overlap of 0.2 µm used to read "overlap -0.000 mm"."""
+    with pytest.raises(GeometryError, match=r"bore [1-3] overlaps the central hole by 0\.\d+ µm") as info:
+        disc_geometry(with_cycloid(solid, central_hole_radius=18.0002))
+    assert "0.000 mm" not in str(info.value)
+    with pytest.raises(GeometryError, match=r"between the central hole and bore [1-3] is only 50 µm thick"):
+        disc_geometry(with_cycloid(solid, central_hole_radius=17.95))

@@ -30,6 +30,7 @@ from .features import (
     LineSegment,
     Wall,
     disc_geometry,
+    feature_text,
 )
 from .kinematics import (PinContacts, closest_points, crank_centres, pin_centres, pin_profile_contacts,
                          pin_profile_contacts_many)
@@ -65,6 +66,7 @@ __all__ = [
     "pin_profile_contacts_many",
     "closest_points",
     "disc_geometry",
+    "feature_text",
     "check_undercut",
     "trochoid_curvature",
     "pitch_errors",

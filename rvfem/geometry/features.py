@@ -16,6 +16,12 @@ before anything is meshed; every problem is a :class:`~rvfem.errors.GeometryErro
 to change. Areas follow from Green's theorem over the outline, ½∮(x dy − y dx); walls are the
 minimum of the exact signed distance of one feature over dense samples of the other's outline
 (docs/theory.md, "Features").
+
+Names: a feature's :attr:`~Feature.name` is also the name of its mesh boundary (physical group)
+and is numbered from 0 like Python indices (``bore_0`` is the bore of bearing 1, ``hole_0`` the
+first lightening hole); messages give them numbered from 1, as everything users read
+(:func:`feature_text`: ``bore_0`` → "bore 1", ``hole_0`` → "hole 1"), with the case keys that
+change them.
 """
 
 from __future__ import annotations
@@ -42,11 +48,39 @@ __all__ = [
     "Wall",
     "DiscGeometry",
     "disc_geometry",
+    "feature_text",
     "WALL_SPACING",
 ]
 
 WALL_SPACING = 0.02
 """Spacing (mm) of the points used to measure walls between features."""
+
+
+def feature_text(name: str) -> str:
+    """A feature's name as messages give it, numbered from 1 like bearings and pins: ``bore_0`` →
+    "bore 1" (the bore of bearing 1), ``hole_2`` → "hole 3", ``central_hole`` → "the central hole",
+    ``profile`` → "the tooth profile"; other names unchanged."""
+    if name == "central_hole":
+        return "the central hole"
+    if name == "profile":
+        return "the tooth profile"
+    stem, _, number = name.rpartition("_")
+    if stem in ("bore", "hole") and number.isdigit():
+        return f"{stem} {int(number) + 1}"
+    return name
+
+
+def _length_text(x: float) -> str:
+    """A wall or an overlap for a message: mm with three decimals, or µm below 0.1 mm (so that a
+    near-touch is not "0.000 mm")."""
+    x = abs(x)
+    return f"{x:.3f} mm" if x >= 0.1 else f"{1000.0 * x:.3g} µm"
+
+
+def _keys_text(keys) -> str:
+    """'a', 'b' or 'c'."""
+    quoted = [f"'{k}'" for k in dict.fromkeys(keys)]
+    return quoted[0] if len(quoted) == 1 else ", ".join(quoted[:-1]) + " or " + quoted[-1]
 
 
 @dataclass(frozen=True)
@@ -197,7 +231,7 @@ class Circle:
     def validate(self) -> None:
         """Raise GeometryError for a non-positive radius."""
         if not self.radius > 0:
-            raise GeometryError(f"{self.name}: the radius must be positive, got {self.radius} mm")
+            raise GeometryError(f"{feature_text(self.name)}: the radius must be positive, got {self.radius} mm")
 
     def outline(self) -> tuple["Arc"]:
         """One full counter-clockwise circle (start angle 0, sweep 2π)."""
@@ -260,15 +294,15 @@ class FanHole:
         f, ri, ro, al = self.fillet_radius, self.inner_radius, self.outer_radius, self.half_span
         if ro - ri <= 2 * f:
             raise GeometryError(
-                f"{self.name}: fillet radius {f} mm does not fit the radial height "
+                f"{feature_text(self.name)}: fillet radius {f} mm does not fit the radial height "
                 f"{ro - ri:.3g} mm of the fan hole (needs fillet < half the height); reduce "
-                "fan_holes.fillet_radius or widen the hole")
+                "'fan_holes.fillet_radius' or widen the hole ('fan_holes.inner_radius', 'fan_holes.outer_radius')")
         go, gi = self.fillet_angles
         if al <= max(go, gi) or (ro - f) * math.cos(go) <= (ri + f) * math.cos(gi):
             raise GeometryError(
-                f"{self.name}: span {math.degrees(2 * al):.3g}° is too narrow for fillets of "
+                f"{feature_text(self.name)}: span {math.degrees(2 * al):.3g}° is too narrow for fillets of "
                 f"{f} mm (needs more than {math.degrees(2 * max(go, gi)):.3g}°); widen the hole "
-                "or reduce fan_holes.fillet_radius")
+                "('fan_holes.span_deg', or a smaller 'fan_holes.ligament') or reduce 'fan_holes.fillet_radius'")
 
     def outline(self) -> tuple:
         """The outline as lines and arcs, counter-clockwise around the hole (hole on the left)."""
@@ -398,7 +432,7 @@ def _default_offset(case: Case) -> float:
     return float(np.angle(np.exp(1j * a[0]) + np.exp(1j * a[1])))
 
 
-def _fan_holes(case: Case, bores: tuple[Circle, ...]) -> list[FanHole]:
+def _fan_holes(case: Case, bores: tuple[Circle, ...], profile: Profile) -> list[FanHole]:
     fan = case.fan_holes
     if fan is None:
         return []
@@ -421,21 +455,43 @@ def _fan_holes(case: Case, bores: tuple[Circle, ...]) -> list[FanHole]:
     for i, a in enumerate(angles):
         lo = _min_valid_half_span(fan, a)
         hi = math.pi / fan.count
+        if wall(lo, a) < L or wall(hi, a) >= L:
+            _fan_radii_outside_disc(case, profile)   # the hole is in the wrong place: say so first
         if wall(lo, a) < L:
             raise GeometryError(
-                f"hole_{i}: the fan-hole ligament of {L} mm cannot be kept: even the narrowest "
-                f"hole with fillets of {fan.fillet_radius} mm leaves only {wall(lo, a):.3g} mm to "
-                "the nearest bore; reduce fan_holes.ligament, move the hole radially, or shrink "
-                "the bores")
+                f"{feature_text(f'hole_{i}')}: 'fan_holes.ligament' = {L:g} mm cannot be kept: even the narrowest "
+                f"hole with fillets of {fan.fillet_radius:g} mm leaves only {_length_text(wall(lo, a))} to "
+                "the nearest bore; reduce 'fan_holes.ligament', move the hole radially ('fan_holes.inner_radius', "
+                "'fan_holes.outer_radius') or shrink the bores ('crank_bearing.bore_radius')")
         if wall(hi, a) >= L:
             raise GeometryError(
-                f"hole_{i}: with fan_holes.ligament = {L} mm the fan holes would meet each other "
-                "before they come that close to a bore; give fan_holes.span_deg instead")
+                f"{feature_text(f'hole_{i}')}: even at its widest (a span of {360.0 / fan.count:.4g}°, where "
+                f"neighbouring fan holes meet) it stays {_length_text(wall(hi, a))} from the bores, more than "
+                f"'fan_holes.ligament' = {L:g} mm, so the ligament cannot set the span; give 'fan_holes.span_deg' "
+                "instead")
         half = brentq(lambda x: wall(x, a) - L, lo, hi, xtol=1e-12)
         h = _fan_hole(f"hole_{i}", fan, a, half)
         h.validate()
         holes.append(h)
     return holes
+
+
+def _fan_radii_outside_disc(case: Case, profile: Profile) -> None:
+    """Raise GeometryError if the fan holes' radii put them into the teeth or the central hole (for
+    any span); called where the span cannot follow from the ligament, to give the reason that
+    applies."""
+    fan, root = case.fan_holes, profile.root_radius
+    central = case.cycloid.central_hole_radius
+    if fan.outer_radius >= root:
+        raise GeometryError(
+            f"the fan holes at radii {fan.inner_radius:g}–{fan.outer_radius:g} mm cut the teeth (root radius "
+            f"{root:.3f} mm): 'fan_holes.outer_radius' must stay below {root - case.mesh.min_wall:.3f} mm "
+            "(the root radius less mesh.min_wall)")
+    if fan.inner_radius <= central:
+        raise GeometryError(
+            f"the fan holes at radii {fan.inner_radius:g}–{fan.outer_radius:g} mm overlap the central hole "
+            f"(radius {central:g} mm): 'fan_holes.inner_radius' must exceed {central + case.mesh.min_wall:g} mm "
+            "(cycloid.central_hole_radius plus mesh.min_wall)")
 
 
 def _min_valid_half_span(fan, angle: float) -> float:
@@ -493,17 +549,48 @@ def _profile_wall(profile: Profile, f) -> Wall:
     return Wall("profile", f.name, float(d[i]), (float(pts[i, 0]), float(pts[i, 1])))
 
 
+def _feature_keys(case: Case, name: str, other: str) -> list[str]:
+    """The case keys that move or resize feature ``name`` away from feature ``other``."""
+    if name == "central_hole":
+        return ["cycloid.central_hole_radius"]
+    if name == "profile":
+        return []
+    if name.startswith("bore_"):
+        return ["crank_bearing.bore_radius", "cranks.circle_radius"]
+    n_fans = case.fan_holes.count if case.fan_holes is not None else 0
+    if name.startswith("hole_") and int(name.split("_")[1]) < n_fans:
+        span = "fan_holes.ligament" if case.fan_holes.ligament is not None else "fan_holes.span_deg"
+        if other == "central_hole":
+            return ["fan_holes.inner_radius"]
+        if other == "profile":
+            return ["fan_holes.outer_radius"]
+        if other.startswith("bore_"):
+            return [span, "fan_holes.inner_radius", "fan_holes.outer_radius"]
+        return [span, "fan_holes.count"]
+    return ["round_holes.radius", "round_holes.circle_radius"]
+
+
+def _pair_keys(case: Case, first: str, second: str) -> str:
+    return _keys_text(_feature_keys(case, second, first) + _feature_keys(case, first, second))
+
+
 def disc_geometry(case: Case) -> DiscGeometry:
     """Build the disc geometry of a case and check it before any meshing.
 
-    Checks (each failure is a GeometryError naming the features and what to change):
+    Checks (each failure is a GeometryError that starts with the case's source, names the
+    features, numbered from 1 ("bore 1", "hole 2"), and the case keys to change):
 
     * the profile has no undercut (see :func:`build_profile`);
-    * fan holes: fillets fit, the ligament to the bores can be kept;
+    * fan holes: fillets fit, the ligament to the bores can be kept (or, where the span cannot
+      follow from it, why: holes in the teeth or in the central hole, or holes that never come
+      that close to a bore);
     * every feature lies inside the profile and no two features (or a feature and the profile)
       overlap;
     * no wall (feature–feature or feature–profile) is thinner than ``mesh.min_wall``; the message
       gives the thinnest wall, its thickness and the two features.
+
+    These checks are cheap (a fraction of a second) and are all of what meshing checks before
+    Gmsh runs: ``rvfem check`` runs them too.
 
     Parameters
     ----------
@@ -513,11 +600,18 @@ def disc_geometry(case: Case) -> DiscGeometry:
     -------
     DiscGeometry
     """
+    try:
+        return _disc_geometry(case)
+    except GeometryError as exc:
+        raise GeometryError(f"{case.source}: {exc}") from None
+
+
+def _disc_geometry(case: Case) -> DiscGeometry:
     profile = build_profile(case)
     central = Circle("central_hole", (0.0, 0.0), case.cycloid.central_hole_radius)
     bores = tuple(Circle(f"bore_{i}", (float(x), float(y)), case.crank_bearing.bore_radius)
                   for i, (x, y) in enumerate(crank_centres(case)))
-    fans = _fan_holes(case, bores)
+    fans = _fan_holes(case, bores, profile)
     holes = tuple(fans) + tuple(_round_holes(case, len(fans)))
     features = (central,) + bores + holes
     for f in features:
@@ -530,8 +624,9 @@ def disc_geometry(case: Case) -> DiscGeometry:
         outside = ~outline.contains_points(pts)
         if np.all(outside):
             raise GeometryError(
-                f"{f.name} lies entirely outside the cycloid profile (root radius "
-                f"{profile.root_radius:.3f} mm); check its position and size")
+                f"{feature_text(f.name)} lies entirely outside the cycloid profile (root radius "
+                f"{profile.root_radius:.3f} mm); check its position and size "
+                f"({_keys_text(_feature_keys(case, f.name, 'profile'))})")
 
     walls = [_profile_wall(profile, f) for f in features]
     for i, f in enumerate(features):
@@ -540,21 +635,23 @@ def disc_geometry(case: Case) -> DiscGeometry:
     walls.sort(key=lambda w: w.thickness)
     thinnest = walls[0]
     min_wall = case.mesh.min_wall
+    first, second = feature_text(thinnest.first), feature_text(thinnest.second)
+    near = f"near ({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm"
+    keys = _pair_keys(case, thinnest.first, thinnest.second)
     if thinnest.thickness <= 0:
+        depth = "touches" if thinnest.thickness == 0 else f"by {_length_text(thinnest.thickness)}"
         if thinnest.first == "profile":
-            msg = (f"{thinnest.second} cuts the cycloid profile (overlap {-thinnest.thickness:.3f} mm; "
-                   f"root radius {profile.root_radius:.3f} mm)")
+            what = "touches the teeth" if thinnest.thickness == 0 else f"cuts into the teeth {depth}"
+            msg = f"{second} {what} (root radius {profile.root_radius:.3f} mm)"
         else:
-            msg = f"{thinnest.second} overlaps {thinnest.first} (overlap {-thinnest.thickness:.3f} mm)"
-        raise GeometryError(
-            f"{msg} near ({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm; move or "
-            "shrink the features (fan_holes / round_holes / crank_bearing.bore_radius / "
-            "cranks.circle_radius / cycloid.central_hole_radius)")
+            msg = f"{second} {'touches' if thinnest.thickness == 0 else 'overlaps'} {first}" \
+                  + ("" if thinnest.thickness == 0 else f" {depth}")
+        them = "it" if thinnest.first == "profile" else "them"
+        raise GeometryError(f"{msg} {near}; move or shrink {them} ({keys})")
     if thinnest.thickness < min_wall:
         raise GeometryError(
-            f"the wall between {thinnest.first} and {thinnest.second} is only "
-            f"{thinnest.thickness:.3f} mm thick (mesh.min_wall = {min_wall} mm), near "
-            f"({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm; move or shrink the "
-            "features, or lower mesh.min_wall if such a thin wall is intended")
+            f"the wall between {first} and {second} is only {_length_text(thinnest.thickness)} thick "
+            f"(mesh.min_wall = {min_wall} mm), {near}; move or shrink the features ({keys}), or lower "
+            "'mesh.min_wall' if such a thin wall is intended")
     return DiscGeometry(case=case, profile=profile, central_hole=central, bores=bores,
                         holes=holes, walls=tuple(walls))

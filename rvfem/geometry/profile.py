@@ -281,7 +281,7 @@ def _half_range(R: float, e: float, a: float, r: float, zc: int, d: int) -> floa
     if f(hi) <= 0:
         raise GeometryError(
             f"the profile for Zp − Zc = {d} does not close: neighbouring tooth spaces do not meet; "
-            "reduce the pin radius or the eccentricity")
+            "reduce 'pins.radius' or 'cycloid.eccentricity'")
     return brentq(f, 0.0, hi, xtol=1e-15)
 
 
@@ -353,11 +353,11 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
     if r <= 0:
         raise GeometryError(
             f"the generating pin radius r_rp + ΔRrp = {pins.radius} + {mod.equidistant} = {r:.4g} mm "
-            "must be positive; reduce the magnitude of cycloid.modification.equidistant")
+            "must be positive; reduce the magnitude of 'cycloid.modification.equidistant'")
     if a * e / R >= 1.0:
         raise GeometryError(
-            f"the trochoid loops: k = e·Zp/(d·(Rp + ΔRp)) = {a * e / R:.4f} ≥ 1; reduce the "
-            "eccentricity or the negative shift modification")
+            f"the trochoid loops: k = e·Zp/(d·(Rp + ΔRp)) = {a * e / R:.4f} ≥ 1; reduce "
+            "'cycloid.eccentricity' or the negative 'cycloid.modification.shift'")
     s_h = _half_range(R, e, a, r, zc, d)
     rho_min, s_min = check_undercut(R, e, a, r, s_h)
     if rho_min <= 0.0:
@@ -368,8 +368,8 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
             f"undercut cycloid profile: the minimum radius of curvature of the convex part of the teeth is "
             f"{rho_min:.4g} mm (≤ 0) at profile angle {ang:.3f}° from a root (repeats on every "
             f"lobe); the generating pin radius r_rp + ΔRrp = {r:.4g} mm must stay below "
-            f"{r_crit:.4g} mm for e = {e} mm, Rp + ΔRp = {R:.4g} mm — reduce pins.radius or "
-            "cycloid.modification.equidistant, or the eccentricity, or enlarge pins.circle_radius")
+            f"{r_crit:.4g} mm for e = {e} mm, Rp + ΔRp = {R:.4g} mm — reduce 'pins.radius' or "
+            "'cycloid.modification.equidistant', or 'cycloid.eccentricity', or enlarge 'pins.circle_radius'")
 
     r_mean = R - r
     rot = pitch_errors(case) / r_mean
@@ -397,7 +397,7 @@ def build_profile(case: Case, samples_per_segment: int = SAMPLES_PER_SEGMENT,
         raise GeometryError(
             "the profile folds over itself where the pitch-error rotation blends between teeth; "
             f"the pitch errors (max |E_t| = {np.max(np.abs(pitch_errors(case))):.4g} mm) are far "
-            "too large — they are meant to be micrometres")
+            "too large — they are meant to be micrometres ('cycloid.pitch_error')")
     sp = _arc_length_params(R, e, a, r, s_h, spline_points - 1)
     spl = profile_eval(prof, np.repeat(np.arange(zc), spline_points), np.tile(sp, zc))
     spl = spl.reshape(zc, spline_points)
