@@ -18,6 +18,10 @@ For P2 models the file holds the linear mesh and the vertex values only (the edg
 are dropped). The ``.pvd`` lists the files with the crank angle in degrees as the time value, so
 ParaView's time controls step through the cycle.
 
+``disc_envelope.vtu`` (:func:`write_envelope_vtu`) holds the cycle's stress envelope; its von Mises
+array is named with the cycle's element order (``von_mises_envelope_P1_MPa``), since the run's
+headline structural peak is re-solved on P2.
+
 The files of one run share the mesh: :func:`vtu_mesh` encodes the points and the cells once (zlib
 level :data:`MESH_ZLIB_LEVEL`), and :func:`write_vtu` and :func:`write_envelope_vtu` take it
 (``mesh=``) instead of encoding them again. The field arrays are compressed with zlib at level
@@ -40,7 +44,7 @@ import numpy as np
 from .postprocess import FieldSnapshot
 
 __all__ = ["POINT_FIELDS", "CELL_FIELDS", "ENVELOPE_FILE", "MESH_ZLIB_LEVEL", "ZLIB_LEVEL", "ZLIB_STRATEGY",
-           "VtuMesh", "vtu_mesh", "vtu_name", "write_vtu", "write_pvd", "write_envelope_vtu"]
+           "VtuMesh", "vtu_mesh", "vtu_name", "write_vtu", "write_pvd", "envelope_field", "write_envelope_vtu"]
 
 #: Point-data arrays of every ``.vtu`` (name → number of components).
 POINT_FIELDS = {
@@ -154,12 +158,19 @@ def vtu_mesh(points: np.ndarray, triangles: np.ndarray, *, level: int = MESH_ZLI
 
 
 def _write_unstructured_grid(path: Path, mesh: VtuMesh, point_data: dict[str, np.ndarray],
-                             cell_data: dict[str, np.ndarray], level: int, strategy: int) -> Path:
+                             cell_data: dict[str, np.ndarray], level: int, strategy: int,
+                             field_data: dict[str, np.ndarray] | None = None) -> Path:
     byte_order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
     parts = ['<?xml version="1.0"?>\n',
              f'<VTKFile type="UnstructuredGrid" version="0.1" byte_order="{byte_order}" '
-             'compressor="vtkZLibDataCompressor">\n<UnstructuredGrid>\n',
-             f'<Piece NumberOfPoints="{mesh.n_points}" NumberOfCells="{mesh.n_cells}">\n', mesh.xml]
+             'compressor="vtkZLibDataCompressor">\n<UnstructuredGrid>\n']
+    if field_data:  # values of the whole data set (ParaView: Information panel, "Field Data")
+        parts.append("<FieldData>\n")
+        parts += [_data_array(name, values, level, strategy).replace(
+            ' format="binary"', f' NumberOfTuples="{len(values)}" format="binary"', 1)
+            for name, values in field_data.items()]
+        parts.append("</FieldData>\n")
+    parts += [f'<Piece NumberOfPoints="{mesh.n_points}" NumberOfCells="{mesh.n_cells}">\n', mesh.xml]
     for tag, data in (("PointData", point_data), ("CellData", cell_data)):
         if data:
             parts.append(f"<{tag}>\n")
@@ -251,12 +262,27 @@ ENVELOPE_FILE = "disc_envelope.vtu"
 """File name of the stress envelope in ``vtk/`` (not part of the ``.pvd`` time series)."""
 
 
+def envelope_field(element_order: int) -> str:
+    """Name of the envelope's von Mises array: ``von_mises_envelope_P1_MPa`` for the P1 cycle.
+
+    The envelope is the load cycle's own vertex stress, of the cycle's element order; the headline
+    structural peak of a run is re-solved on P2 (P1 vertex stresses lie low at a hole fillet), so
+    the name says which order the field is.
+    """
+    return f"von_mises_envelope_P{int(element_order)}_MPa"
+
+
 def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray,
-                       von_mises: np.ndarray, theta: np.ndarray, *, mesh: VtuMesh | None = None,
-                       level: int = ZLIB_LEVEL, strategy: int = ZLIB_STRATEGY) -> Path:
-    """Write the cycle's stress envelope as a ``.vtu``: point data ``von_mises_envelope_MPa``
-    (the largest vertex von Mises stress of every vertex over every solved crank angle) and
-    ``envelope_theta_deg`` (the crank angle at which it occurs).
+                       von_mises: np.ndarray, theta: np.ndarray, *, element_order: int = 1,
+                       structural_peak_MPa: float | None = None, structural_peak_order: int | None = None,
+                       mesh: VtuMesh | None = None, level: int = ZLIB_LEVEL,
+                       strategy: int = ZLIB_STRATEGY) -> Path:
+    """Write the cycle's stress envelope as a ``.vtu``: point data :func:`envelope_field`
+    (``von_mises_envelope_P1_MPa``: the largest vertex von Mises stress of every vertex over every
+    solved crank angle, of the cycle's element order) and ``envelope_theta_deg`` (the crank angle at
+    which it occurs); field data ``element_order`` and, when given, the headline structural peak
+    ``structural_peak_von_mises_MPa`` with its ``structural_peak_element_order`` (2 where it was
+    re-solved on P2), to compare the field with.
 
     Parameters
     ----------
@@ -267,6 +293,12 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
         MPa.
     theta : ndarray (n_vertices,)
         rad.
+    element_order : int
+        Element order of the load cycle the envelope comes from.
+    structural_peak_MPa : float, optional
+        The run's structural stress peak (``summary.json`` ``peak_von_mises_MPa``).
+    structural_peak_order : int, optional
+        Its element order (default: ``element_order``).
     mesh : VtuMesh, optional
         ``vtu_mesh(points, triangles)`` (see :func:`write_vtu`).
     level, strategy : int
@@ -278,6 +310,11 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
     """
     if mesh is None:
         mesh = vtu_mesh(points, triangles)
-    point_data = {"von_mises_envelope_MPa": np.asarray(von_mises, dtype=float),
+    point_data = {envelope_field(element_order): np.asarray(von_mises, dtype=float),
                   "envelope_theta_deg": np.round(np.degrees(np.asarray(theta, dtype=float)), ANGLE_DECIMALS)}
-    return _write_unstructured_grid(Path(path), mesh, point_data, {}, level, strategy)
+    field_data = {"element_order": np.array([element_order], dtype=np.int64)}
+    if structural_peak_MPa is not None:
+        field_data["structural_peak_von_mises_MPa"] = np.array([structural_peak_MPa], dtype=float)
+        field_data["structural_peak_element_order"] = np.array(
+            [element_order if structural_peak_order is None else structural_peak_order], dtype=np.int64)
+    return _write_unstructured_grid(Path(path), mesh, point_data, {}, level, strategy, field_data)

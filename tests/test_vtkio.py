@@ -93,7 +93,7 @@ def test_a_shared_mesh_gives_the_same_files(disc, tmp_path):
     env = vtkio.write_envelope_vtu(tmp_path / "env.vtu", points, triangles, vm, theta, mesh=mesh)
     assert env.read_bytes() == vtkio.write_envelope_vtu(tmp_path / "env2.vtu", points, triangles, vm, theta).read_bytes()
     back = meshio.read(env)
-    np.testing.assert_array_equal(back.point_data["von_mises_envelope_MPa"], vm)
+    np.testing.assert_array_equal(back.point_data["von_mises_envelope_P1_MPa"], vm)
     np.testing.assert_array_equal(back.point_data["envelope_theta_deg"], np.round(np.degrees(theta), vtkio.ANGLE_DECIMALS))
 
 
@@ -114,4 +114,23 @@ def test_a_long_array_spans_several_blocks(tmp_path):
     back = meshio.read(path)
     np.testing.assert_array_equal(back.points[:, :2], points)
     np.testing.assert_array_equal(back.cells[0].data, triangles)
-    np.testing.assert_array_equal(back.point_data["von_mises_envelope_MPa"], vm)
+    np.testing.assert_array_equal(back.point_data["von_mises_envelope_P1_MPa"], vm)
+
+
+def test_the_envelope_says_its_element_order_and_the_headline_peak(disc, tmp_path):
+    """The envelope is the cycle's (P1) field while the headline structural peak is re-solved on
+    P2: the array name carries the element order, the field data the headline value and its order."""
+    points, triangles, snapshot = disc
+    vm, theta = snapshot.stress.nodal.von_mises, snapshot.stress.nodal.angle1
+    path = vtkio.write_envelope_vtu(tmp_path / "env.vtu", points, triangles, vm, theta, element_order=1,
+                                    structural_peak_MPa=110.25, structural_peak_order=2)
+    back = meshio.read(path)
+    assert list(back.point_data) == [vtkio.envelope_field(1), "envelope_theta_deg"]
+    assert vtkio.envelope_field(1) == "von_mises_envelope_P1_MPa"
+    np.testing.assert_array_equal(back.point_data["von_mises_envelope_P1_MPa"], vm)
+    assert back.field_data["element_order"].tolist() == [1]
+    assert back.field_data["structural_peak_von_mises_MPa"].tolist() == [110.25]
+    assert back.field_data["structural_peak_element_order"].tolist() == [2]
+    p2 = meshio.read(vtkio.write_envelope_vtu(tmp_path / "p2.vtu", points, triangles, vm, theta, element_order=2))
+    assert list(p2.point_data) == ["von_mises_envelope_P2_MPa", "envelope_theta_deg"]
+    assert p2.field_data["element_order"].tolist() == [2] and "structural_peak_von_mises_MPa" not in p2.field_data
