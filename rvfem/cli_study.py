@@ -50,7 +50,7 @@ def _is_case_file(path: str) -> bool:
 
 
 def _format_compare(c: dict, out) -> None:
-    from .result_compare import STATISTICS
+    from .result_compare import STATISTICS, overall_titles
 
     w = out.write
     w(f"A: {c['a']['label']} ({c['a']['path']})\n")
@@ -67,15 +67,13 @@ def _format_compare(c: dict, out) -> None:
             cells.append(f"{row['a'][key]:10.1f} {row['b'][key]:10.1f} {'–' if r is None else format(r, '7.4f'):>7}")
         w(f"{row['bearing']:>7d} " + " ".join(cells) + "\n")
     o = c["overall"]
-    w(f"\n{'whole disc':<30} {'A':>10} {'B':>10} {'B/A':>8}\n")
-    titles = {"max_load_N": "largest bearing load, N", "equivalent_load_N": "largest F_m, N",
-              "L10h_h": "shortest L10h, h", "handbook_max_load_N": "handbook max load, N",
-              "handbook_equivalent_load_N": "handbook F_m, N", "peak_von_mises_MPa": "peak von Mises, MPa",
-              "peak_away_from_contacts_MPa": "peak away from contacts, MPa"}
+    titles = overall_titles(c)
+    width = max(len(t) for t in titles.values())
+    w(f"\n{'whole disc':<{width}} {'A':>10} {'B':>10} {'B/A':>8}\n")
     for key, title in titles.items():
         a, b, r = o["a"].get(key), o["b"].get(key), o["ratio"].get(key)
         fmt = (lambda v: "–" if v is None else f"{v:10.1f}")
-        w(f"{title:<30} {fmt(a):>10} {fmt(b):>10} {'–' if r is None else format(r, '8.4f'):>8}\n")
+        w(f"{title:<{width}} {fmt(a):>10} {fmt(b):>10} {'–' if r is None else format(r, '8.4f'):>8}\n")
     r = o["ratio"]
     if r["max_load_N"] is not None and r["equivalent_load_N"] is not None and r["L10h_h"] is not None:
         w(f"\nB against A: largest load {100 * (r['max_load_N'] - 1):+.1f} %, equivalent load "
@@ -151,29 +149,44 @@ def _add_study_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-plots", action="store_true", help="no plots (study.csv and the report only)")
 
 
+def _id_width(ids) -> int:
+    """Width of the id column: the longest id, up to :data:`rvfem.study.MAX_ID_LENGTH`."""
+    from .study import MAX_ID_LENGTH
+
+    return max(7, min(MAX_ID_LENGTH, max((len(i) for i in ids), default=0)))
+
+
 def _print_variants(study) -> None:
+    from .study import short_id
+
     print(f"study '{study.name}' ({study.kind}) on {study.base_case}: {len(study.variants)} variants")
+    width = _id_width(v.id for v in study.variants)
     for v in study.variants:
         own = ", ".join(f"{k} = {val!r}" for k, val in v.settings) or "(the base case)"
-        print(f"  {v.id:<40} {own}")
+        print(f"  {short_id(v.id, width):<{width}}  {own}")
 
 
 def _format_rows(rows) -> None:
+    from .study import short_id
+
     def f(v, spec):
         return "–" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
-    head = (f"{'variant':<40} {'status':<8} {'max N':>8} {'vs hb':>7} {'vs base':>8} {'F_m N':>8} "
+    width = _id_width(r["id"] for r in rows)
+    head = (f"{'variant':<{width}} {'status':<8} {'max N':>8} {'vs hb':>7} {'vs base':>8} {'F_m N':>8} "
             f"{'life/hb':>7} {'life/base':>9} {'s_vm MPa':>8} {'time s':>7}")
     print(head)
     print("-" * len(head))
     for r in rows:
-        print(f"{r['id'][:40]:<40} {r['status']:<8} {f(r['max_load_N'], '8.1f')} "
+        print(f"{short_id(r['id'], width):<{width}} {r['status']:<8} {f(r['max_load_N'], '8.1f')} "
               f"{f(r['max_vs_handbook_percent'], '+6.1f')}% {f(r['max_vs_base_percent'], '+7.1f')}% "
               f"{f(r['equivalent_load_N'], '8.1f')} {f(r['life_ratio'], '7.3f')} {f(r['life_ratio_vs_base'], '9.3f')} "
-              f"{f(r['peak_away_from_contacts_MPa'], '8.1f')} {f(r['wall_time_s'], '7.1f')}"
+              f"{f(r['peak_von_mises_MPa'], '8.1f')} {f(r['wall_time_s'], '7.1f')}"
               + ("" if r["computed"] or r["status"] != "ok" else "  (earlier run)"))
         if r["error"]:
-            print(f"{'':<40} {r['error']}")
+            print(f"{'':<{width}} {r['error']}")
+    print("s_vm: structural stress peak away from contacts, von Mises (the value rvfem run reports: P2 re-solve "
+          "by default); time: the variant's run time")
 
 
 class _StudyProgress:
@@ -184,12 +197,14 @@ class _StudyProgress:
         self.tty = stream.isatty()
 
     def __call__(self, done: int, total: int, record: dict) -> None:
+        from .study import short_id
+
         if self.tty:
             if self.bar is None:
                 from tqdm import tqdm
 
                 self.bar = tqdm(total=total, initial=done - 1, unit="variant", file=self.stream, desc="rvfem study")
-            self.bar.set_postfix_str(f"{record['id'][:30]}: {record['status']}")
+            self.bar.set_postfix_str(f"{short_id(record['id'], 40)}: {record['status']}")
             self.bar.update(1)
         else:
             wall = record.get("wall_time_s")
@@ -225,7 +240,8 @@ def _run_study(args: argparse.Namespace) -> int:
         progress.close()
     _format_rows(result.rows)
     print(f"\n{len(result.rows)} variants: {result.computed} computed, {result.reused} from an earlier run, "
-          f"{result.failed} failed; wall time {result.wall_time_s:.1f} s")
+          f"{result.failed} failed; compute time of the variants {result.compute_time_s:.1f} s (earlier runs "
+          f"included), wall time {result.wall_time_s:.1f} s")
     print(f"  results: {result.out_dir}/ (study.csv, report.html, variants/<id>/; see docs/studies.md)")
     return EXIT_OK
 

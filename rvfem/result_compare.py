@@ -4,7 +4,8 @@
 ``bearing_loads.csv`` (schema: ``docs/outputs.md``) — and :func:`compare_results` puts two of
 them side by side: per bearing the flexible maximum, minimum and equivalent load F_m and the
 L10h life of A and B and their ratios B / A, plus the largest load, the handbook values and the
-von Mises peaks. :func:`comparison_plot` overlays the load curves and :func:`comparison_html`
+structural stress peaks (the headline P2 value and the P1 cycle's, both away from contacts). :func:`comparison_figure` overlays the load curves (a matplotlib ``Figure``;
+:func:`comparison_plot` writes it as a PNG) and :func:`comparison_html`
 writes a small self-contained page. ``rvfem compare A B`` is the command line for it.
 
 Example::
@@ -31,7 +32,7 @@ import numpy as np
 from .errors import OutputError
 
 __all__ = ["ResultFolder", "STATISTICS", "read_result", "result_from_case", "compare_results",
-           "comparison_plot", "comparison_html"]
+           "overall_titles", "comparison_figure", "comparison_plot", "comparison_html"]
 
 STATISTICS = (("max_load_N", "max N"), ("min_load_N", "min N"), ("equivalent_load_N", "F_m N"), ("L10h_h", "L10h h"))
 """Per-bearing statistics compared (summary.json key of ``bearings[].flexible``, column title)."""
@@ -133,10 +134,40 @@ def _overall(r: ResultFolder) -> dict:
 
 def _describe(r: ResultFolder) -> dict:
     model = r.summary.get("model", {})
+    stress = r.summary.get("stress") or {}
+    recovered = stress.get("structural_peak") or {}
+    away = stress.get("away_from_contacts") or {}
+    cycle_order = away.get("element_order", model.get("element_order"))
     return {"label": r.label, "path": str(r.path), "case_digest": r.summary.get("case", {}).get("digest"),
             "bearing_model": model.get("bearing_model"), "pin_model": model.get("pin_model"),
             "element_order": model.get("element_order"), "angle_step_deg": model.get("angle_step_deg"),
-            "output_torque_Nm": model.get("output_torque_Nm")}
+            "output_torque_Nm": model.get("output_torque_Nm"),
+            "peak_element_order": recovered.get("element_order", cycle_order),
+            "cycle_element_order": cycle_order}
+
+
+def _orders(a: dict, b: dict, key: str) -> str:
+    orders = [a.get(key), b.get(key)]
+    if None in orders:
+        return "P?"
+    return f"P{orders[0]}" if orders[0] == orders[1] else f"P{orders[0]} (A) / P{orders[1]} (B)"
+
+
+def overall_titles(comparison: dict) -> dict:
+    """Titles of the whole-disc quantities of a :func:`compare_results` result (key → title).
+
+    Both stress peaks are structural peaks away from the contacts: ``peak_von_mises_MPa`` is the
+    headline value of ``rvfem run`` (re-solved on P2 by default), ``peak_away_from_contacts_MPa``
+    the peak of the load cycle's own stress envelope (P1 by default: lower at a hole
+    fillet); the titles give the element order of each.
+    """
+    a, b = comparison["a"], comparison["b"]
+    return {"max_load_N": "largest bearing load, N", "equivalent_load_N": "largest F_m, N",
+            "L10h_h": "shortest L10h, h", "handbook_max_load_N": "handbook max load, N",
+            "handbook_equivalent_load_N": "handbook F_m, N",
+            "peak_von_mises_MPa": f"structural peak ({_orders(a, b, 'peak_element_order')}, away from contacts), MPa",
+            "peak_away_from_contacts_MPa":
+                f"structural peak, {_orders(a, b, 'cycle_element_order')} cycle (away from contacts), MPa"}
 
 
 def compare_results(a: ResultFolder, b: ResultFolder) -> dict:
@@ -180,16 +211,21 @@ def compare_results(a: ResultFolder, b: ResultFolder) -> dict:
     }
 
 
-def comparison_plot(a: ResultFolder, b: ResultFolder, path: str | os.PathLike) -> Path:
-    """PNG of |F| over θ of every bearing: A and B flexible (solid), handbook (dotted)."""
-    import matplotlib
+def comparison_figure(a: ResultFolder, b: ResultFolder):
+    """The load curves of A and B as a :class:`matplotlib.figure.Figure`: |F| over θ of every
+    bearing, A solid, B dashed, the handbook dotted.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    The figure is drawn without :mod:`matplotlib.pyplot` (an Agg canvas), so the caller's backend
+    is left alone; in a notebook, display it with ``display(fig)`` or as a cell's last value.
+    """
+    from matplotlib import rcParams
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    path = Path(path)
-    fig, ax = plt.subplots(figsize=(8, 5.5))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(8, 5.5))
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    colours = rcParams["axes.prop_cycle"].by_key()["color"]
     for i in range(a.flexible_N.shape[1]):
         ax.plot(a.theta_deg, a.flexible_N[:, i], "-", color=colours[i % len(colours)], lw=1.2,
                 label=f"A {a.label}, bearing {i + 1}")
@@ -207,9 +243,14 @@ def comparison_plot(a: ResultFolder, b: ResultFolder, path: str | os.PathLike) -
     ax.set_title(f"A = {a.label} (solid lines) vs B = {b.label} (dashed)", fontsize=10)
     ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.14), frameon=False)
     fig.tight_layout()
+    return fig
+
+
+def comparison_plot(a: ResultFolder, b: ResultFolder, path: str | os.PathLike) -> Path:
+    """Write :func:`comparison_figure` as a PNG and return its path."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    comparison_figure(a, b).savefig(path, dpi=110)
     return path
 
 
@@ -239,8 +280,9 @@ def comparison_html(comparison: dict, plot: str | os.PathLike | None, path: str 
             for k, _ in STATISTICS) + "</tr>")
     parts.append("</table><h2>Whole disc</h2><table><tr><th class='l'>quantity</th><th>A</th><th>B</th><th>B/A</th></tr>")
     o = comparison["overall"]
+    titles = overall_titles(comparison)
     for key in o["a"]:
-        parts.append(f"<tr><td class='l'>{e(key)}</td><td>{_f(o['a'][key], '.1f')}</td><td>{_f(o['b'][key], '.1f')}</td>"
+        parts.append(f"<tr><td class='l'>{e(titles.get(key, key))}</td><td>{_f(o['a'][key], '.1f')}</td><td>{_f(o['b'][key], '.1f')}</td>"
                      f"<td>{_f(o['ratio'][key], '.4f')}</td></tr>")
     parts.append("</table>")
     if plot is not None:

@@ -53,8 +53,10 @@ half-written variant folder; a lock file refuses a second study writing into the
 from __future__ import annotations
 
 import base64
+import contextlib
 import csv
 import dataclasses
+import hashlib
 import html
 import io
 import itertools
@@ -64,7 +66,9 @@ import math
 import os
 import re
 import shutil
+import signal
 import socket
+import threading
 import time
 import tomllib
 import uuid
@@ -91,6 +95,7 @@ __all__ = [
     "local_cluster",
     "SingleThreadedBlas",
     "study_rows",
+    "study_figures",
     "read_study_csv",
     "toml_literal",
 ]
@@ -229,8 +234,29 @@ def _value_text(value: Any) -> str:
     return str(value)
 
 
+MAX_ID_LENGTH = 64
+"""Longest variant id made from the settings; a longer one is shortened (see :func:`short_id`)."""
+
+
+def short_id(text: str, width: int = MAX_ID_LENGTH) -> str:
+    """``text`` if it has at most ``width`` characters, else its beginning and ``--`` and six hex
+    digits of its hash: readable, and two different texts stay different."""
+    if len(text) <= width:
+        return text
+    digest = hashlib.sha1(text.encode("utf-8")).hexdigest()[:6]
+    return text[:max(width - 8, 1)] + "--" + digest
+
+
 def _variant_id(settings: Sequence[tuple[str, Any]]) -> str:
-    return _SAFE.sub("_", ",".join(f"{key}={_value_text(value)}" for key, value in settings))
+    """``key=value`` joined by commas. Longer than :data:`MAX_ID_LENGTH`, the keys lose their
+    table (``ligament=3.5``), the rest is cut and six hex digits of the full text's hash are
+    appended, so that ids stay distinct."""
+    full = _SAFE.sub("_", ",".join(f"{key}={_value_text(value)}" for key, value in settings))
+    if len(full) <= MAX_ID_LENGTH:
+        return full
+    brief = _SAFE.sub("_", ",".join(f"{key.rsplit('.', 1)[-1]}={_value_text(value)}" for key, value in settings))
+    digest = hashlib.sha1(full.encode("utf-8")).hexdigest()[:6]
+    return brief[:MAX_ID_LENGTH - 8].rstrip(",=") + "--" + digest
 
 
 def _lookup(data: dict, key: str) -> Any:
@@ -658,11 +684,52 @@ def local_cluster(workers: int | None = None):
     if os.environ.get("PYTHONPATH"):
         env["PYTHONPATH"] = os.environ["PYTHONPATH"]
     try:
-        return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                            env=env, silence_logs=logging.ERROR, host="127.0.0.1",
-                            plugins=(SingleThreadedBlas(pin_core=True),))
+        with _sigint_ignored_by_children():
+            # no dashboard; the scheduler's small HTTP server (health, metrics) on a free port, not
+            # on 8787, which another cluster may hold ("Port 8787 is already in use" otherwise)
+            return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                                env=env, silence_logs=logging.ERROR, host="127.0.0.1",
+                                plugins=(SingleThreadedBlas(pin_core=True),))
     except Exception as exc:
         raise ClusterError(f"cannot start a local Dask cluster of {n} workers: {_one_line(exc)}") from None
+
+
+@contextlib.contextmanager
+def _sigint_ignored_by_children():
+    """SIGINT ignored while the local cluster starts its worker processes, which keep it ignored.
+
+    Ctrl-C at a terminal (and a notebook's "interrupt kernel") signals the whole process group:
+    without this every worker process would print the traceback of its own KeyboardInterrupt.
+    The workers are stopped by this process instead, which cancels the variants and closes the
+    cluster. A no-op outside the main thread (only it can change signal handlers).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def _dask_logging_silenced():
+    """Dask's loggers silenced but for critical messages (restored afterwards): the warnings of
+    a cluster shut down after Ctrl-C ("Worker process still alive after 4.0 seconds, killing")
+    say nothing the interrupted study does not."""
+    loggers = [logging.getLogger("distributed")] + [
+        logger for name, logger in logging.root.manager.loggerDict.items()
+        if name.startswith("distributed.") and isinstance(logger, logging.Logger)]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels):
+            logger.setLevel(level)
 
 
 def _connect(scheduler: str, timeout_s: float):
@@ -701,6 +768,11 @@ class StudyResult:
     files : dict
         ``"csv"``, ``"json"``, ``"report"`` and the plots (name → path).
     wall_time_s : float
+        Wall time of this call, seconds.
+    compute_time_s : float
+        The variants' own run times added up, seconds: those computed in this call and those
+        taken from an earlier run (their recorded time), each case once (a variant ``same_as``
+        another is not counted again); failed variants count, cancelled ones do not.
     """
 
     out_dir: Path
@@ -711,6 +783,7 @@ class StudyResult:
     failed: int
     files: dict
     wall_time_s: float
+    compute_time_s: float = 0.0
 
 
 def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, scheduler: str | None = None,
@@ -817,14 +890,21 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
     plot_files = _plots(study, rows, out_dir / "plots") if plots else {}
     files.update(plot_files)
     files["report"] = out_dir / "report.html"
+    compute = _compute_time(records)
     wall = time.perf_counter() - started
-    _write_atomic(files["report"], _report_html(study, rows, plot_files, wall))
+    _write_atomic(files["report"], _report_html(study, rows, plot_files, wall, compute))
     computed = sum(1 for r in records.values() if r["computed"])
     failed = sum(1 for r in records.values() if r["status"] != "ok")
     return StudyResult(out_dir=out_dir, study=study, rows=tuple(rows), computed=computed,
                        reused=sum(1 for r in records.values()
                                   if not r["computed"] and r["status"] == "ok" and not r.get("same_as")),
-                       failed=failed, files=files, wall_time_s=wall)
+                       failed=failed, files=files, wall_time_s=wall, compute_time_s=compute)
+
+
+def _compute_time(records: dict) -> float:
+    """The variants' recorded run times added up (each case once; unknown times left out)."""
+    times = (r.get("wall_time_s") for r in records.values() if not r.get("same_as"))
+    return math.fsum(t for t in times if isinstance(t, (int, float)) and math.isfinite(t))
 
 
 def _same_case_records(study: Study, records: dict, first_of: dict) -> None:
@@ -850,6 +930,7 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
 
             client = Client(cluster, set_as_default=False)
     futures = []
+    interrupted = False
     try:
         try:
             client.register_plugin(SingleThreadedBlas())
@@ -880,7 +961,8 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
             done += 1
             if progress is not None:
                 progress(done, total, record)
-    except BaseException:
+    except BaseException as exc:
+        interrupted = isinstance(exc, KeyboardInterrupt)
         if futures:
             try:
                 client.cancel(futures, force=True)
@@ -888,10 +970,12 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
                 log.debug("cancelling the futures failed", exc_info=True)
         raise
     finally:
-        if own_client:
-            client.close()
+        with _dask_logging_silenced() if interrupted else contextlib.nullcontext():
+            if own_client:
+                client.close()
+            if cluster is not None:
+                cluster.close()
         if cluster is not None:
-            cluster.close()
             _remove_partials(variants_dir)  # the local workers are gone: nothing writes there any more
 
 
@@ -1059,21 +1143,34 @@ def _numeric(values: Sequence[Any]) -> bool:
     return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
 
 
-def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
-    import matplotlib
+def _figure(size: tuple[float, float], **subplots):
+    """A figure on an Agg canvas (never :mod:`matplotlib.pyplot`: the caller's backend, e.g. a
+    notebook's inline backend, is left alone) and its axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    fig = Figure(figsize=size)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(**subplots)
 
-    folder.mkdir(exist_ok=True)
+
+def study_figures(study: Study, rows: Sequence[dict]) -> dict:
+    """The plots of a study as :class:`matplotlib.figure.Figure` objects, by name.
+
+    ``"response_<key>"`` per parameter (grid), ``"tornado"`` (sensitivity, when the base is ok) and
+    ``"variants"`` (always, once a variant is ok); empty if no variant is ok. ``rows`` are the rows
+    of ``study.csv`` (:attr:`StudyResult.rows` or :func:`read_study_csv`). The figures are drawn
+    without :mod:`matplotlib.pyplot`, so the caller's backend is left alone; in a notebook, show
+    one with ``display(fig)`` or as a cell's last value.
+    """
     ok = [r for r in rows if r["status"] == "ok"]
-    files: dict[str, Path] = {}
+    figures: dict[str, Any] = {}
     if not ok:
-        return files
+        return figures
     if study.kind == "grid":
         for p in study.parameters:
             others = [q for q in study.parameters if q is not p]
-            fig, ax = plt.subplots(figsize=(6.4, 4.2))
+            fig, ax = _figure((6.4, 4.2))
             groups: dict[tuple, list[dict]] = {}
             for r in ok:
                 if r["role"] == "grid":
@@ -1095,10 +1192,7 @@ def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
             if len(groups) <= 8:
                 ax.legend(fontsize=7)
             fig.tight_layout()
-            path = folder / f"response_{_SAFE.sub('_', p.key)}.png"
-            fig.savefig(path, dpi=110)
-            plt.close(fig)
-            files[f"response_{p.key}"] = path
+            figures[f"response_{p.key}"] = fig
     elif study.kind == "sensitivity":
         by_id = {r["id"]: r for r in rows}
         base = by_id.get("base")
@@ -1114,7 +1208,7 @@ def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
                 span = max((abs(x) for x in d if not math.isnan(x)), default=0.0)
                 bars.append((span, p, d, life))
             bars.sort(key=lambda b: b[0])
-            fig, axes = plt.subplots(1, 2, figsize=(10, 1.2 + 0.55 * len(bars)), sharey=True)
+            fig, axes = _figure((10, 1.2 + 0.55 * len(bars)), nrows=1, ncols=2, sharey=True)
             y = range(len(bars))
             for ax, idx, title in ((axes[0], 2, "largest bearing load vs base, %"),
                                    (axes[1], 3, "L10h vs base, %")):
@@ -1131,11 +1225,8 @@ def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
             fig.suptitle(f"{study.name}: one-at-a-time sensitivity around the base "
                          f"(largest load {base['max_load_N']:.0f} N)", fontsize=10)
             fig.tight_layout()
-            path = folder / "tornado.png"
-            fig.savefig(path, dpi=110)
-            plt.close(fig)
-            files["tornado"] = path
-    fig, ax = plt.subplots(figsize=(max(6.4, 0.45 * len(rows) + 2), 4.2))
+            figures["tornado"] = fig
+    fig, ax = _figure((max(6.4, 0.45 * len(rows) + 2), 4.2))
     x = range(len(rows))
     ax.bar([i - 0.2 for i in x], [r["max_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, largest load")
     ax.bar([i + 0.2 for i in x], [r["equivalent_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, F_m")
@@ -1146,10 +1237,22 @@ def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
     ax.legend(fontsize=7)
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout()
-    path = folder / "variants.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    files["variants"] = path
+    figures["variants"] = fig
+    return figures
+
+
+def _plot_file_name(name: str) -> str:
+    return f"{_SAFE.sub('_', name)}.png"
+
+
+def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
+    """Write :func:`study_figures` into ``folder`` as PNG files; name → path."""
+    folder.mkdir(exist_ok=True)
+    files: dict[str, Path] = {}
+    for name, fig in study_figures(study, rows).items():
+        path = folder / _plot_file_name(name)
+        fig.savefig(path, dpi=110)
+        files[name] = path
     return files
 
 
@@ -1161,7 +1264,7 @@ def _fmt(value: Any, spec: str) -> str:
     return html.escape(str(value))
 
 
-def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float) -> str:
+def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float, compute_s: float) -> str:
     e = html.escape
     parts = [
         "<!DOCTYPE html><html><head><meta charset='utf-8'>",
@@ -1173,10 +1276,14 @@ def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float) -> 
         f"<p>{e(study.description)}</p>" if study.description else "",
         f"<p>Kind: <b>{e(study.kind)}</b>; base case <code>{e(study.base_case.name)}</code>"
         + (f" with overrides <code>{e('; '.join(study.overrides))}</code>" if study.overrides else "")
-        + f"; {len(rows)} variants, {sum(r['status'] == 'ok' for r in rows)} ok; "
-        f"wall time {wall_s:.1f} s.</p>",
+        + f"; {len(rows)} variants, {sum(r['status'] == 'ok' for r in rows)} ok "
+        f"({sum(r['status'] == 'ok' and not r['computed'] and not r['same_as'] for r in rows)} from an earlier run); "
+        f"compute time of the variants {compute_s:.1f} s (their run times added up, earlier runs included); "
+        f"wall time of this run {wall_s:.1f} s.</p>",
         "<p>Loads are the flexible (finite-element) crank-bearing loads of each variant's own analysis; "
         "'handbook' is the rigid model of the same variant; 'vs base' compares with the base case. "
+        "peak_von_mises_MPa is the structural stress peak away from contacts that rvfem run reports "
+        "(re-solved on P2 by default; study.csv also has the P1 cycle's peak_away_from_contacts_MPa). "
         "Life ratio = L10h / L10h of the reference (shortest-lived bearing). Each variant's full results "
         "are in <code>variants/&lt;id&gt;/</code>.</p>",
     ]
@@ -1187,7 +1294,7 @@ def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float) -> 
             ("max_load_N", "", ".1f"), ("handbook_max_load_N", "", ".1f"), ("max_vs_handbook_percent", "", "+.1f"),
             ("max_vs_base_percent", "", "+.1f"), ("equivalent_load_N", "", ".1f"),
             ("equivalent_vs_base_percent", "", "+.1f"), ("L10h_h", "", ".0f"), ("life_ratio", "", ".3f"),
-            ("life_ratio_vs_base", "", ".3f"), ("peak_away_from_contacts_MPa", "", ".1f"),
+            ("life_ratio_vs_base", "", ".3f"), ("peak_von_mises_MPa", "", ".1f"),
             ("wall_time_s", "", ".1f"), ("error", "l", "s")]
     parts.append("<h2>Variants</h2><table><tr>" + "".join(f"<th class='{c}'>{e(n)}</th>" for n, c, _ in cols) + "</tr>")
     for r in rows:

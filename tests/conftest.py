@@ -163,3 +163,22 @@ def structured_annulus(r_in=8.0, r_out=30.0, n_r=6, n_t=72):
                            np.column_stack([a.ravel(), d.ravel(), c.ravel()])])
     loop = lambda k: np.column_stack([idx[k], np.roll(idx[k], -1)])  # noqa: E731
     return points, triangles, {"central_hole": loop(0), "profile": loop(-1)}
+
+
+_DRAWS_A_FIGURE = re.compile(r"\b(plt\.subplots|plt\.figure|comparison_figure|study_figures)\(")
+
+
+def assert_figures_shown(nb) -> int:
+    """Every code cell of an executed notebook that draws a figure (``plt.subplots``,
+    ``plt.figure``, rvfem's figure functions) shows it: a PNG is among the cell's outputs, as
+    Jupyter's inline backend puts it there. Returns the number of figures shown (at least one)."""
+    shown = 0
+    for i, cell in enumerate(nb.cells):
+        if cell.cell_type != "code":
+            continue
+        pngs = sum("image/png" in out.get("data", {}) for out in cell.get("outputs", []))
+        if _DRAWS_A_FIGURE.search(cell.source):
+            assert pngs, f"cell {i} draws a figure but shows none:\n{cell.source[:300]}"
+        shown += pngs
+    assert shown, "the notebook shows no figure"
+    return shown

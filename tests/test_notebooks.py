@@ -4,7 +4,9 @@ and JupyterLab do. Only the parameters are changed (a coarser crank-angle step, 
 cache) to stay fast; what the notebooks compute is then checked against physics.
 
 ``notebooks/design_study.ipynb`` and ``notebooks/what_drives_the_flexibility_effect.ipynb`` have
-their own test files (tests/test_study.py, tests/test_verification.py).
+their own test files (tests/test_study.py, tests/test_verification.py). Every notebook's figures
+must be in its executed outputs (``conftest.assert_figures_shown``): rvfem draws its own figures
+without pyplot, so a notebook's inline backend stays on.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, assert_figures_shown
 
 nbformat = pytest.importorskip("nbformat")
 nbclient = pytest.importorskip("nbclient")
@@ -70,6 +72,7 @@ def _execute(path: Path, cache: Path) -> tuple[dict, str]:
     client = nbclient.NotebookClient(nb, kernel_name="python3", timeout=900,
                                      resources={"metadata": {"path": str(path.parent)}})
     client.execute()
+    assert_figures_shown(nb)
     text = []
     for cell in nb.cells:
         for out in cell.get("outputs", []):

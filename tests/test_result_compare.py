@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import html
 import json
 import shutil
 
@@ -92,6 +93,32 @@ def test_compare_folders_json_plot_and_page(solid_result, tmp_path, monkeypatch,
     code = _main(["compare", solid_result, b], monkeypatch)
     text = capsys.readouterr().out
     assert code == 0 and "largest load -10.0 %" in text and "L10h × 1.42" in text
+    # both stress peaks are structural peaks away from the contacts: the headline P2 re-solve and
+    # the P1 cycle's envelope, each labelled with its element order (screen and page)
+    for label in ("structural peak (P2, away from contacts), MPa",
+                  "structural peak, P1 cycle (away from contacts), MPa"):
+        assert label in text and html.escape(label) in page
+    assert "peak von Mises" not in text and "peak away from contacts" not in text
+
+
+def test_comparison_figure_leaves_the_backend_alone(solid_result, tmp_path):
+    """The figure is drawn without pyplot: a notebook's inline backend stays on."""
+    import matplotlib
+    from matplotlib.figure import Figure
+
+    from rvfem.result_compare import comparison_figure, comparison_plot
+
+    before = matplotlib.get_backend()
+    matplotlib.use("svg")   # stands for a notebook's inline backend
+    try:
+        a = read_result(solid_result)
+        fig = comparison_figure(a, a)
+        assert isinstance(fig, Figure) and len(fig.axes[0].lines) == 2 * a.flexible_N.shape[1] + 1
+        path = comparison_plot(a, a, tmp_path / "sub" / "c.png")
+        assert path.stat().st_size > 10_000
+        assert matplotlib.get_backend() == "svg"
+    finally:
+        matplotlib.use(before)
 
 
 def test_missing_result_is_one_line(tmp_path, monkeypatch, capsys):

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, assert_figures_shown
 from rvfem import cli
 from rvfem.case import load_case
 from rvfem.cli_study import COMPARE, STUDY
@@ -209,6 +209,15 @@ def test_rerun_recomputes_nothing(cluster_study, monkeypatch, capsys):
     after = {p.name: (p / "summary.json").stat().st_mtime_ns for p in (out / "variants").iterdir()}
     assert after == before
     assert all(r["computed"] == "no" and r["status"] == "ok" for r in read_study_csv(out / "study.csv"))
+    # the compute time is the variants' recorded run times, those of the first run included;
+    # the wall time is this (short) run's
+    recorded = sum(json.loads((p / "summary.json").read_text())["timings_s"]["total"]
+                   for p in (out / "variants").iterdir())
+    assert result.compute_time_s == pytest.approx(recorded, rel=1e-12)
+    assert result.compute_time_s > result.wall_time_s
+    report = (out / "report.html").read_text()
+    assert f"compute time of the variants {result.compute_time_s:.1f} s" in report
+    assert f"wall time of this run {result.wall_time_s:.1f} s" in report
 
 
 def test_a_failing_variant_is_recorded_and_the_study_goes_on(scheduler, cluster_study, meshes, tmp_path):
@@ -362,6 +371,7 @@ def test_notebook_runs_from_its_own_folder(tmp_path, monkeypatch):
     nb = nbformat.read(path, as_version=4)
     NotebookClient(nb, timeout=300, kernel_name="python3",
                    resources={"metadata": {"path": str(path.parent)}}).execute()
+    assert assert_figures_shown(nb) >= 2   # its own response curves and the study's plot
     checks = json.loads((tmp_path / "design_study" / "run_info.json").read_text())
     rows = read_study_csv(tmp_path / "design_study" / "study.csv")
     assert all(r["status"] == "ok" for r in rows)
@@ -435,3 +445,123 @@ high = "rigid_bore"
     files = _plots(study, list(rows.values()), tmp_path / "plots")
     assert set(files) == {"tornado", "variants"}
     assert all(p.stat().st_size > 5000 for p in files.values())
+
+
+def test_plots_are_figures_and_leave_the_backend_alone(tmp_path):
+    """A notebook's inline backend survives the study's and the comparison's plots: rvfem draws
+    on Figure objects (no pyplot, no matplotlib.use) and returns them for display."""
+    study_file = _write(tmp_path / "s.toml", _study_text("sensitivity", """
+[[parameter]]
+key = "fan_holes.ligament"
+low = 3.5
+high = 5.5
+"""))
+    script = f"""
+import sys
+import matplotlib
+matplotlib.use("svg")     # stands for a notebook's inline backend
+from matplotlib.figure import Figure
+from rvfem.study import load_study, study_figures, _plots
+study = load_study({str(study_file)!r})
+rows = []
+for v in study.variants:
+    rows.append({{"id": v.id, "role": v.role, "varied": ",".join(k for k, _ in v.settings), "status": "ok",
+                 "fan_holes.ligament": dict(v.settings).get("fan_holes.ligament", 4.5),
+                 "max_load_N": 1100.0 + len(rows), "equivalent_load_N": 880.0, "handbook_max_load_N": 1000.0,
+                 "max_vs_base_percent": float(len(rows)), "life_ratio_vs_base": 1.0 - 0.01 * len(rows)}})
+figures = study_figures(study, rows)
+assert set(figures) == {{"tornado", "variants"}} and all(isinstance(f, Figure) for f in figures.values())
+files = _plots(study, rows, __import__("pathlib").Path({str(tmp_path / "plots")!r}))
+assert sorted(p.name for p in files.values()) == ["tornado.png", "variants.png"]
+assert matplotlib.get_backend() == "svg", matplotlib.get_backend()
+assert "matplotlib.pyplot" not in sys.modules
+print("ok")
+"""
+    out = subprocess.run([sys.executable, "-c", script], env=_env(), capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+    assert all((tmp_path / "plots" / name).stat().st_size > 5000 for name in ("tornado.png", "variants.png"))
+
+
+def test_long_variant_ids_stay_distinct_and_readable(tmp_path, capsys):
+    """Ids longer than MAX_ID_LENGTH are shortened with a hash of the full text; the table and the
+    variant list print ids whole, so two crank-support variants never look the same."""
+    from rvfem.cli_study import _format_rows, _print_variants
+    from rvfem.study import MAX_ID_LENGTH, short_id
+
+    path = _write(tmp_path / "s.toml", _study_text("grid", """
+[[parameter]]
+key = "crank_support.support_stiffness_N_per_mm"
+values = [250000.0, 1000000.0]
+
+[[parameter]]
+key = "fan_holes.fillet_radius"
+values = [1.0, 3.0]
+"""))
+    study = load_study(path)
+    ids = [v.id for v in study.variants]
+    assert len(set(ids)) == len(ids)
+    long = [i for i in ids if i != "base"]
+    assert all(len(i) <= MAX_ID_LENGTH for i in ids)
+    # the full text is over 64 characters: table prefix dropped, cut, a hash appended
+    assert long[0].startswith("support_stiffness_N_per_mm=250000.0,fillet_radius=1.0")
+    assert all(len(i.rsplit("--", 1)[1]) == 6 for i in long)
+    assert load_study(path).variants[1].id == long[0]           # stable: a rerun resumes
+    assert short_id("x" * 80, 40) != short_id("x" * 79 + "y", 40) and len(short_id("x" * 80, 40)) == 40
+    # a one-parameter sensitivity keeps its full key=value ids, and the tables show them whole
+    shipped = load_study(ROOT / "studies" / "rv40e_fanholes_tornado.toml")
+    support = [v.id for v in shipped.variants if v.id.startswith("crank_support.")]
+    assert support == ["crank_support.support_stiffness_N_per_mm=250000.0",
+                       "crank_support.support_stiffness_N_per_mm=1000000.0"]
+    _print_variants(shipped)
+    rows = [{"id": vid, "status": "ok", "max_load_N": 1000.0, "max_vs_handbook_percent": 10.0,
+             "max_vs_base_percent": 0.0, "equivalent_load_N": 800.0, "life_ratio": 0.7, "life_ratio_vs_base": 1.0,
+             "peak_von_mises_MPa": 110.4, "peak_away_from_contacts_MPa": 90.6, "wall_time_s": 5.0,
+             "computed": True, "error": ""} for vid in support]
+    _format_rows(rows)
+    out = capsys.readouterr().out
+    for vid in support:
+        assert f"  {vid}  " in out                # the variant list
+        assert any(line.startswith(vid + " ") for line in out.splitlines())   # the results table
+    # the table's stress is the headline (P2) peak of rvfem run, not the P1 cycle's
+    assert "110.4" in out and "90.6" not in out and "s_vm: structural stress peak" in out
+
+
+def test_compute_time_counts_every_case_once():
+    from rvfem.study import _compute_time
+
+    records = {"base": {"wall_time_s": 10.0}, "a": {"wall_time_s": 5.0},
+               "same": {"wall_time_s": 10.0, "same_as": "base"}, "cancelled": {"wall_time_s": float("nan")},
+               "failed": {"wall_time_s": 0.5}}
+    assert _compute_time(records) == 15.5
+
+
+def test_ctrl_c_on_a_local_cluster_prints_one_line(meshes, tmp_path):
+    """Ctrl-C at a terminal signals the whole process group, the local cluster's workers too: the
+    command still prints one line ("interrupted"), no worker traceback, no Dask warning."""
+    study_file = _write(tmp_path / "grid.toml", _study_text("grid", """
+[[parameter]]
+key = "loads.torque_Nm"
+values = [250.0, 300.0, 350.0, 450.0, 500.0]
+"""))
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-c", RUNNER, "study", str(study_file), "-o", str(out),
+                             "--workers", "2", "--cache-dir", str(meshes)],
+                            env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)   # its own process group, as a terminal's job
+    try:
+        end = time.monotonic() + 240
+        while not list((out / "variants").glob("*/summary.json")):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < end, "no variant finished in time"
+            time.sleep(0.1)
+        os.killpg(proc.pid, signal.SIGINT)       # what Ctrl-C does
+        _, stderr = proc.communicate(timeout=120)
+    finally:
+        _stop(proc)
+    assert proc.returncode == 130, stderr
+    lines = stderr.splitlines()
+    assert lines[-1] == "rvfem: interrupted", stderr
+    assert all(line.startswith("rvfem") for line in lines), stderr      # the start line, progress lines
+    assert "Traceback" not in stderr and "distributed" not in stderr and "KeyboardInterrupt" not in stderr
+    assert not (out / LOCK_NAME).exists()
+    assert not [p for p in (out / "variants").iterdir() if p.name.startswith(".")]

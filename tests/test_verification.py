@@ -11,7 +11,7 @@ import pytest
 from rvfem import verification
 from rvfem.verification import Check, Section, render
 
-from conftest import ROOT
+from conftest import ROOT, assert_figures_shown
 
 MANUAL = ROOT / "docs" / "verification.md"
 NOTEBOOK = ROOT / "notebooks" / "what_drives_the_flexibility_effect.ipynb"
@@ -110,6 +110,7 @@ def test_sensitivity_notebook_runs_from_its_folder():
     errors = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
               if o.get("output_type") == "error"]
     assert not errors
+    assert assert_figures_shown(nb) >= 3   # every figure it draws is in its outputs
     printed = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code"
                       for o in c.get("outputs", []) if o.get("name") == "stdout")
     assert "largest drivers of Δmax" in printed
