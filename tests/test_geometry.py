@@ -533,3 +533,20 @@ def test_a_near_touch_is_given_in_micrometres(solid):
     assert "0.000 mm" not in str(info.value)
     with pytest.raises(GeometryError, match=r"between the central hole and bore [1-3] is only 50 µm thick"):
         disc_geometry(with_cycloid(solid, central_hole_radius=17.95))
+
+
+def test_a_disc_of_metres_is_checked_on_capped_samples():
+    """The fan-hole disc scaled 30×: its outlines are sampled at most WALL_SAMPLES times per feature
+    length (not every 0.02 mm), and the walls still come out right (the ligament 30 × 4.5 mm)."""
+    from rvfem.geometry.features import WALL_SAMPLES
+
+    sets = ["pins.circle_radius=1920", "pins.radius=90", "cycloid.eccentricity=39", "cycloid.central_hole_radius=360",
+            "cranks.circle_radius=1080", "crank_bearing.bore_radius=540", "crank_bearing.pitch_diameter=930",
+            "crank_bearing.roller_diameter=150", "fan_holes.inner_radius=510", "fan_holes.outer_radius=1470",
+            "fan_holes.ligament=135", "fan_holes.fillet_radius=60", "mesh.size_interior=75", "mesh.size_flank=10",
+            "mesh.size_bore=12", "mesh.size_hole=15", "mesh.min_wall=60"]
+    geom = disc_geometry(load_case(CASES / "rv40e_fanholes.toml", sets))
+    assert WALL_SAMPLES * 0.02 == pytest.approx(400.0)
+    wall = geom.walls[0]
+    assert {wall.first[:5], wall.second[:5]} == {"bore_", "hole_"}
+    assert wall.thickness == pytest.approx(135.0, abs=1e-3)

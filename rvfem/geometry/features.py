@@ -53,7 +53,15 @@ __all__ = [
 ]
 
 WALL_SPACING = 0.02
-"""Spacing (mm) of the points used to measure walls between features."""
+"""Spacing (mm) of the points used to measure walls between features (widened on features longer
+than WALL_SAMPLES·WALL_SPACING = 400 mm, see :data:`WALL_SAMPLES`)."""
+
+WALL_SAMPLES = 20_000
+"""Most points per :attr:`Feature.sampling_length` when walls are measured: a feature longer than
+400 mm (a bore of more than 64 mm radius; discs far larger than the largest RV reducers) is sampled
+at sampling_length/WALL_SAMPLES instead of WALL_SPACING, so that checking a large disc stays cheap.
+The error of a wall measured on samples is about spacing²/(8·radius of curvature): 0.05 µm for a
+1 mm fillet at 0.02 mm spacing, 1.3 µm at 0.1 mm."""
 
 
 def feature_text(name: str) -> str:
@@ -532,7 +540,7 @@ def _wall(a, b) -> Wall:
     signed distance (and the other way round)."""
     best = None
     for f, g in ((a, b), (b, a)):
-        pts = f.sample(WALL_SPACING)
+        pts = f.sample(max(WALL_SPACING, f.sampling_length / WALL_SAMPLES))
         d = g.signed_distance(pts)
         i = int(np.argmin(d))
         if best is None or d[i] < best[0]:
@@ -620,7 +628,7 @@ def _disc_geometry(case: Case) -> DiscGeometry:
     # every feature inside the profile
     outline = _MplPath(profile.points)
     for f in features:
-        pts = f.sample(0.5)
+        pts = f.sample(max(0.5, f.sampling_length / 1000.0))   # enough to tell "entirely outside"
         outside = ~outline.contains_points(pts)
         if np.all(outside):
             raise GeometryError(
