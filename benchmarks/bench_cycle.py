@@ -45,7 +45,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rvfem import contact, cycle, fem, reducer  # noqa: E402
+from rvfem import contact, crankshaft, cycle, fem  # noqa: E402
 from rvfem.case import load_case  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 
@@ -94,7 +94,7 @@ def measure(case, mesh_dir: str, thetas: np.ndarray) -> dict:
                symmetry=system.symmetry, assembly_s=setup["assembly"], factorization_s=setup["factorization"],
                interface_s=setup["interface"])
     t0 = time.perf_counter()
-    result = cycle.load_cycle(system, thetas, stage=None)
+    result = cycle.load_cycle(system, thetas, stage=cycle.single_disc_stage(system))
     out["cycle_s"] = time.perf_counter() - t0
     tm = result.timings
     out.update(columns_solved=tm["columns_solved"], columns_mapped=system.compliance.columns_mapped,
@@ -106,7 +106,7 @@ def measure(case, mesh_dir: str, thetas: np.ndarray) -> dict:
     del system, result
     if case.loads.discs == 2:
         pair_system = cycle.build_system(case, mesh)
-        stage = reducer.build_stage(pair_system, discs=2)
+        stage = cycle.build_stage(pair_system, discs=2, influence=crankshaft.crankshaft_influence(case))
         t0 = time.perf_counter()
         pair = cycle.load_cycle(pair_system, thetas, stage=stage)
         out["pair_s"] = time.perf_counter() - t0

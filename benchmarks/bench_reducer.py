@@ -6,7 +6,7 @@ sharing the carrier → crankshafts as beams (when the case has ``[crank_support
 minimum and equivalent load, their deltas against the handbook and the life ratio; the torque
 share of one disc over the cycle; and, with ``--half-pitch``, the difference between modelling
 disc B as disc A at θ + 180° and the exact disc B whose teeth sit half a tooth pitch from disc A's
-against the bores and holes (a second mesh and compliance; see :mod:`rvfem.reducer`).
+against the bores and holes (a second mesh and compliance; see :mod:`rvfem.cycle`).
 
 Run: ``python benchmarks/bench_reducer.py [CASE ...] [--step 1] [--half-pitch] [--set KEY=VALUE ...]``.
 """
@@ -24,7 +24,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from rvfem import cycle, reducer  # noqa: E402
+from rvfem import attribution, crankshaft, cycle  # noqa: E402
 from rvfem.case import load_case  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 
@@ -44,7 +44,7 @@ def main(argv=None) -> int:
         system = cycle.build_system(case, mesh_case(case, args.mesh_dir))
         thetas = cycle.cycle_angles(case)
         t0 = time.perf_counter()
-        attr = reducer.attribution(system, thetas)
+        attr = attribution.attribution(system, thetas)
         dt = time.perf_counter() - t0
         print(f"\n{case.name}: {len(thetas)} angles, attribution in {dt:.1f} s "
               f"(case model: {attr.final}); bearing 1, deltas against the handbook")
@@ -55,14 +55,15 @@ def main(argv=None) -> int:
                       f"{r['delta_min_percent']:+6.1f}% {r['equivalent_N']:8.1f} {r['delta_equivalent_percent']:+5.1f}% "
                       f"{r['life_ratio']:6.3f}")
         if case.loads.discs == 2:
-            stage = reducer.build_stage(system, discs=2)
+            stage = cycle.build_stage(system, discs=2, influence=crankshaft.crankshaft_influence(case))
             pair = cycle.load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
             share = pair.disc_torque_Nmm[:, 0] / (case.loads.torque_Nm * 500.0)
             print(f"  torque of disc A / (T/2): {share.min():.4f} … {share.max():.4f} ({stage.describe()})")
             if args.half_pitch:
-                case_b = reducer.half_pitch_case(case)
+                case_b = cycle.half_pitch_case(case)
                 system_b = cycle.build_system(case_b, mesh_case(case_b, args.mesh_dir))
-                exact = reducer.build_stage(system, discs=2, second=system_b, second_disc="half_pitch")
+                exact = cycle.build_stage(system, discs=2, influence=crankshaft.crankshaft_influence(case),
+                                          second=system_b, second_disc="half_pitch")
                 t0 = time.perf_counter()
                 res = cycle.load_cycle(system, thetas, saved_angles_deg=(), stage=exact)
                 dt = time.perf_counter() - t0

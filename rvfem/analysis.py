@@ -553,8 +553,8 @@ def duty_cycle_fe(system, thetas: np.ndarray, cycle, comparison, linear_life_h: 
     linear_life_h : float
         The linear-scaling service life, hours.
     """
-    from . import compare
     from . import cycle as cycle_module
+    from .rigid import equivalent_load
 
     t0 = time.perf_counter()
     case = system.case
@@ -567,10 +567,12 @@ def duty_cycle_fe(system, thetas: np.ndarray, cycle, comparison, linear_life_h: 
         if math.isclose(torque, rated_T, rel_tol=1e-12):
             fm[torque] = rated_fm
             continue
-        case_t = case.replace(loads=dataclasses.replace(case.loads, torque_Nm=torque))
-        system_t = dataclasses.replace(system, case=case_t)
-        cyc = cycle_module.load_cycle(system_t, thetas)
-        fm[torque] = [b.flexible.equivalent_N for b in compare.rigid_vs_flexible(case_t, cyc).bearings]
+        # the same system at another operating point: no new factorisation, the compliance
+        # columns and contact sets of the case's cycle reused
+        op = cycle_module.OperatingPoint(torque, case.analysis.friction)
+        cyc = cycle_module.load_cycle(system, thetas, op=op, saved_angles_deg=())
+        fm[torque] = [float(equivalent_load(f, case.analysis.equivalent_load_exponent))
+                      for f in cyc.bearing_loads.T]
     errors = tuple(100.0 * max((f / (f0 * t / rated_T) - 1.0 for f, f0 in zip(fm[t], rated_fm)), key=abs)
                    for t in torques)
     rating = iso281.crank_bearing_rating(case.crank_bearing)
@@ -630,7 +632,7 @@ class Analysis:
         ``cycle_per_angle`` and, with the attribution, ``attribution_compute`` (its own wall time;
         the stage ``attribution`` is the wait for it when :func:`analyse` computes it beside other
         stages, the computation itself when ``rvfem run`` does, after the VTK files).
-    attribution : rvfem.reducer.Attribution or None
+    attribution : rvfem.attribution.Attribution or None
         None from ``analyse(..., attribute=False)`` until the caller adds it. The flexibility
         effect step by step: handbook → equal share of the FE pin resultant →
         one disc with T/discs → two discs sharing the carrier → crankshafts (those that apply;
@@ -969,7 +971,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         give the service life from those loads (:func:`duty_cycle_fe`; stage ``duty_cycle``, one
         load cycle per torque, no new factorisation).
     attribute : bool
-        Compute the attribution (:func:`rvfem.reducer.attribution`, stage ``attribution``). False
+        Compute the attribution (:func:`rvfem.attribution.attribution`, stage ``attribution``). False
         leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`):
         :func:`rvfem.run.run_case` computes it while the output files are drawn.
     on_model : callable, optional
@@ -1108,12 +1110,12 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
 
 
 def attribution_of(system, thetas, cycle):
-    """The attribution of a case's flexible load cycle (:func:`rvfem.reducer.attribution`): the
+    """The attribution of a case's flexible load cycle (:func:`rvfem.attribution.attribution`): the
     modelling steps the case's own model does not already give, on the same angles and the same
     compliance."""
-    from . import reducer
+    from . import attribution
 
-    return reducer.attribution(system, thetas, cycles={reducer.case_step(system.case): cycle})
+    return attribution.attribution(system, thetas, cycles={attribution.case_step(system.case): cycle})
 
 
 def _timed(function, *args, **kwargs):

@@ -1,18 +1,62 @@
-"""The flexible load cycle: the disc model of a case, one crank angle, a full crank revolution.
+"""The flexible load cycle of a reducer stage: the disc model of a case, one crank angle, the
+stage (one disc, or two discs on one carrier with crankshafts) and a full crank revolution.
 
 Typical use from a notebook::
 
     from rvfem.case import load_case
     from rvfem.mesh import mesh_case
-    from rvfem.cycle import build_system, solve_angle, load_cycle
+    from rvfem.cycle import OperatingPoint, build_system, solve_angle, load_cycle
 
     case = load_case("cases/rv40e_fanholes.toml")
     system = build_system(case, mesh_case(case))
     one = solve_angle(system, theta=0.0)             # crank angle in rad
-    cycle = load_cycle(system)                       # 0…360° at the case's angle step
+    cycle = load_cycle(system)                       # 0…360° at the case's angle step and torque
+    reverse = load_cycle(system, op=OperatingPoint(-412.0, 0.05))   # same system, reversed torque
 
 The stiffness of the disc is assembled and factorised once (:func:`build_system`); every crank
-angle reuses it through the lazily filled column compliance of :mod:`rvfem.contact`.
+angle and every operating point (:class:`OperatingPoint`: torque, pin friction) reuses it through
+the lazily filled column compliance of :mod:`rvfem.contact`. One disc is a stage with one body:
+every cycle is solved by :func:`solve_stage_cycle`.
+
+**The reducer stage.** A two-disc RV reducer is not one disc on rigid eccentrics with half the torque. Disc B runs 180°
+behind disc A and the two discs share
+
+1. the **carrier**: one rotation φ, so the output torque divides between the discs by their
+   stiffness at each crank angle (T_A + T_B = T_out, not T_out/2 each), and
+2. every **crankshaft**: a beam on two support bearings in the carrier's end plates carrying both
+   discs' eccentrics. The eccentric of crank i under disc k moves by
+   w_k,i = −Σ_k' f_kk' · F_k',i (F the bearing force on disc k', so −F acts on the eccentric),
+   the same 2×2 influence matrix f (mm/N) in x and y (a round shaft on radially isotropic
+   bearings). The part of the two discs' forces that is common on a crank (the torque-carrying
+   tangential force) sees the soft path through the support bearings; the part that is opposite
+   (the rotating pin-force components, ≈ 180° apart) sees the much stiffer bending between them.
+
+Both couplings enter the condensed contact problem of :func:`rvfem.contact.solve_bodies`: the
+discs are two bodies with their own contacts and rigid motions, one carrier unknown, and the
+crankshafts add the compliance H[c, c'] = f_kk' · (d_c · d_c') between bearing contacts c, c' of
+the same crank (d the unit force direction on the disc, in the carrier frame).
+
+**Disc B.** Disc B is the same part and mesh as disc A, but it cannot sit in the same orientation:
+seen from disc B the pin ring is the one disc A would see at θ + 180° turned by half a pin pitch,
+which is disc A's view at θ + 180° − β turned as a whole by β = π/Zc (for a one-tooth difference;
+β = (2π − π·(Zp − Zc))/Zc in general, 0 for an even tooth difference). So disc B's teeth sit half a
+tooth pitch from disc A's against the bores and holes. Two ways to model it:
+
+* ``"same_as_first"`` (default): disc B is disc A at θ + 180° (same mesh, same compliance). This
+  misplaces disc B's teeth by β against its bores and holes; in exchange one pair solve gives
+  both discs' states (disc A at θ and at θ + 180°), so 180° of pair solves make the full cycle.
+* ``"half_pitch"``: disc B is a second model whose bores and holes are turned by −β against the
+  teeth, solved at θ + 180° − β and turned back by β: the exact geometry, at the price of a second
+  mesh, factorisation and compliance and 360° of pair solves.
+
+The difference between the two on the shipped RV-40E pair is measured in
+``benchmarks/bench_reducer.py`` (see docs/theory.md).
+
+**Torque convention.** As for one disc (docs/theory.md), each disc's torque is the moment of its
+pin forces about its own centre, and the carrier rotation turns each disc's eccentric centres about
+the disc centre; the handbook's ΣP_x·e·Zc = T/2 per disc is the equal split of this total.
+
+The crankshaft influence matrix comes from :func:`rvfem.crankshaft.crankshaft_influence`.
 """
 
 from __future__ import annotations
@@ -32,6 +76,7 @@ from . import contact, registry
 from ._arrays import max_load_index
 from .case import Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
+from .crankshaft import crankshaft_influence
 from .errors import CaseError, ContactError
 from .geometry import crank_centres
 from .models import bearing_contacts_many, roller_angles
@@ -40,6 +85,17 @@ from .models import bearing_contacts_many, roller_angles
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "SECOND_DISC_MODELS",
+    "ReducerStage",
+    "PairResult",
+    "build_stage",
+    "case_stage",
+    "single_disc_stage",
+    "half_pitch_case",
+    "second_disc_phase",
+    "solve_pair",
+    "solve_stage_cycle",
+    "OperatingPoint",
     "DiscSystem",
     "AngleResult",
     "CycleResult",
@@ -50,6 +106,35 @@ __all__ = [
     "displacement",
     "roller_angles",
 ]
+
+
+@dataclass(frozen=True)
+class OperatingPoint:
+    """What varies between solves of one disc model: the output torque and the pin friction.
+
+    A torque sweep, a duty cycle or a hysteresis loop is a loop over operating points on one
+    :class:`DiscSystem` (one factorisation, one column compliance).
+
+    Attributes
+    ----------
+    torque_Nm : float
+        Output torque T_out of the stage, N·m, signed (negative: the reversed direction). One disc
+        modelled alone carries T_out/discs.
+    friction : float
+        Coulomb coefficient μ at the pins (0: frictionless).
+    """
+
+    torque_Nm: float
+    friction: float = 0.0
+
+    @classmethod
+    def of(cls, case: Case) -> "OperatingPoint":
+        """The case's own operating point: ``loads.torque_Nm`` and ``analysis.friction``."""
+        return cls(float(case.loads.torque_Nm), float(case.analysis.friction))
+
+    def disc_torque_Nmm(self, case: Case) -> float:
+        """The torque of one disc with the equal share T_out/discs, N·mm."""
+        return self.torque_Nm * 1000.0 / case.loads.discs
 
 
 FOOTPRINT_ELEMENTS = 1.5
@@ -86,9 +171,10 @@ class DiscSystem:
     node_rotation : ndarray of int or None
         The FE node that each node turns into by 2π/N (symmetric meshes).
     contact_sets : dict
-        Cache of :func:`contact_set` by crank angle and the objects the contacts are built from
-        (mutable, like the compliance): the cycles of the attribution revisit the case cycle's
-        angles; also the contact maps of :func:`turn_result`.
+        Cache of :func:`contact_set` by crank angle, pin friction and model (mutable, like the
+        compliance; keyed by value, :func:`_contact_model_key`): the cycles of the attribution and
+        the operating points of a sweep revisit the same angles; also the contact maps of
+        :func:`turn_result`, by angle and turn.
     """
 
     case: Case
@@ -205,24 +291,24 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
                       pin_stiffness_N_per_mm, times, bearings, pins, symmetry, node_rotation)
 
 
-def pin_contacts(system: DiscSystem, theta: float, pc=None):
+def pin_contacts(system: DiscSystem, theta: float, friction: float, pc=None):
     """The pin contacts of crank angle θ (rad) as a :class:`rvfem.models.ContactGroup`.
 
     Each pin pushes along the inward normal of the profile at its closest point; the gap is the
-    exact one of the (modified, pitch-error) profile. With friction (``analysis.friction`` = μ)
-    the load on the disc is λ·(d + μ·s·t) along the known sliding direction, while the gap is
-    still measured along the normal d. The pin model's law gets the angle's contacts and the
-    flank curvature at each pin's closest point (the Hertz law depends on it). ``pc`` passes the
-    angle's :class:`rvfem.geometry.PinContacts` if they are already computed.
+    exact one of the (modified, pitch-error) profile. With friction (μ = ``friction``, the
+    operating point's) the load on the disc is λ·(d + μ·s·t) along the known sliding direction,
+    while the gap is still measured along the normal d. The pin model's law gets the angle's
+    contacts and the flank curvature at each pin's closest point (the Hertz law depends on it).
+    ``pc`` passes the angle's :class:`rvfem.geometry.PinContacts` if they are already computed.
     """
     from .geometry import pin_profile_contacts
 
     if pc is None:
         pc = pin_profile_contacts(system.geometry, theta)
-    return pin_contacts_many(system, [pc])[0]
+    return pin_contacts_many(system, [pc], friction)[0]
 
 
-def pin_contacts_many(system: DiscSystem, pcs) -> list:
+def pin_contacts_many(system: DiscSystem, pcs, friction: float) -> list:
     """:func:`pin_contacts` of many crank angles from their :class:`rvfem.geometry.PinContacts`:
     the closest points of all of them located on the footprint grid at once."""
     from .geometry import pin_centres, profile_curvature
@@ -239,7 +325,7 @@ def pin_contacts_many(system: DiscSystem, pcs) -> list:
     cols, wts = prof.columns_at(s, inward)   # pins push along the inward normal
     curvature = profile_curvature(system.geometry.profile, np.concatenate([pc.segment for pc in pcs]),
                                   np.concatenate([pc.param for pc in pcs]))
-    mu = case.analysis.friction
+    mu = friction
     if mu > 0:
         # Coulomb friction along the known sliding direction: the pin centre's velocity relative
         # to the disc (the pins are taken as not rolling in their grooves); the friction force on
@@ -270,39 +356,45 @@ def pin_contacts_many(system: DiscSystem, pcs) -> list:
     return out
 
 
-def contact_set(system: DiscSystem, theta: float) -> tuple[ContactSet, list[str]]:
-    """The contacts of crank angle θ (rad): every pin (the pin model's), then the bearing contacts
-    (the bearing model's).
+def contact_set(system: DiscSystem, theta: float, op: OperatingPoint | None = None
+                ) -> tuple[ContactSet, list[str]]:
+    """The contacts of crank angle θ (rad) at the operating point ``op`` (default the case's):
+    every pin (the pin model's), then the bearing contacts (the bearing model's).
 
     Returns the contact set and a name per contact (``pin 7``, ``bearing 1 roller 3``, ...).
-    Built once per angle and system (:attr:`DiscSystem.contact_sets`).
+    Built once per angle, pin friction and system (:attr:`DiscSystem.contact_sets`).
     """
-    return contact_sets(system, [theta])[0]
+    return contact_sets(system, [theta], OperatingPoint.of(system.case) if op is None else op)[0]
 
 
-def contact_sets(system: DiscSystem, thetas) -> list[tuple[ContactSet, list[str]]]:
+def contact_sets(system: DiscSystem, thetas, op: OperatingPoint) -> list[tuple[ContactSet, list[str]]]:
     """:func:`contact_set` of many crank angles; the pin contacts of the angles not built yet
-    come from one vectorised closest-point search (:func:`rvfem.geometry.pin_profile_contacts_many`)."""
+    come from one vectorised closest-point search (:func:`rvfem.geometry.pin_profile_contacts_many`).
+
+    The cache is keyed by value: the crank angle, the pin friction (the only part of the
+    operating point the contacts depend on; the torque enters the solve alone) and the models the
+    contacts come from (:func:`_contact_model_key`)."""
     from .geometry import pin_profile_contacts_many
 
-    # a system copied with dataclasses.replace shares the cache: an entry is valid only for the
-    # very objects it was built from (kept in the entry, so that their ids cannot be reused)
-    owner = (system.case, system.interface, system.geometry, system.bearings, system.pins)
-    ids = tuple(id(o) for o in owner)
-    keys = [(round(float(theta), 12),) + ids for theta in thetas]
-
-    def cached(key):
-        hit = system.contact_sets.get(key)
-        return hit is not None and all(a is b for a, b in zip(hit[0], owner))
-
-    missing = {key: float(theta) for key, theta in zip(keys, thetas) if not cached(key)}
+    model = _contact_model_key(system)
+    keys = [(round(float(theta), 12), float(op.friction)) + model for theta in thetas]
+    missing = {key: float(theta) for key, theta in zip(keys, thetas) if key not in system.contact_sets}
     if missing:
         angles = list(missing.values())
-        pins = pin_contacts_many(system, pin_profile_contacts_many(system.geometry, angles))
+        pins = pin_contacts_many(system, pin_profile_contacts_many(system.geometry, angles), op.friction)
         bearings = bearing_contacts_many(system.bearings, system.interface, crank_centres(system.case), angles)
         for key, p, b in zip(missing, pins, bearings):
-            system.contact_sets[key] = (owner, _contact_set(system, p, b))
-    return [system.contact_sets[key][1] for key in keys]
+            system.contact_sets[key] = _contact_set(system, p, b)
+    return [system.contact_sets[key] for key in keys]
+
+
+def _contact_model_key(system: DiscSystem) -> tuple:
+    """What a system's contacts depend on besides the crank angle and the friction, by value: the
+    case (frozen, hashable) and the bearing and pin models with their stiffness options. Systems
+    that share an interface and a compliance (:func:`dataclasses.replace` of one disc model with
+    another case) share the cache without mixing their contacts."""
+    return (system.case, system.bearing_model, system.pin_model, system.bearing_stiffness_scale,
+            system.pin_stiffness_N_per_mm)
 
 
 def _contact_set(system: DiscSystem, pins, bearings) -> tuple[ContactSet, list[str]]:
@@ -394,13 +486,16 @@ class AngleResult:
 
 
 def solve_angle(system: DiscSystem, theta: float, start: AngleResult | None = None, *,
+                op: OperatingPoint | None = None,
                 contacts: tuple[ContactSet, list[str]] | None = None) -> AngleResult:
-    """Solve one crank angle θ (rad). ``start`` warm-starts from a neighbouring angle;
+    """Solve one crank angle θ (rad) of one disc with the equal torque share T_out/discs at the
+    operating point ``op`` (default the case's). ``start`` warm-starts from a neighbouring angle;
     ``contacts`` passes the angle's :func:`contact_set` if it is already built."""
     case = system.case
-    cset, names = contact_set(system, theta) if contacts is None else contacts
+    op = OperatingPoint.of(case) if op is None else op
+    cset, names = contact_set(system, theta, op) if contacts is None else contacts
     sol = contact.solve_contact(
-        cset, system.interface, system.compliance, case.loads.disc_torque_Nmm,
+        cset, system.interface, system.compliance, op.disc_torque_Nmm(case),
         start=None if start is None else start.solution,
         max_iterations=case.analysis.max_active_set_iterations,
         label=f"at crank angle {math.degrees(theta):.2f}° ", names=names,
@@ -419,7 +514,7 @@ def angle_result(system: DiscSystem, theta: float, sol: AngleSolution, cset: Con
 
 
 def turn_result(system: DiscSystem, result: AngleResult, k: int,
-                contacts: ContactSet | None = None) -> AngleResult:
+                contacts: ContactSet | None = None, op: OperatingPoint | None = None) -> AngleResult:
     """The solution at θ + k·2π/N from the one at θ, by the disc's exact N-fold symmetry.
 
     Turning the whole configuration by 2π/N maps the disc (and its mesh) onto itself, the
@@ -439,7 +534,9 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     k : int
         Number of 2π/N steps.
     contacts : ContactSet, optional
-        The contact set at θ + k·2π/N (built here otherwise).
+        The contact set at θ + k·2π/N (built here otherwise, at the operating point ``op``).
+    op : OperatingPoint, optional
+        The operating point ``result`` was solved at; default the case's.
 
     Raises
     ------
@@ -453,22 +550,22 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
         return result
     beta = 2.0 * math.pi * k / system.symmetry      # signed: the result is labelled θ + β
     theta = result.theta + beta
-    cset = contacts if contacts is not None else contact_set(system, theta)[0]
+    cset = contacts if contacts is not None else contact_set(system, theta, op)[0]
     old = result.contacts
-    # the map depends only on the two contact sets and the turn: found once per system (the
-    # attribution's cycles turn the same solved angles); the entry keeps its objects so that a
-    # reused id cannot hit
-    key = ("map", id(old), id(cset), k, id(system.compliance))
-    hit = system.contact_sets.get(key)
-    if hit is None or hit[0][0] is not old or hit[0][1] is not cset or hit[0][2] is not system.compliance:
+    # the map depends only on the two contact sets and the turn, which the solved angle, the turn
+    # and whether the pins carry friction loads determine (contact sets are built once per angle
+    # and friction, :func:`contact_sets`): found once per system (the attribution's cycles and the
+    # operating points of a sweep turn the same solved angles)
+    key = ("map", round(float(result.theta), 12), k, old.W_load is not None) + _contact_model_key(system)
+    M = system.contact_sets.get(key)
+    if M is None:
         pairs = [(old.W, cset.W)]
         if old.W_load is not None or cset.W_load is not None:      # friction: the load weights map too
             pairs.append((old.load_weights, cset.load_weights))
         M = _permutation_map(system.compliance.rotation_power(k), *pairs, turned=_turned_probes(system, k))
         if M is None:
             M = _contact_map(system.compliance.rotation_power(k), *pairs)
-        hit = system.contact_sets[key] = ((old, cset, system.compliance), M)
-    M = hit[1]
+        system.contact_sets[key] = M
     # gaps, offsets and levers (mm; 1e-9 mm absolute, 1e-8 relative)
     mapped = M @ np.stack([old.gap0, old.offset, old.lever], axis=1)
     direct = np.stack([cset.gap0, cset.offset, cset.lever], axis=1)
@@ -492,7 +589,7 @@ def solve_from_last(solve, last: list):
     """``solve(start)`` for the next of equally spaced angles, ``last`` the results of the (up to
     two) angles before it: started from their linear extrapolation
     (:func:`rvfem.contact.extrapolated_start`), or from the last result if that start does not
-    settle. Results are :class:`AngleResult` or :class:`rvfem.reducer.PairResult` (disc by disc)."""
+    settle. Results are :class:`AngleResult` or :class:`PairResult` (disc by disc)."""
     if len(last) < 2:
         return solve(last[-1] if last else None)
 
@@ -505,22 +602,6 @@ def solve_from_last(solve, last: list):
         return solve(extrapolated(*last))
     except ContactError:
         return solve(last[-1])
-
-
-def turn_or_solve(system: DiscSystem, source: AngleResult, k: int, theta: float,
-                  contacts: ContactSet | None = None) -> AngleResult:
-    """:func:`turn_result` of ``source`` by k steps, checked to land on ``theta``; solved
-    directly (warm-started from ``source``) when the contacts do not map."""
-    if k == 0:
-        return source
-    try:
-        out = turn_result(system, source, k, contacts)
-    except ValueError as exc:
-        log.warning("%s; solving %.2f° directly", exc, math.degrees(theta))
-        return solve_angle(system, theta, source)
-    if abs(out.theta - theta) > 1e-9:
-        raise ValueError(f"turned angle {out.theta} does not land on {theta}")
-    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -811,7 +892,7 @@ class CycleResult:
         The full solution of every angle (any displacement field can be rebuilt exactly from it
         with :func:`displacement`).
     stage : str
-        The reducer-stage model (:meth:`rvfem.reducer.ReducerStage.describe`).
+        The reducer-stage model (:meth:`ReducerStage.describe`).
     disc_torque_Nmm : ndarray (n, discs) or None
         Each disc's share of the carrier torque (two discs sharing the carrier), N·mm; None for
         one disc with T/discs.
@@ -851,14 +932,377 @@ class CycleResult:
         return abs(torque_Nmm) / 1000.0 / (phi * 180.0 * 60.0 / math.pi)
 
 
-def likely_columns(system: DiscSystem, sets: list[ContactSet]) -> np.ndarray:
+# ------------------------------------------------------------------------------------------------
+# The reducer stage: one disc, or two discs on one carrier and crankshafts
+# ------------------------------------------------------------------------------------------------
+
+SECOND_DISC_MODELS = ("same_as_first", "half_pitch")
+
+
+def second_disc_phase(case) -> float:
+    """β, rad: disc B seen from its bores is disc A at θ + π − β turned by β (module docstring).
+
+    From Rp·u(2πj/Zp + θ·d/Zp) − e·u(θ) (d = Zp − Zc): disc B at crank angle θ sees the pins of
+    crank angle θ + π with the ring turned back by π·d/Zp; a rotation β of the whole picture with
+    β·Zc ≡ −π·d (mod 2π) absorbs it. The smallest non-negative solution is returned.
+    """
+    zp, zc = case.pins.count, case.cycloid.teeth
+    d = zp - zc
+    return float(np.mod((2.0 * math.pi - math.pi * d) / zc, 2.0 * math.pi / zc))
+
+
+# ------------------------------------------------------------------------------------------------
+# The stage and one pair of discs
+# ------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReducerStage:
+    """Everything of a reducer stage that does not change with the crank angle.
+
+    Attributes
+    ----------
+    first : rvfem.cycle.DiscSystem
+        Disc A.
+    second : rvfem.cycle.DiscSystem or None
+        Disc B's model; None for a single disc, ``first`` itself for ``"same_as_first"``.
+    second_phase : float
+        β, rad: disc B is solved at θ + π − β and its results turned by β (0 for
+        ``"same_as_first"``).
+    influence : ndarray (discs, discs) or None
+        Crankshaft influence matrix, mm/N (None: rigid eccentrics).
+    """
+
+    first: object
+    second: object | None
+    second_phase: float
+    influence: np.ndarray | None
+
+    @property
+    def discs(self) -> int:
+        return 1 if self.second is None else 2
+
+    def carrier_torque_Nmm(self, op: OperatingPoint) -> float:
+        """Torque on the carrier from the discs modelled here at the operating point, N·mm: T_out
+        for two discs, T_out/discs for one disc (the handbook's equal share)."""
+        return op.torque_Nm * 1000.0 * self.discs / self.first.case.loads.discs
+
+    @property
+    def mirrored_pairs(self) -> bool:
+        """True when the pair at θ + π is the pair at θ with the discs swapped (disc B is disc A
+        at θ + π and the crankshaft is symmetric), so that 180° of pairs make a cycle."""
+        if self.second is not self.first or self.second_phase != 0.0:
+            return False
+        f = self.influence
+        return f is None or bool(np.isclose(f[0, 0], f[1, 1], rtol=1e-12, atol=0.0))
+
+    def describe(self) -> str:
+        """What the stage model is, for the report and the screen."""
+        if self.discs == 1:
+            disc = "one disc carrying T/discs (the handbook's equal share)"
+        else:
+            disc = ("two discs sharing one carrier (the torque divides by their stiffness); disc B "
+                    + ("modelled as disc A at θ + 180°" if self.second is self.first and self.second_phase == 0
+                       else "with its teeth half a pitch from disc A's against the bores and holes"))
+        crank = ("crank support rigid: upper bound of the flexibility effect" if self.influence is None
+                 else "crankshafts as beams on elastic support bearings")
+        return f"{disc}; {crank}"
+
+
+def _rotation(beta: float) -> np.ndarray:
+    c, s = math.cos(beta), math.sin(beta)
+    return np.array([[c, -s], [s, c]])
+
+
+def build_stage(system, *, discs: int, influence: np.ndarray | None, second=None,
+                second_disc: str = "same_as_first") -> ReducerStage:
+    """A reducer stage of a disc model (:func:`case_stage` builds the one the case asks for).
+
+    Parameters
+    ----------
+    system : DiscSystem
+        Disc A.
+    discs : {1, 2}
+        1: one disc with the equal torque share T_out/discs; 2: both discs on one carrier.
+    influence : ndarray or None
+        Crankshaft influence matrix (mm/N, :func:`rvfem.crankshaft.crankshaft_influence`); None for
+        rigid eccentrics.
+    second : DiscSystem, optional
+        Disc B's model for ``second_disc = "half_pitch"``: the case with its cranks and holes turned
+        by −β (:func:`half_pitch_case`), meshed and built like disc A.
+    second_disc : {"same_as_first", "half_pitch"}
+    """
+    case = system.case
+    if discs == 1:
+        f = None if influence is None else np.asarray(influence, dtype=float)[:1, :1]
+        return ReducerStage(system, None, 0.0, f)
+    if discs != 2:
+        raise CaseError(f"a reducer stage has one or two discs, got {discs}")
+    if case.loads.discs != 2:
+        raise CaseError("two discs sharing the carrier need loads.discs = 2")
+    if second_disc not in SECOND_DISC_MODELS:
+        raise CaseError(f"second disc model must be one of {', '.join(SECOND_DISC_MODELS)}, got {second_disc!r}")
+    f = None if influence is None else np.asarray(influence, dtype=float)
+    if f is not None and f.shape != (2, 2):
+        raise CaseError("the crankshaft influence matrix of two discs must be 2×2")
+    if second_disc == "same_as_first":
+        return ReducerStage(system, system, 0.0, f)
+    if second is None:
+        raise CaseError("second_disc = 'half_pitch' needs the second disc's model (see half_pitch_case)")
+    return ReducerStage(system, second, second_disc_phase(case), f)
+
+
+def single_disc_stage(system) -> ReducerStage:
+    """One disc carrying T_out/discs on rigid eccentrics: the handbook's model and rvfem 0.1's."""
+    return build_stage(system, discs=1, influence=None)
+
+
+def case_stage(system, second=None, second_disc: str = "same_as_first") -> ReducerStage:
+    """The reducer stage the case asks for: both discs on one carrier for ``loads.discs = 2`` with
+    the crankshafts of ``[crank_support]`` (rigid eccentrics without it), or, with
+    ``loads.torque_split = "equal"`` or one disc, one disc carrying T_out/discs. The equal split is
+    rvfem 0.1's and the handbook's model, on rigid eccentrics ([crank_support] belongs to the
+    two-disc stage). ``second``, ``second_disc`` as in :func:`build_stage`."""
+    case = system.case
+    equal_split = case.loads.discs > 1 and case.loads.torque_split == "equal"
+    discs = 1 if equal_split or case.loads.discs == 1 else 2
+    influence = None if (discs == 1 and equal_split) else crankshaft_influence(case)
+    return build_stage(system, discs=discs, influence=influence, second=second, second_disc=second_disc)
+
+
+def half_pitch_case(case):
+    """Disc B's case for the exact model: cranks (and the holes that follow them) turned by −β.
+
+    Holes placed by an explicit ``angle_offset_deg`` are turned too; everything else is unchanged.
+    Solved at θ + π − β and turned back by β, this is disc B with its teeth half a tooth pitch from
+    disc A's against the bores and holes.
+    """
+    import dataclasses
+
+    beta = math.degrees(second_disc_phase(case))
+    cranks = dataclasses.replace(case.cranks, angles_deg=tuple(a - beta for a in case.cranks.angles_deg))
+    changes = {"cranks": cranks}
+    for table in ("fan_holes", "round_holes"):
+        holes = getattr(case, table)
+        if holes is not None and holes.angle_offset_deg is not None:
+            changes[table] = dataclasses.replace(holes, angle_offset_deg=holes.angle_offset_deg - beta)
+    return dataclasses.replace(case, **changes)
+
+
+@dataclass(frozen=True)
+class PairResult:
+    """One crank angle of the stage.
+
+    Attributes
+    ----------
+    results : tuple of rvfem.cycle.AngleResult
+        Disc A at θ (and disc B, in its own model's frame and crank angle).
+    bearing_forces : ndarray (discs, N, 2)
+        Bearing forces on each disc in the carrier frame, N.
+    torque_Nmm : ndarray (discs,)
+        Each disc's share of the carrier torque, N·mm.
+    eccentric_displacement : ndarray (discs, N, 2)
+        Displacement of each eccentric relative to the carrier (crankshaft deflection), mm.
+    """
+
+    results: tuple
+    bearing_forces: np.ndarray
+    torque_Nmm: np.ndarray
+    eccentric_displacement: np.ndarray
+
+
+def _disc_angles(stage: ReducerStage, theta: float) -> list[float]:
+    """The crank angle of each disc's own frame at the stage's crank angle θ (rad): disc A at θ,
+    disc B at θ + π − its phase."""
+    return [theta] if stage.second is None else [theta, theta + math.pi - stage.second_phase]
+
+
+def _bodies(stage: ReducerStage, theta: float, op: OperatingPoint):
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    thetas = _disc_angles(stage, theta)
+    phases = [0.0, stage.second_phase][:len(systems)]
+    sets = [contact_set(s, th, op) for s, th in zip(systems, thetas)]
+    return systems, thetas, phases, sets
+
+
+def _directions(system, cset) -> np.ndarray:
+    """Unit force on the disc per unit λ of each contact, (n_contacts, 2), disc frame."""
+    WL = cset.load_weights
+    return np.asarray(WL.T @ system.interface.resultants[:, :2])
+
+
+def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | None:
+    """H[c, c'] = f_kk' · (d_c · d_c') for the bearing contacts c (disc k), c' (disc k') of the
+    same crank, d in the carrier frame (mm/N); None for rigid eccentrics."""
+    if stage.influence is None:
+        return None
+    zp = stage.first.case.pins.count
+    dirs, crank, disc = [], [], []
+    for k, (s, beta, (cset, names)) in enumerate(zip(systems, phases, sets)):
+        d = _directions(s, cset) @ _rotation(beta).T
+        b = np.full(len(names), -1)
+        b[zp:] = cset.bearing[zp:]
+        dirs.append(d)
+        crank.append(b)
+        disc.append(np.full(len(names), k))
+    d = np.vstack(dirs)
+    crank = np.concatenate(crank)
+    disc = np.concatenate(disc)
+    same = (crank[:, None] == crank[None, :]) & (crank[:, None] >= 0)
+    f = stage.influence[disc[:, None], disc[None, :]]
+    return np.where(same, f * (d @ d.T), 0.0)
+
+
+def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None, *,
+               op: OperatingPoint | None = None) -> PairResult:
+    """Solve the stage at crank angle θ (rad) and the operating point ``op`` (default the case's):
+    disc A at θ with disc B at θ + 180°."""
+    op = OperatingPoint.of(stage.first.case) if op is None else op
+    systems, thetas, phases, sets = _bodies(stage, theta, op)
+    case = stage.first.case
+    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
+    H = coupling_matrix(stage, systems, phases, sets)
+    sols = contact.solve_bodies(
+        [contact.Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.carrier_torque_Nmm(op),
+        coupling=H, start=None if start is None else [r.solution for r in start.results],
+        max_iterations=case.analysis.max_active_set_iterations,
+        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names)
+    return _pair(stage, tuple(angle_result(s, th, sol, c)
+                              for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)))
+
+
+def _pair(stage: ReducerStage, results: tuple) -> PairResult:
+    """A PairResult from each disc's solution (disc A first)."""
+    return PairResult(results, *_stage_loads(stage, [r.bearing_forces for r in results],
+                                             [r.solution.residual["torque_Nmm"] for r in results]))
+
+
+def _stage_loads(stage: ReducerStage, bearing_forces: list, torques: list):
+    """The bearing forces of each disc in the carrier frame (discs, N, 2), the discs' torques and
+    the eccentric displacements, from each disc's bearing forces in its own frame (disc A first)."""
+    phases = [0.0, stage.second_phase][:len(bearing_forces)]
+    forces = np.stack([f @ _rotation(beta).T for f, beta in zip(bearing_forces, phases)])
+    w = np.zeros_like(forces)
+    if stage.influence is not None:
+        w = -np.einsum("kl,lnj->knj", stage.influence, forces)
+    return forces, np.array(torques), w
+
+
+def _first_and_loads(pair: PairResult) -> tuple:
+    """Disc A's result and (bearing forces, torques, eccentric displacements) of a pair."""
+    return pair.results[0], (pair.bearing_forces, pair.torque_Nmm, pair.eccentric_displacement)
+
+
+def _turned_bearing_forces(result, k: int, order: int) -> np.ndarray:
+    """The bearing forces (N, 2) of ``result`` turned by k·2π/N: bearing i's force, turned, is
+    bearing i + k's (the same as :func:`rvfem.cycle.turn_result` gives, to round-off)."""
+    return np.roll(result.bearing_forces @ _rotation(2.0 * math.pi * k / order).T, k, axis=0)
+
+
+# ------------------------------------------------------------------------------------------------
+# A full cycle
+# ------------------------------------------------------------------------------------------------
+
+
+def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoint, progress=None):
+    """Solve the stage at every crank angle at the operating point ``op``, each pair started from
+    the ones before it (:func:`solve_from_last`). One disc is a stage with one body.
+
+    Only the angles that symmetry does not give are solved (:func:`rvfem.cycle.symmetry_plan`):
+    with :attr:`ReducerStage.mirrored_pairs` the pair at θ + 180° is the pair at θ with the discs
+    swapped; with N-fold symmetric discs the pair at θ + 360°/N is the pair at θ turned
+    (:func:`rvfem.cycle.turn_result`). ``progress(done, n)`` counts the crank angles of disc A
+    obtained so far.
+
+    Returns
+    -------
+    results : list of rvfem.cycle.AngleResult
+        Disc A at every θ.
+    extras : dict
+        ``disc_torque_Nmm`` (n, discs), ``disc_bearing_forces`` (n, discs, N, 2) in the carrier
+        frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
+        stage's description), ``prefetch_seconds`` (the compliance columns computed before).
+    """
+    thetas = np.asarray(thetas, dtype=float)
+    n = len(thetas)
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    order = min(s.symmetry for s in systems)
+    mirrored = stage.discs == 2 and stage.mirrored_pairs
+    solve_at, source = symmetry_plan(thetas, order, mirrored)
+    step = 2.0 * math.pi / order
+
+    t0 = time.perf_counter()
+
+    def cset(k, theta):
+        return contact_set(systems[k], theta, op)[0]
+
+    # the contacts of every angle a disc is solved at and of every angle disc A is turned to,
+    # built in one sweep per system
+    wanted = [[] for _ in systems]
+    for j, (i, swap, k) in enumerate(source):
+        own = _disc_angles(stage, float(thetas[i]))
+        if (swap, k) == (0, 0):
+            for d in range(len(systems)):
+                wanted[d].append(own[d])
+        else:
+            wanted[0].append(own[swap] + k * step)
+    for d, s in enumerate(systems):
+        contact_sets(s, wanted[d], op)           # the solved angles are among them (source[i] = i)
+    for s in {id(s): s for s in systems}.values():
+        ks = [k for k, t in enumerate(systems) if t is s]
+        s.compliance.ensure(likely_columns(s, [cset(k, _disc_angles(stage, float(thetas[i]))[k])
+                                               for i in solve_at for k in ks], stage.carrier_torque_Nmm(op)))
+    t_prefetch = time.perf_counter() - t0
+    log.info("stage compliance prefetch %.2f s", t_prefetch)
+    pairs: list[PairResult] = []
+    for i in solve_at:
+        pairs.append(solve_from_last(lambda start: solve_pair(stage, float(thetas[i]), start, op=op), pairs[-2:]))
+        if progress is not None:
+            progress(len(pairs) * n // len(solve_at), n)
+    results, torque, forces, w = [], [], [], []
+    for j, (i, swap, k) in enumerate(source):
+        src = pairs[i].results
+        if swap:
+            src = src[::-1]                      # mirrored pair: disc B is disc A at θ + π
+        if (swap, k) == (0, 0):
+            first, loads = _first_and_loads(pairs[i])
+        else:
+            # disc A's solution turned by k steps (its contacts checked against the turned ones);
+            # disc B, which may land at θ_j + π − 2π when the discs are swapped (the same state,
+            # the cycle being 2π-periodic: roller_angles), enters only through its bearing forces
+            # and torque, turned and unchanged
+            try:
+                first = turn_result(systems[0], src[0], k, cset(0, src[0].theta + k * step), op)
+                loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
+                                     [r.solution.residual["torque_Nmm"] for r in src])     # turning keeps torques
+            except ValueError as exc:
+                log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(thetas[j]))
+                first, loads = _first_and_loads(solve_pair(stage, float(thetas[j]), pairs[i], op=op))
+            if abs(first.theta - thetas[j]) > 1e-9:
+                raise RuntimeError(f"symmetry plan lands at {first.theta} instead of {thetas[j]}")
+        results.append(first)
+        forces.append(loads[0])
+        torque.append(loads[1])
+        w.append(loads[2])
+    extras = {
+        "disc_torque_Nmm": np.array(torque),
+        "disc_bearing_forces": np.array(forces),
+        "eccentric_displacement": np.array(w),
+        "pair_solves": len(solve_at),
+        "stage": stage.describe(),
+        "prefetch_seconds": t_prefetch,
+    }
+    return results, extras
+
+
+def likely_columns(system: DiscSystem, sets: list[ContactSet], torque: float) -> np.ndarray:
     """Interface columns the load cycle will need, to compute them in one parallel sweep.
 
     Every roller and bearing column, and those of the pins that touch (gap ≤ 1 µm) on the side
-    that resists the disc torque (with a margin). Columns missed here are computed when first
-    needed, at a higher cost per column (small batches, one thread).
+    that resists the torque (its sign; N·mm) with a margin. Columns missed here are computed
+    when first needed, at a higher cost per column (small batches, one thread).
     """
-    T = system.case.loads.disc_torque_Nmm
+    T = torque
     zp = system.case.pins.count
     cols = []
     for cset in sets:
@@ -883,9 +1327,10 @@ def cycle_angles(case: Case) -> np.ndarray:
     return load_cycle_angles(case.analysis.angle_step_deg)
 
 
-def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress=None,
+def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, op: OperatingPoint | None = None,
+               stage: ReducerStage | None = None, progress=None,
                saved_angles_deg: tuple[float, ...] | None = None,
-               stress_envelope: bool = False, stage="case") -> CycleResult:
+               stress_envelope: bool = False) -> CycleResult:
     """Solve every crank angle of a revolution, each started from the ones before it
     (:func:`solve_from_last`).
 
@@ -894,6 +1339,15 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
     system : DiscSystem
     thetas : ndarray, optional
         Crank angles, rad; default a full revolution at ``case.analysis.angle_step_deg``.
+    op : OperatingPoint, optional
+        Output torque and pin friction; default the case's (:meth:`OperatingPoint.of`). Cycles at
+        other operating points reuse the system's factorisation, compliance columns and contact
+        sets.
+    stage : ReducerStage, optional
+        The reducer-stage model (:func:`build_stage`); default the case's (:func:`case_stage`: two
+        discs sharing the carrier for ``loads.discs = 2`` unless ``loads.torque_split = "equal"``,
+        crankshafts from ``[crank_support]``). One disc with T/discs on rigid eccentrics is
+        :func:`single_disc_stage`.
     progress : callable, optional
         Called as ``progress(i, n)`` after each solve (the CLI draws its progress bar with it).
     saved_angles_deg : tuple, optional
@@ -903,39 +1357,17 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, progress
         Also track the largest vertex von Mises stress of every vertex over all angles: the
         fields of the distinct solved angles, back-substituted FIELD_BATCH at a time, and one
         sparse product per batch (0.5 s on the default case); turned angles reuse them.
-    stage : rvfem.reducer.ReducerStage, None or "case"
-        The reducer-stage model: "case" (default) builds it from the case (two discs sharing the
-        carrier for ``loads.discs = 2`` unless ``loads.torque_split = "equal"``; crankshafts from
-        ``[crank_support]``); None is one disc with T/discs on rigid eccentrics.
     """
-    from . import reducer
-
     case = system.case
     thetas = cycle_angles(case) if thetas is None else np.asarray(thetas, dtype=float)
-    if isinstance(stage, str):
-        stage = reducer.default_stage(system)
+    op = OperatingPoint.of(case) if op is None else op
+    stage = case_stage(system) if stage is None else stage
     t0 = time.perf_counter()
     # the per-angle systems are small (~100 unknowns): threaded BLAS only adds overhead there
     # (measured 7x slower on two cores), so the cycle runs BLAS single-threaded
-    extras = {}
     with threadpool_limits(limits=1, user_api="blas"):
-        if stage is None:
-            solve_at, source = symmetry_plan(thetas, system.symmetry)
-            sets = contact_sets(system, thetas)
-            system.compliance.ensure(likely_columns(system, [sets[i][0] for i in solve_at]))
-            t_prefetch = time.perf_counter() - t0
-            solved: list[AngleResult] = []
-            for i in solve_at:
-                solved.append(solve_from_last(
-                    lambda start: solve_angle(system, float(thetas[i]), start, contacts=sets[i]), solved[-2:]))
-                if progress is not None:
-                    progress(len(solved) * len(thetas) // len(solve_at), len(thetas))
-            results = [turn_or_solve(system, solved[i], k, float(thetas[j]), sets[j][0])
-                       for j, (i, _, k) in enumerate(source)]
-            extras = {"pair_solves": len(solve_at)}
-        else:
-            results, extras = reducer.solve_stage_cycle(stage, thetas, progress)
-            t_prefetch = 0.0
+        results, extras = solve_stage_cycle(stage, thetas, op, progress)
+        t_prefetch = extras.pop("prefetch_seconds")
         t_cycle = time.perf_counter() - t0
         t1 = time.perf_counter()
         envelope = envelope_theta = None

@@ -563,7 +563,7 @@ def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
 
 
 def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
-    from .reducer import crankshaft_influence
+    from .crankshaft import crankshaft_influence
 
     cy, case = a.cycle, a.case
     share = None

@@ -469,7 +469,7 @@ class _Discs:
 def rigid_limit_section(discs: _Discs) -> Section:
     import dataclasses
 
-    from . import compare, cycle, reducer, registry, rigid
+    from . import compare, crankshaft, cycle, registry, rigid
 
     theta = _thetas()
     stiff = dict(stiffness_scale=1e6, bearing_model="rigid_bore", bearing_stiffness_scale=1e3,
@@ -477,7 +477,7 @@ def rigid_limit_section(discs: _Discs) -> Section:
     # the handbook and the classical distribution have no friction
     case = _case("rv40e_solid", "analysis.friction=0")
     system = dataclasses.replace(discs.system("rv40e_solid", **stiff), case=case)
-    one = cycle.load_cycle(system, theta, saved_angles_deg=(), stage=None)
+    one = cycle.load_cycle(system, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
     hb = rigid.handbook_bearing_loads(case, theta)
     f_max = hb.magnitude.max()
     hb_vec = np.stack([hb.fx, hb.fy], axis=-1).transpose(1, 0, 2)
@@ -485,7 +485,7 @@ def rigid_limit_section(discs: _Discs) -> Section:
     pins = rigid.classical_pin_forces(case, theta, exact_moment=True).magnitude.T
     e_pin = np.abs(one.pin_forces - pins).max() / pins.max()
     loaded = set(int(n) for n in one.pins_in_contact)
-    pair_stage = reducer.build_stage(system, discs=2, influence=None)
+    pair_stage = cycle.build_stage(system, discs=2, influence=None)
     pair = cycle.load_cycle(system, theta, saved_angles_deg=(), stage=pair_stage)
     T = case.loads.torque_Nm * 1000.0
     share = np.abs(pair.disc_torque_Nmm / (T / 2) - 1.0).max()
@@ -495,7 +495,7 @@ def rigid_limit_section(discs: _Discs) -> Section:
                      "crank_bearing.linear_stiffness_N_per_mm=2e5", "analysis.friction=0")
     lin_system = dataclasses.replace(linear, case=lin_case,
                                      bearings=registry.bearing_model("rollers")(lin_case, 1.0))
-    lin = cycle.load_cycle(lin_system, theta, saved_angles_deg=(), stage=None)
+    lin = cycle.load_cycle(lin_system, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(lin_system))
     e_share = (np.abs(lin.bearing_forces - compare.equal_share_forces(lin_case, lin)).max()
                / lin.bearing_loads.max())
     hand = "handbook model, Gao et al. eqs. 4-10 (rigid disc, T/2 per disc)"
@@ -523,17 +523,17 @@ def rigid_limit_section(discs: _Discs) -> Section:
 
 
 def invariants_section(discs: _Discs) -> tuple[Section, Section]:
-    from . import cycle, reducer
+    from . import crankshaft, cycle
 
     theta = _thetas()
     solid = discs.system("rv40e_solid")
     case = solid.case
-    one = cycle.load_cycle(solid, theta, saved_angles_deg=(), stage=None)
+    one = cycle.load_cycle(solid, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(solid))
     c = cycle.crank_centres(case)
     moment = (c[None, :, 0] * one.bearing_forces[..., 1] - c[None, :, 1] * one.bearing_forces[..., 0]).sum(axis=1)
     e_moment = np.abs(moment / case.loads.disc_torque_Nmm - 1.0).max()
     fan = discs.system("rv40e_fanholes")
-    stage = reducer.build_stage(fan, discs=2)
+    stage = cycle.case_stage(fan)
     pair = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=stage)
     T = fan.case.loads.torque_Nm * 1000.0
     e_carrier = np.abs(pair.disc_torque_Nmm.sum(axis=1) / T - 1.0).max()
@@ -556,7 +556,7 @@ def invariants_section(discs: _Discs) -> tuple[Section, Section]:
     shift = int(round(360.0 / case.cranks.count / STEP_DEG))
     full_case = _case("rv40e_solid", "mesh.symmetric=false")
     full = build_system(full_case, mesh_case(full_case, discs.cache))
-    every = cycle.load_cycle(full, theta, saved_angles_deg=(), stage=None)
+    every = cycle.load_cycle(full, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(full))
     F = every.bearing_loads
     e = max(np.abs(F[:, i] - np.roll(F[:, 0], i * shift)).max() for i in range(1, case.cranks.count)) / F.max()
     rows = [Check("one solid disc, full-disc mesh, every angle solved: bearing i at θ + 120°·i vs bearing 1 "
@@ -564,7 +564,7 @@ def invariants_section(discs: _Discs) -> tuple[Section, Section]:
                   "relative to F_max")]
     worst = 0.0
     for j in (7, 20, 33):               # pairs obtained by 120° turns and 180° swaps
-        direct = reducer.solve_pair(stage, float(theta[j]))
+        direct = cycle.solve_pair(stage, float(theta[j]))
         worst = max(worst, float(np.abs(direct.bearing_forces[0] - pair.bearing_forces[j]).max()))
     worst /= float(pair.bearing_loads.max())
     rows.append(Check("fan-hole pair on crankshafts, symmetric mesh: pairs turned and swapped from "
@@ -600,13 +600,14 @@ def convergence_section(discs: _Discs) -> Section:
         case = load_case(CASES / "rv40e_fanholes.toml", sizes)
         mesh = mesh_case(case, discs.cache)
         system = cycle.build_system(case, mesh)
-        peaks.append(float(cycle.load_cycle(system, theta, saved_angles_deg=(), stage=None).bearing_loads.max()))
+        one_disc = cycle.single_disc_stage(system)
+        peaks.append(float(cycle.load_cycle(system, theta, saved_angles_deg=(), stage=one_disc).bearing_loads.max()))
         nodes.append(mesh.n_nodes)
     change = peaks[2] / peaks[1] - 1.0
     p2 = discs.system("rv40e_fanholes", order=2)
     p1 = discs.system("rv40e_fanholes")
-    f2 = float(cycle.load_cycle(p2, theta, saved_angles_deg=(), stage=None).bearing_loads.max())
-    f1 = float(cycle.load_cycle(p1, theta, saved_angles_deg=(), stage=None).bearing_loads.max())
+    f2 = float(cycle.load_cycle(p2, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(p2)).bearing_loads.max())
+    f1 = float(cycle.load_cycle(p1, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(p1)).bearing_loads.max())
     checks = (
         Check(f"fan-hole disc, one disc: peak bearing load, {nodes[1]} → {nodes[2]} nodes, N",
               "validation ladder (docs/theory.md § 10): < 1 % between the two finest meshes", peaks[1], peaks[2], change, 0.01),
@@ -637,19 +638,19 @@ def beam_by_integration(span: float, load_at: float, x: np.ndarray, EI: float) -
 
 
 def reducer_section(discs: _Discs) -> Section:
-    from . import cycle, reducer
+    from . import crankshaft, cycle
 
     L, EI, kGA = 40.0, 2.0e9, 3.0e7
     roark = "Roark's *Formulas for Stress and Strain*, simply supported beam, central load: L³/(48EI)"
-    f_mid = reducer.beam_influence(L, [L / 2], EI)[0, 0]
+    f_mid = crankshaft.beam_influence(L, [L / 2], EI)[0, 0]
     z = np.array([13.0, 24.5])
-    f_two = reducer.beam_influence(L, z, EI)
+    f_two = crankshaft.beam_influence(L, z, EI)
     ref_two = np.column_stack([beam_by_integration(L, z[j], z, EI) for j in range(2)])
     e_two = np.abs(f_two / ref_two - 1.0).max()
-    f_shear = reducer.beam_influence(L, [L / 2], np.inf, kGA)[0, 0]
+    f_shear = crankshaft.beam_influence(L, [L / 2], np.inf, kGA)[0, 0]
     c1, c2 = 2e-6, 5e-6
-    f_spring = reducer.beam_influence(L, [L / 2], np.inf, None, (c1, c2))[0, 0]
-    f_end = reducer.beam_influence(L, [1e-6 * L], np.inf, None, (c1, c2))[0, 0]
+    f_spring = crankshaft.beam_influence(L, [L / 2], np.inf, None, (c1, c2))[0, 0]
+    f_end = crankshaft.beam_influence(L, [1e-6 * L], np.inf, None, (c1, c2))[0, 0]
     checks = [
         Check("beam influence, central load, mm/N", roark, L**3 / (48 * EI), f_mid, f_mid / (L**3 / (48 * EI)) - 1,
               1e-14),
@@ -667,15 +668,15 @@ def reducer_section(discs: _Discs) -> Section:
     ]
     theta = _thetas()[:6]
     fan = discs.system("rv40e_fanholes")
-    rigid = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=reducer.build_stage(fan, discs=2, influence=None))
-    stiff = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=reducer.build_stage(
+    rigid = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=cycle.build_stage(fan, discs=2, influence=None))
+    stiff = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=cycle.build_stage(
         fan, discs=2, influence=1e-14 * np.array([[2.0, 1.0], [1.0, 2.0]])))
     e_stiff = np.abs(stiff.bearing_forces - rigid.bearing_forces).max() / np.abs(rigid.bearing_forces).max()
     checks.append(Check("crankshafts of 10¹⁴ N/mm vs rigid crank support: bearing forces",
                         "limit of a rigid crank support", "rigid support",
                         f"{np.abs(stiff.bearing_forces).max():.1f} N peak", e_stiff, 1e-6, "relative to F_max"))
-    f = reducer.beam_influence(40.0, [15.0, 25.0], 2e9, 3e7, (2e-6, 2e-6))
-    pair = reducer.solve_pair(reducer.build_stage(fan, discs=2, influence=f), 0.3)
+    f = crankshaft.beam_influence(40.0, [15.0, 25.0], 2e9, 3e7, (2e-6, 2e-6))
+    pair = cycle.solve_pair(cycle.build_stage(fan, discs=2, influence=f), 0.3)
     w = -np.einsum("kl,lnj->knj", f, pair.bearing_forces)
     e_w = np.abs(pair.eccentric_displacement - w).max() / np.abs(w).max()
     checks.append(Check("eccentric displacements vs −f·F of both discs' bearing forces",

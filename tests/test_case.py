@@ -174,7 +174,7 @@ def test_bad_choices_list_the_options_and_suggest(case_text, tmp_path, table, ke
         ("cycloid", "thickness", "0", "must be positive"),
         ("cycloid", "central_hole_radius", "-1.0", "must be positive"),
         ("crank_bearing", "bore_radius", "-18.0", "must be positive"),
-        ("crank_bearing", "radial_clearance", "-0.005", "must be non-negative"),
+        ("crank_bearing", "radial_clearance", "-0.05", "must be at least -0.02 mm"),
         ("loads", "discs", "0", "must be positive"),
         ("material", "youngs_modulus", "-1.0", "must be positive"),
         ("analysis", "equivalent_load_exponent", "0.0", "must be positive"),

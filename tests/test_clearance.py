@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvfem import contact, cycle, reducer
+from rvfem import attribution, contact, cycle
 from rvfem.mesh import mesh_case
 
 from conftest import CASES_DIR, coarse_case
@@ -28,25 +28,18 @@ def _system(name: str, clearance_mm: float, mesh_dir):
     return cycle.build_system(case, mesh_case(case, mesh_dir))
 
 
-def _carrier_torque(case) -> float:
-    """The torque the carrier equation of a cycle balances, N·mm: T_out with the reducer stage, the
-    disc's share on one disc."""
-    return (case.loads.torque_Nm * 1e3 if reducer.default_stage is not None and reducer.case_step(case) != "one_disc"
-            else case.loads.disc_torque_Nmm)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_every_attribution_step_carries_the_torque_at_every_clearance(name, mesh_dir):
     for um in CLEARANCES_UM:
         system = _system(name, um * 1e-3, mesh_dir)
         case = system.case
-        att = reducer.attribution(system, THETA)           # every step solved here, none passed in
+        att = attribution.attribution(system, THETA)           # every step solved here, none passed in
         for step in att.steps:
             assert np.all(step.loads.max(axis=1) > 0.0), f"{name} at {um} µm: step {step.key} lost the load"
         # the attribution's last step is the case's own model: the same as the cycle of a run
         run = cycle.load_cycle(system, THETA, saved_angles_deg=())
-        own = att.step(reducer.case_step(case)).loads
+        own = att.step(attribution.case_step(case)).loads
         assert np.allclose(own, run.bearing_loads.T, rtol=1e-6, atol=1e-6 * run.bearing_loads.max())
         # every solve is in equilibrium with the torque on the carrier
         torque = max(abs(r.solution.residual["torque_Nmm"]) for r in run.solutions)

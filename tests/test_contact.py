@@ -185,8 +185,9 @@ def test_reverse_torque_is_the_mirror_image_of_forward_torque(tmp_path, pin_mode
     mesh = mesh_case(forward, tmp_path)
     mirrored, image = _mirrored_mesh(mesh, forward.cranks.angles_deg)
     theta = np.radians([0.0, 17.0, 55.0, 200.0])
-    a = cycle.load_cycle(cycle.build_system(forward, mesh), theta, saved_angles_deg=(), stage=None)
-    b = cycle.load_cycle(cycle.build_system(reverse, mirrored), -theta, saved_angles_deg=(), stage=None)
+    s_forward, s_reverse = cycle.build_system(forward, mesh), cycle.build_system(reverse, mirrored)
+    a = cycle.load_cycle(s_forward, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(s_forward))
+    b = cycle.load_cycle(s_reverse, -theta, saved_angles_deg=(), stage=cycle.single_disc_stage(s_reverse))
     scale = a.bearing_loads.max()
     fa = a.bearing_forces                       # (n, N, 2)
     fb = b.bearing_forces[:, image]             # bearing at −α_i in place of bearing i

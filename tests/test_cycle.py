@@ -54,7 +54,7 @@ def test_rigid_limit_reproduces_handbook_and_classical_pin_forces(solid):
     system = cycle.build_system(case, mesh, stiffness_scale=1e6, bearing_model="rigid_bore",
                                 bearing_stiffness_scale=1e3, pin_model="linear",
                                 pin_stiffness_N_per_mm=3e5)
-    result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=None)
+    result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
     hb = rigid.handbook_bearing_loads(case, THETA)
     f_max = hb.magnitude.max()
     assert np.abs(result.bearing_loads.T - hb.magnitude).max() <= 0.03 * f_max
@@ -74,7 +74,7 @@ def test_rigid_disc_shares_load_equally_with_linear_rollers(solid):
     _, mesh = solid
     case = coarse("rv40e_solid", crank_bearing={"stiffness_law": "linear", "linear_stiffness_N_per_mm": 2e5})
     system = cycle.build_system(case, mesh, stiffness_scale=1e3)
-    result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=None)
+    result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
     share = compare.equal_share_forces(case, result)
     assert np.abs(result.bearing_forces - share).max() <= 0.005 * result.bearing_loads.max()
 
@@ -84,7 +84,7 @@ def test_rigid_disc_with_palmgren_rollers_deviates_from_equal_share_by_the_nonli
     more than its equal share; the deviation is small but clearly above the linear case's."""
     case, mesh = solid
     system = cycle.build_system(case, mesh, stiffness_scale=1e3)
-    result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=None)
+    result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
     share = compare.equal_share_forces(case, result)
     dev = np.abs(result.bearing_forces - share).max() / result.bearing_loads.max()
     assert 0.005 < dev < 0.05
@@ -99,7 +99,7 @@ def test_rigid_disc_with_palmgren_rollers_deviates_from_equal_share_by_the_nonli
 def solid_cycle(solid):
     case, mesh = solid
     system = cycle.build_system(case, mesh)
-    return case, system, cycle.load_cycle(system, THETA, saved_angles_deg=(0.0,), stage=None)
+    return case, system, cycle.load_cycle(system, THETA, saved_angles_deg=(0.0,), stage=cycle.single_disc_stage(system))
 
 
 def test_equilibrium_closes_to_round_off(solid_cycle):
@@ -173,7 +173,7 @@ def test_fan_holes_raise_the_maximum_bearing_load(solid, fanholes, bearing_model
     maxima = {}
     for name, (case, mesh) in (("solid", solid), ("fanholes", fanholes)):
         system = cycle.build_system(case, mesh, bearing_model=bearing_model)
-        result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=None)
+        result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
         maxima[name] = compare.rigid_vs_flexible(case, result).bearings[0].delta_max_percent
     assert maxima["fanholes"] > maxima["solid"] + 3.0
 
@@ -247,7 +247,7 @@ def test_contacts_of_many_angles_are_those_built_one_by_one(fanholes):
     case, mesh = fanholes
     system = cycle.build_system(case, mesh)
     thetas = np.radians([0.0, 7.0, 119.0, 359.0])
-    batched = cycle.contact_sets(system, thetas)
+    batched = cycle.contact_sets(system, thetas, cycle.OperatingPoint.of(system.case))
     prof = system.interface.grids["profile"]
     centres = crank_centres(case)
     zp = case.pins.count

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from rvfem import cycle, reducer, rigid
+from rvfem import crankshaft, cycle, rigid
 from rvfem.case import case_from_dict, case_to_dict, load_case
 from rvfem.mesh import mesh_case
 
@@ -38,13 +38,13 @@ def beam_by_integration(span, load_at, x, EI):
 
 
 def test_central_load_gives_the_textbook_mid_span_deflection():
-    f = reducer.beam_influence(L, [L / 2], EI)
+    f = crankshaft.beam_influence(L, [L / 2], EI)
     assert f[0, 0] == pytest.approx(L**3 / (48 * EI), rel=1e-14)
 
 
 def test_two_loads_match_the_integrated_beam():
     z = np.array([13.0, 24.5])
-    f = reducer.beam_influence(L, z, EI)
+    f = crankshaft.beam_influence(L, z, EI)
     for j in range(2):
         ref = beam_by_integration(L, z[j], z, EI)
         assert np.allclose(f[:, j], ref, rtol=1e-6)    # measured 2e-10 (grid of 2e5 steps)
@@ -53,25 +53,25 @@ def test_two_loads_match_the_integrated_beam():
 
 def test_support_compliance_alone_is_springs_and_a_lever():
     c1, c2 = 2e-6, 5e-6
-    f = reducer.beam_influence(L, [L / 2], np.inf, None, (c1, c2))
+    f = crankshaft.beam_influence(L, [L / 2], np.inf, None, (c1, c2))
     # a central load splits equally: the beam centre moves by the mean support deflection
     assert f[0, 0] == pytest.approx((c1 + c2) / 4, rel=1e-14)
     # a load near support 1 goes almost entirely into it
-    g = reducer.beam_influence(L, [1e-6 * L], np.inf, None, (c1, c2))
+    g = crankshaft.beam_influence(L, [1e-6 * L], np.inf, None, (c1, c2))
     assert g[0, 0] == pytest.approx(c1, rel=1e-5)
 
 
 def test_shear_alone_gives_the_timoshenko_mid_span_deflection():
     kGA = 3.0e7
-    f = reducer.beam_influence(L, [L / 2], np.inf, kGA)
+    f = crankshaft.beam_influence(L, [L / 2], np.inf, kGA)
     assert f[0, 0] == pytest.approx(L / (4 * kGA), rel=1e-14)
 
 
 def test_influence_matrix_is_symmetric_positive_definite_and_superposes():
     z = [12.0, 21.0]
-    parts = [reducer.beam_influence(L, z, EI), reducer.beam_influence(L, z, np.inf, 3e7),
-             reducer.beam_influence(L, z, np.inf, None, (1e-6, 2e-6))]
-    f = reducer.beam_influence(L, z, EI, 3e7, (1e-6, 2e-6))
+    parts = [crankshaft.beam_influence(L, z, EI), crankshaft.beam_influence(L, z, np.inf, 3e7),
+             crankshaft.beam_influence(L, z, np.inf, None, (1e-6, 2e-6))]
+    f = crankshaft.beam_influence(L, z, EI, 3e7, (1e-6, 2e-6))
     assert np.allclose(f, sum(parts), rtol=1e-14)
     assert np.allclose(f, f.T, rtol=1e-14) and np.all(np.linalg.eigvalsh(f) > 0)
 
@@ -83,9 +83,9 @@ def test_crankshaft_influence_from_journal_diameter():
                               bending_stiffness_Nmm2=None, journal_diameter=d, shear=True, span=L,
                               eccentric_positions=(15.0, 25.0), support_stiffness_pair=(4e5, 5e5),
                               carrier_stiffness_pair=(1e6, None))
-    f = reducer.crankshaft_influence(SimpleNamespace(crank_support=support))
+    f = crankshaft.crankshaft_influence(SimpleNamespace(crank_support=support))
     kappa = 6 * (1 + nu) / (7 + 6 * nu)
-    ref = reducer.beam_influence(L, [15.0, 25.0], E * math.pi * d**4 / 64,
+    ref = crankshaft.beam_influence(L, [15.0, 25.0], E * math.pi * d**4 / 64,
                                  kappa * E / (2 * (1 + nu)) * math.pi * d * d / 4,
                                  (1 / 4e5 + 1 / 1e6, 1 / 5e5))
     assert np.array_equal(f, ref)
@@ -93,16 +93,16 @@ def test_crankshaft_influence_from_journal_diameter():
 
 def test_second_disc_phase_is_half_a_tooth_pitch_for_one_tooth_difference():
     case = load_case(CASES_DIR / "rv40e.toml")
-    assert reducer.second_disc_phase(case) == pytest.approx(math.pi / case.cycloid.teeth, rel=1e-14)
+    assert cycle.second_disc_phase(case) == pytest.approx(math.pi / case.cycloid.teeth, rel=1e-14)
     # the pins disc B sees at θ (ring of the common housing, centre opposite its eccentric) are
     # the pins of θ + π − β turned by β
     from rvfem.geometry import pin_centres
 
-    beta, th = reducer.second_disc_phase(case), 0.7
+    beta, th = cycle.second_disc_phase(case), 0.7
     zp, zc, e, rp = case.pins.count, case.cycloid.teeth, case.cycloid.eccentricity, case.pins.circle_radius
     ang = 2 * np.pi * np.arange(zp) / zp + th * (zp - zc) / zp
     seen_by_b = rp * np.stack([np.cos(ang), np.sin(ang)], 1) - e * np.array([math.cos(th + math.pi), math.sin(th + math.pi)])
-    turned = pin_centres(case, th + math.pi - beta) @ reducer._rotation(beta).T
+    turned = pin_centres(case, th + math.pi - beta) @ cycle._rotation(beta).T
     dist = np.linalg.norm(seen_by_b[:, None] - turned[None], axis=2).min(axis=1)
     assert dist.max() < 1e-12
 
@@ -120,7 +120,7 @@ def fan_system(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def fan_pair_cycle(fan_system):
-    stage = reducer.build_stage(fan_system, discs=2, influence=None)
+    stage = cycle.build_stage(fan_system, discs=2, influence=None)
     return stage, cycle.load_cycle(fan_system, THETA, saved_angles_deg=(), stage=stage)
 
 
@@ -149,14 +149,14 @@ def test_mirrored_pairs_equal_direct_pair_solves(fan_system):
     """The second half of the cycle comes from disc B of the first half's pairs; solving those
     angles directly gives the same state to the solver's tolerance."""
     system = cycle.build_system(fan_system.case, fan_system.mesh, bearing_model="rigid_bore")
-    stage = reducer.build_stage(system, discs=2, influence=None)
+    stage = cycle.build_stage(system, discs=2, influence=None)
     result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=stage)
     assert result.timings["pair_solves"] == len(THETA) // 6    # 180° swaps and 120° turns: 60° solved
     # the solver stops when the spring laws hold to 1e-8·T/r (≈ 6e-5 N here): two independent
     # solves of one state agree to that, not to round-off
-    atol = 1e-8 * stage.torque_Nmm / float(np.abs(system.interface.points).max())
+    atol = 1e-8 * stage.carrier_torque_Nmm(cycle.OperatingPoint.of(system.case)) / float(np.abs(system.interface.points).max())
     for j in (20, 27, 35):
-        direct = reducer.solve_pair(stage, float(THETA[j]))
+        direct = cycle.solve_pair(stage, float(THETA[j]))
         assert np.allclose(direct.bearing_forces[0], result.bearing_forces[j], rtol=0, atol=atol)
         assert np.allclose(direct.bearing_forces[1], result.disc_bearing_forces[j, 1], rtol=0, atol=atol)
         assert direct.torque_Nmm[0] == pytest.approx(result.disc_torque_Nmm[j, 0], rel=1e-9)
@@ -167,7 +167,7 @@ def test_mirrored_and_turned_pairs_with_rollers_equal_direct_pair_solves(fan_pai
     """Exact with rollers too: their cages take one revolution's phases (rvfem.models.roller_angles)."""
     stage, result = fan_pair_cycle
     for j in (20, 35):
-        direct = reducer.solve_pair(stage, float(THETA[j]))
+        direct = cycle.solve_pair(stage, float(THETA[j]))
         assert np.abs(direct.bearing_forces[0] - result.bearing_forces[j]).max() < 1e-8 * result.bearing_loads.max()
 
 
@@ -188,7 +188,7 @@ def test_two_discs_lower_the_fan_hole_peak_against_one_disc_with_half_the_torque
     maximum bearing load falls (an independent full-system solver: +20.3 % → +13.8 % over the
     handbook on the default mesh)."""
     _, pair = fan_pair_cycle
-    one = cycle.load_cycle(fan_system, THETA, saved_angles_deg=(), stage=None)
+    one = cycle.load_cycle(fan_system, THETA, saved_angles_deg=(), stage=cycle.single_disc_stage(fan_system))
     hb = rigid.handbook_bearing_loads(fan_system.case, THETA).magnitude.max()
     assert pair.bearing_loads.max() < one.bearing_loads.max()
     assert 0.08 < pair.bearing_loads.max() / hb - 1 < 0.20
@@ -202,7 +202,7 @@ def test_stiff_discs_share_the_torque_equally_and_give_the_handbook_loads(tmp_pa
     system = cycle.build_system(case, mesh_case(case, tmp_path_factory.mktemp("meshes")),
                                 stiffness_scale=1e6, bearing_model="rigid_bore",
                                 bearing_stiffness_scale=1e3, pin_model="linear", pin_stiffness_N_per_mm=3e5)
-    stage = reducer.build_stage(system, discs=2, influence=None)
+    stage = cycle.build_stage(system, discs=2, influence=None)
     result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=stage)
     T = case.loads.torque_Nm * 1000.0
     share = result.disc_torque_Nmm / (T / 2)
@@ -215,7 +215,7 @@ def test_stiff_discs_share_the_torque_equally_and_give_the_handbook_loads(tmp_pa
 def test_very_stiff_crankshafts_give_the_rigid_support_result(fan_system, fan_pair_cycle):
     _, rigid_support = fan_pair_cycle
     f = 1e-14 * np.array([[2.0, 1.0], [1.0, 2.0]])     # mm/N: 10¹⁴ N/mm
-    stage = reducer.build_stage(fan_system, discs=2, influence=f)
+    stage = cycle.build_stage(fan_system, discs=2, influence=f)
     result = cycle.load_cycle(fan_system, THETA[:6], saved_angles_deg=(), stage=stage)
     ref = rigid_support.bearing_forces[:6]
     assert np.abs(result.bearing_forces - ref).max() <= 1e-6 * np.abs(ref).max()
@@ -225,12 +225,12 @@ def test_very_stiff_crankshafts_give_the_rigid_support_result(fan_system, fan_pa
 def test_crankshaft_deflection_follows_the_influence_matrix(fan_system):
     """The reported eccentric displacements are −f·F of the forces on both discs, and a softer
     crank support moves the eccentrics more."""
-    f = reducer.beam_influence(40.0, [15.0, 25.0], 2e9, 3e7, (2e-6, 2e-6))
-    stage = reducer.build_stage(fan_system, discs=2, influence=f)
-    pair = reducer.solve_pair(stage, 0.3)
+    f = crankshaft.beam_influence(40.0, [15.0, 25.0], 2e9, 3e7, (2e-6, 2e-6))
+    stage = cycle.build_stage(fan_system, discs=2, influence=f)
+    pair = cycle.solve_pair(stage, 0.3)
     w = -np.einsum("kl,lnj->knj", f, pair.bearing_forces)
     assert np.allclose(pair.eccentric_displacement, w, rtol=1e-12)
-    softer = reducer.solve_pair(reducer.build_stage(fan_system, discs=2, influence=2 * f), 0.3)
+    softer = cycle.solve_pair(cycle.build_stage(fan_system, discs=2, influence=2 * f), 0.3)
     assert np.abs(softer.eccentric_displacement).max() > 1.5 * np.abs(pair.eccentric_displacement).max()
     assert softer.torque_Nmm.sum() == pytest.approx(fan_system.case.loads.torque_Nm * 1000.0, rel=1e-12)
 
@@ -244,11 +244,11 @@ def test_pin_friction_converges_on_two_discs_with_rigid_bores_and_keeps_each_dis
     mu = 0.05
     case = coarse("rv40e_solid", analysis={"friction": mu}, crank_bearing={"model": "rigid_bore"})
     system = cycle.build_system(case, mesh_case(case, tmp_path_factory.mktemp("meshes")))
-    stage = reducer.build_stage(system)
+    stage = cycle.case_stage(system)
     assert stage.discs == 2 and stage.influence is not None
     T = case.loads.torque_Nm * 1000.0
     for theta in (-0.02, 0.0, 0.02):
-        pair = reducer.solve_pair(stage, theta)
+        pair = cycle.solve_pair(stage, theta)
         assert pair.torque_Nmm.sum() == pytest.approx(T, rel=1e-12)
         for r in pair.results:
             res = r.solution.residual
@@ -275,8 +275,8 @@ def test_pin_friction_converges_with_clearance_all_round_and_stiff_bores(tmp_pat
     data["cycloid"]["modification"]["equidistant"] = 0.005
     case = case_from_dict(data, source="clearance all round")
     system = cycle.build_system(case, mesh_case(case, tmp_path_factory.mktemp("meshes")))
-    stage = reducer.build_stage(system, discs=2, influence=None)
-    pair = reducer.solve_pair(stage, 0.0)
+    stage = cycle.build_stage(system, discs=2, influence=None)
+    pair = cycle.solve_pair(stage, 0.0)
     assert pair.torque_Nmm.sum() == pytest.approx(case.loads.torque_Nm * 1000.0, rel=1e-12)
     for r in pair.results:
         assert r.solution.iterations <= 8                    # measured 3
