@@ -8,8 +8,9 @@ with :func:`param`::
 The field's type annotation gives the TOML type (``int``, ``float``, ``str``, ``bool``, a list of
 numbers ``tuple[float, ...]``, a matrix ``tuple[tuple[float, ...], ...]``, a number or a list
 ``float | tuple[float, ...]``, a sub-table (another dataclass), an optional sub-table
-``Dataclass | None``, an array of tables ``tuple[Dataclass, ...]``); ``X | None`` makes a key
-optional with the default None. The metadata gives the unit, the bounds, the choices, the
+``Dataclass | None``, an array of tables ``tuple[Dataclass, ...]``, or ``Any``: any TOML value,
+passed on unchecked for the caller to interpret); ``X | None`` makes a key optional with the
+default None. The metadata gives the unit, the bounds, the choices, the
 documentation and, for a default that depends on other keys, the function that computes it.
 
 From these declarations
@@ -125,7 +126,8 @@ class FieldSpec:
     """One key of a table: the dataclass field, its declaration and its kind.
 
     ``kind`` is one of ``"int"``, ``"float"``, ``"str"``, ``"bool"``, ``"floats"``, ``"matrix"``,
-    ``"float_or_floats"``, ``"table"``, ``"tables"``; ``item`` is the dataclass of a table kind.
+    ``"float_or_floats"``, ``"table"``, ``"tables"``, ``"any"`` (any TOML value, unchecked);
+    ``item`` is the dataclass of a table kind.
     """
 
     name: str
@@ -164,6 +166,8 @@ def _kind(hint: Any) -> tuple[str, bool, type | None]:
         hint, args = rest[0], typing.get_args(rest[0])
     if hint in (int, float, str, bool):
         return hint.__name__, optional, None
+    if hint is Any:
+        return "any", optional, None
     if dataclasses.is_dataclass(hint):
         return "table", optional, hint
     if typing.get_origin(hint) is tuple and len(args) == 2 and args[1] is Ellipsis:
@@ -310,6 +314,8 @@ def check_value(spec: FieldSpec, value: Any, key: str, fail: Callable[[str, str]
     p, kind = spec.param, spec.kind
     if value is None and spec.optional:
         return None
+    if kind == "any":
+        return value
     if kind == "bool":
         if not isinstance(value, bool):
             raise fail(key, f"must be true or false, got {_short(value)}")
@@ -359,7 +365,7 @@ def _dotted(prefix: str, name: str) -> str:
 
 
 def read_table(cls: type, data: Any, prefix: str, source: str, values: dict[str, Any] | None = None,
-               extra: Mapping[str, Any] | None = None) -> Any:
+               extra: Mapping[str, Any] | None = None, *, explain: bool = False) -> Any:
     """Read the table ``data`` (parsed TOML) at dotted key ``prefix`` into dataclass ``cls``.
 
     Order of the checks: the value is a table; no unknown key (the closest known key is
@@ -379,6 +385,9 @@ def read_table(cls: type, data: Any, prefix: str, source: str, values: dict[str,
         Values read so far by dotted key (for defaults computed from other keys); filled in.
     extra : mapping or None
         Further constructor arguments (fields that are not keys of the file).
+    explain : bool
+        Longer messages for small tables (a study file's): an unknown key lists the known keys
+        (instead of "remove it or check the spelling") and a missing key gives its ``doc``.
 
     Raises
     ------
@@ -399,23 +408,26 @@ def read_table(cls: type, data: Any, prefix: str, source: str, values: dict[str,
             hint = closest(name, names)
             raise fail(_dotted(prefix, name), "is not a known key"
                        + (f" (did you mean '{_dotted(prefix, hint)}'?)" if hint else "")
-                       + "; remove it or check the spelling")
+                       + (f"; known keys: {', '.join(names)}" if explain else "; remove it or check the spelling"))
     kwargs: dict[str, Any] = {}
     for spec in specs:
         key = _dotted(prefix, spec.name)
         if spec.name not in data:
             if spec.required:
-                raise fail(key, "is missing (required table)" if spec.kind == "table" else "is missing (required)")
+                what = "required table" if spec.kind == "table" else "required"
+                raise fail(key, f"is missing ({what}: {spec.param.doc})" if explain and spec.param.doc
+                           else f"is missing ({what})")
             value = spec.default(values)
         elif spec.kind == "table":
-            value = read_table(spec.item, data[spec.name], key, source, values)
+            value = read_table(spec.item, data[spec.name], key, source, values, explain=explain)
         elif spec.kind == "tables":
             rows = data[spec.name]
             if not isinstance(rows, list):
                 raise fail(key, f"must be an array of tables ([[{key}]])")
             if spec.param.max_length is not None and len(rows) > spec.param.max_length:
                 raise fail(key, f"must have at most {spec.param.max_length} rows, got {len(rows)}")
-            value = tuple(read_table(spec.item, row, f"{key}[{i}]", source, values) for i, row in enumerate(rows))
+            value = tuple(read_table(spec.item, row, f"{key}[{i}]", source, values, explain=explain)
+                          for i, row in enumerate(rows))
         else:
             value = check_value(spec, data[spec.name], key, fail)
         kwargs[spec.name] = value
@@ -466,7 +478,7 @@ def check_fields(obj: Any, prefix: str, source: str) -> None:
 
 _TYPE_TEXT = {
     "int": "integer", "float": "number", "str": "string", "bool": "boolean", "floats": "list of numbers",
-    "matrix": "list of lists of numbers", "float_or_floats": "number or list of numbers",
+    "matrix": "list of lists of numbers", "float_or_floats": "number or list of numbers", "any": "any value",
 }
 
 

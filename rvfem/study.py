@@ -78,6 +78,7 @@ from typing import Any, Callable, Sequence
 
 from .case import case_to_dict, load_case, parse_override
 from .errors import CaseError, OutputError, RvfemError
+from .schema import param, read_table
 
 log = logging.getLogger(__name__)
 
@@ -273,21 +274,48 @@ def _check_value(where: str, value: Any) -> None:
         raise CaseError(f"{where}: expected a number, string, boolean or array, got a table")
 
 
-def _read_table(where: str, table: Any, allowed: dict[str, str], required: tuple[str, ...]) -> dict:
-    """Check one TOML table: known keys only (with a hint), required keys present."""
-    if not isinstance(table, dict):
-        raise CaseError(f"{where}: expected a table")
-    for key in table:
-        if key not in allowed:
-            import difflib
+# The tables of a study file, declared for :func:`rvfem.schema.read_table` (which checks unknown
+# and missing keys and the types; what a value means is checked below).
 
-            hint = difflib.get_close_matches(key, list(allowed), n=1)
-            raise CaseError(f"{where}.{key}: unknown key" + (f" (did you mean '{hint[0]}'?)" if hint else "")
-                            + f"; known keys: {', '.join(allowed)}")
-    for key in required:
-        if key not in table:
-            raise CaseError(f"{where}.{key}: missing ({allowed[key]})")
-    return table
+
+@dataclass(frozen=True, kw_only=True)
+class _StudyTable:
+    """The top level of a study file."""
+
+    name: str | None = param(None, doc="study name")
+    description: str = param("", doc="text")
+    base_case: str = param(doc="path of the base case file, relative to the study file")
+    kind: str = param(choices=STUDY_KINDS, doc=f"one of {', '.join(STUDY_KINDS)}")
+    overrides: Any = param(None, doc="table of dotted case keys")
+    parameter: Any = param((), doc="array of tables [[parameter]]")
+    variant: Any = param((), doc="array of tables [[variant]]")
+
+
+@dataclass(frozen=True, kw_only=True)
+class _GridParameterTable:
+    """A ``[[parameter]]`` table of a grid study."""
+
+    key: str = param(doc="dotted case key")
+    values: Any = param(doc="array of values")
+    label: str | None = param(None, doc="text for plots")
+
+
+@dataclass(frozen=True, kw_only=True)
+class _SensitivityParameterTable:
+    """A ``[[parameter]]`` table of a sensitivity study."""
+
+    key: str = param(doc="dotted case key")
+    low: Any = param(doc="low value")
+    high: Any = param(doc="high value")
+    label: str | None = param(None, doc="text for plots")
+
+
+@dataclass(frozen=True, kw_only=True)
+class _VariantTable:
+    """A ``[[variant]]`` table of a list study."""
+
+    id: str | None = param(None, doc="folder name of the variant")
+    set: Any = param(doc="table of dotted case keys")
 
 
 def _overrides_table(where: str, table: Any) -> tuple[tuple[str, Any], ...]:
@@ -309,6 +337,170 @@ def _validated_case(base_case: Path, overrides: tuple[str, ...], where: str):
         return load_case(base_case, overrides)
     except CaseError as exc:
         raise CaseError(f"{where}: {exc}") from None
+
+
+@dataclass(frozen=True)
+class _StudyHeader:
+    """The top level of a study file, checked.
+
+    ``overrides`` are the study's then the extra ones (``--set``); ``raw_parameters`` and
+    ``raw_variants`` are the ``[[parameter]]`` and ``[[variant]]`` arrays as parsed.
+    """
+
+    path: Path
+    name: str
+    description: str
+    kind: str
+    base_case: Path
+    overrides: tuple[str, ...]
+    raw_parameters: Any
+    raw_variants: Any
+
+    @property
+    def where(self) -> str:
+        """Where the messages point: the study file as given."""
+        return f"{self.path}"
+
+    def read_table(self, cls: type, data: Any, prefix: str):
+        """One table of this study file read through :func:`rvfem.schema.read_table`."""
+        return read_table(cls, data, prefix, str(self.path), explain=True)
+
+
+@dataclass(frozen=True)
+class _VariantSpec:
+    """A variant before its case is checked: its role, its settings and the id the file gives."""
+
+    role: str
+    settings: tuple[tuple[str, Any], ...]
+    id: str | None = None
+
+
+@dataclass(frozen=True)
+class _StudyPlan:
+    """What a study varies: its parameters and the variants beside the base, in order."""
+
+    parameters: tuple[Parameter, ...]
+    specs: tuple[_VariantSpec, ...]
+
+
+def _parse_study_file(path: Path) -> dict:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise CaseError(f"{path}: cannot read the study file ({exc.strerror or exc})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CaseError(f"{path}: not a valid TOML file ({exc})") from None
+
+
+def _read_header(path: Path, extra_overrides: Sequence[str]) -> _StudyHeader:
+    """The top level of the study file: name, description, kind, base case and overrides."""
+    top = read_table(_StudyTable, _parse_study_file(path), "", str(path), explain=True)
+    where = f"{path}"
+    name = path.stem if top.name is None else top.name
+    if not name.strip() or _SAFE.search(name):
+        raise CaseError(f"{where}: name: expected a non-empty name of letters, digits and ._=,+-, got {name!r}")
+    base_case = (path.parent / top.base_case).resolve()
+    if not base_case.is_file():
+        raise CaseError(f"{where}: base_case: no case file {top.base_case!r} next to the study file "
+                        f"({base_case} does not exist)")
+    overrides = {} if top.overrides is None else top.overrides
+    study_overrides = tuple(f"{k}={toml_literal(v)}" for k, v in _overrides_table(f"{where}: overrides", overrides))
+    for text in extra_overrides:
+        parse_override(text)  # its own one-line error
+    return _StudyHeader(path=path, name=name, description=top.description, kind=top.kind, base_case=base_case,
+                        overrides=study_overrides + tuple(extra_overrides), raw_parameters=top.parameter,
+                        raw_variants=top.variant)
+
+
+def _read_parameter(head: _StudyHeader, i: int, raw: Any, earlier: Sequence[Parameter],
+                    base_data: dict) -> Parameter:
+    """The ``i``-th ``[[parameter]]`` table (from 1) of a grid or sensitivity study, each of its
+    values checked on the base case."""
+    pw = f"{head.where}: parameter[{i}]"
+    table = _GridParameterTable if head.kind == "grid" else _SensitivityParameterTable
+    row = head.read_table(table, raw, f"parameter[{i}]")
+    key = row.key
+    if not key:
+        raise CaseError(f"{pw}.key: expected a dotted case key such as \"fan_holes.ligament\"")
+    if any(p.key == key for p in earlier):
+        raise CaseError(f"{pw}.key: {key!r} is varied twice")
+    if head.kind == "grid":
+        values = row.values
+        if not isinstance(values, list) or not values:
+            raise CaseError(f"{pw}.values: expected a non-empty array")
+        if len(set(map(repr, values))) != len(values):
+            raise CaseError(f"{pw}.values: a value appears twice")
+    else:
+        values = [row.low, row.high]
+    for v in values:
+        _check_value(f"{pw} ({key})", v)
+    for v in values:  # each value on its own: the error names the parameter and the key
+        _validated_case(head.base_case, head.overrides + (f"{key}={toml_literal(v)}",), f"{pw} (key {key})")
+    return Parameter(key, tuple(values), _lookup(base_data, key), key if row.label is None else row.label)
+
+
+def _parameter_plan(head: _StudyHeader, base_data: dict) -> _StudyPlan:
+    """The variants of a grid study (every combination) or of a sensitivity study (one parameter
+    at a time to its low and its high value)."""
+    where, kind = head.where, head.kind
+    if head.raw_variants:
+        raise CaseError(f"{where}: variant: only a study of kind 'list' has [[variant]] tables")
+    if not head.raw_parameters:
+        raise CaseError(f"{where}: parameter: a {kind} study needs at least one [[parameter]] table")
+    parameters: list[Parameter] = []
+    for i, raw in enumerate(head.raw_parameters, start=1):
+        parameters.append(_read_parameter(head, i, raw, parameters, base_data))
+    if kind == "grid":
+        specs = tuple(_VariantSpec("grid", tuple((p.key, v) for p, v in zip(parameters, combo)))
+                      for combo in itertools.product(*(p.values for p in parameters)))
+    else:  # a side equal to the base value is the base itself: not run twice
+        specs = tuple(_VariantSpec(role, ((p.key, value),)) for p in parameters
+                      for role, value in zip(("low", "high"), p.values) if value != p.base_value)
+    return _StudyPlan(tuple(parameters), specs)
+
+
+def _read_list_variant(head: _StudyHeader, i: int, raw: Any) -> _VariantSpec:
+    """The ``i``-th ``[[variant]]`` table (from 1) of a list study."""
+    vw = f"{head.where}: variant[{i}]"
+    row = head.read_table(_VariantTable, raw, f"variant[{i}]")
+    settings = _overrides_table(f"{vw}.set", row.set)
+    if not settings:
+        raise CaseError(f"{vw}.set: empty (the base case is always run as variant 'base')")
+    if row.id is not None and not _ID_PATTERN.match(row.id):
+        raise CaseError(f"{vw}.id: expected letters, digits and ._=,+- (a folder name), got {row.id!r}")
+    return _VariantSpec("list", settings, row.id)
+
+
+def _list_plan(head: _StudyHeader, base_data: dict) -> _StudyPlan:
+    """The variants of a list study; its parameters are the keys the variants set."""
+    where = head.where
+    if head.raw_parameters:
+        raise CaseError(f"{where}: parameter: a study of kind 'list' names its variants in [[variant]] tables")
+    if not head.raw_variants:
+        raise CaseError(f"{where}: variant: a list study needs at least one [[variant]] table")
+    specs = tuple(_read_list_variant(head, i, raw) for i, raw in enumerate(head.raw_variants, start=1))
+    keys: dict[str, list] = {}
+    for spec in specs:
+        for key, value in spec.settings:
+            keys.setdefault(key, []).append(value)
+    parameters = tuple(Parameter(k, tuple(v), _lookup(base_data, k), k) for k, v in keys.items())
+    return _StudyPlan(parameters, specs)
+
+
+def _variants(head: _StudyHeader, base_digest: str, plan: _StudyPlan) -> tuple[Variant, ...]:
+    """The base and the variants of ``plan`` with their ids, each variant's case checked."""
+    variants = [Variant("base", "base", (), head.overrides, base_digest)]
+    ids = {"base": "the base case"}
+    for n, spec in enumerate(plan.specs, start=1):
+        vid = spec.id or _variant_id(spec.settings)
+        vw = f"{head.where}: variant {vid!r}"
+        if vid in ids:
+            raise CaseError(f"{vw}: two variants have this id (the other: {ids[vid]}); give distinct values or ids")
+        ids[vid] = f"variant {n}"
+        own = tuple(f"{k}={toml_literal(v)}" for k, v in spec.settings)
+        case = _validated_case(head.base_case, head.overrides + own, vw)
+        variants.append(Variant(vid, spec.role, spec.settings, head.overrides + own, case.digest()))
+    return tuple(variants)
 
 
 def load_study(path: str | os.PathLike, extra_overrides: Sequence[str] = ()) -> Study:
@@ -333,129 +525,15 @@ def load_study(path: str | os.PathLike, extra_overrides: Sequence[str] = ()) -> 
         variants with the same id.
     """
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise CaseError(f"{path}: cannot read the study file ({exc.strerror or exc})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise CaseError(f"{path}: not a valid TOML file ({exc})") from None
-    top = _read_table(f"{path}: study", data, {
-        "name": "study name", "description": "text", "base_case": "path of the base case file, relative to the study file",
-        "kind": f"one of {', '.join(STUDY_KINDS)}", "overrides": "table of dotted case keys",
-        "parameter": "array of tables [[parameter]]", "variant": "array of tables [[variant]]",
-    }, ("base_case", "kind"))
-    where = f"{path}"
-    name = top.get("name", path.stem)
-    if not isinstance(name, str) or not name.strip() or _SAFE.search(name):
-        raise CaseError(f"{where}: name: expected a non-empty name of letters, digits and ._=,+-, got {name!r}")
-    description = top.get("description", "")
-    if not isinstance(description, str):
-        raise CaseError(f"{where}: description: expected a string")
-    kind = top["kind"]
-    if kind not in STUDY_KINDS:
-        raise CaseError(f"{where}: kind: expected one of {', '.join(repr(k) for k in STUDY_KINDS)}, got {kind!r}")
-    if not isinstance(top["base_case"], str):
-        raise CaseError(f"{where}: base_case: expected the path of a case file (a string)")
-    base_case = (path.parent / top["base_case"]).resolve()
-    if not base_case.is_file():
-        raise CaseError(f"{where}: base_case: no case file {top['base_case']!r} next to the study file "
-                        f"({base_case} does not exist)")
-    study_overrides = tuple(f"{k}={toml_literal(v)}" for k, v in _overrides_table(f"{where}: overrides",
-                                                                                     top.get("overrides", {})))
-    for text in extra_overrides:
-        parse_override(text)  # its own one-line error
-    overrides = study_overrides + tuple(extra_overrides)
-    base = _validated_case(base_case, overrides, f"{where}: overrides")
+    head = _read_header(path, extra_overrides)
+    base = _validated_case(head.base_case, head.overrides, f"{head.where}: overrides")
+    if not isinstance(head.raw_parameters, (list, tuple)) or not isinstance(head.raw_variants, (list, tuple)):
+        raise CaseError(f"{head.where}: parameter and variant must be arrays of tables ([[parameter]], [[variant]])")
     base_data = case_to_dict(base)
-
-    raw_parameters = top.get("parameter", [])
-    raw_variants = top.get("variant", [])
-    if not isinstance(raw_parameters, list) or not isinstance(raw_variants, list):
-        raise CaseError(f"{where}: parameter and variant must be arrays of tables ([[parameter]], [[variant]])")
-
-    parameters: list[Parameter] = []
-    specs: list[tuple[str, tuple[tuple[str, Any], ...]]] = []  # (role, settings) per variant
-    names: list[str | None] = []
-    if kind in ("grid", "sensitivity"):
-        if raw_variants:
-            raise CaseError(f"{where}: variant: only a study of kind 'list' has [[variant]] tables")
-        if not raw_parameters:
-            raise CaseError(f"{where}: parameter: a {kind} study needs at least one [[parameter]] table")
-        fields = ({"key": "dotted case key", "values": "array of values", "label": "text for plots"}
-                  if kind == "grid" else
-                  {"key": "dotted case key", "low": "low value", "high": "high value", "label": "text for plots"})
-        required = ("key", "values") if kind == "grid" else ("key", "low", "high")
-        seen: set[str] = set()
-        for i, raw in enumerate(raw_parameters, start=1):
-            pw = f"{where}: parameter[{i}]"
-            raw = _read_table(pw, raw, fields, required)
-            key = raw["key"]
-            if not isinstance(key, str) or not key:
-                raise CaseError(f"{pw}.key: expected a dotted case key such as \"fan_holes.ligament\"")
-            if key in seen:
-                raise CaseError(f"{pw}.key: {key!r} is varied twice")
-            seen.add(key)
-            if kind == "grid":
-                values = raw["values"]
-                if not isinstance(values, list) or not values:
-                    raise CaseError(f"{pw}.values: expected a non-empty array")
-                if len(set(map(repr, values))) != len(values):
-                    raise CaseError(f"{pw}.values: a value appears twice")
-            else:
-                values = [raw["low"], raw["high"]]
-            for v in values:
-                _check_value(f"{pw} ({key})", v)
-            label = raw.get("label", key)
-            if not isinstance(label, str):
-                raise CaseError(f"{pw}.label: expected a string")
-            for v in values:  # each value on its own: the error names the parameter and the key
-                _validated_case(base_case, overrides + (f"{key}={toml_literal(v)}",), f"{pw} (key {key})")
-            parameters.append(Parameter(key, tuple(values), _lookup(base_data, key), label))
-        if kind == "grid":
-            for combo in itertools.product(*(p.values for p in parameters)):
-                specs.append(("grid", tuple((p.key, v) for p, v in zip(parameters, combo))))
-                names.append(None)
-        else:
-            for p in parameters:  # a side equal to the base value is the base itself: not run twice
-                for role, value in zip(("low", "high"), p.values):
-                    if value != p.base_value:
-                        specs.append((role, ((p.key, value),)))
-                        names.append(None)
-    else:
-        if raw_parameters:
-            raise CaseError(f"{where}: parameter: a study of kind 'list' names its variants in [[variant]] tables")
-        if not raw_variants:
-            raise CaseError(f"{where}: variant: a list study needs at least one [[variant]] table")
-        keys: dict[str, list] = {}
-        for i, raw in enumerate(raw_variants, start=1):
-            vw = f"{where}: variant[{i}]"
-            raw = _read_table(vw, raw, {"id": "folder name of the variant", "set": "table of dotted case keys"},
-                              ("set",))
-            settings = _overrides_table(f"{vw}.set", raw["set"])
-            if not settings:
-                raise CaseError(f"{vw}.set: empty (the base case is always run as variant 'base')")
-            vid = raw.get("id")
-            if vid is not None and (not isinstance(vid, str) or not _ID_PATTERN.match(vid)):
-                raise CaseError(f"{vw}.id: expected letters, digits and ._=,+- (a folder name), got {vid!r}")
-            for key, value in settings:
-                keys.setdefault(key, []).append(value)
-            specs.append(("list", settings))
-            names.append(vid)
-        parameters = [Parameter(k, tuple(v), _lookup(base_data, k), k) for k, v in keys.items()]
-
-    variants = [Variant("base", "base", (), overrides, base.digest())]
-    ids = {"base": "the base case"}
-    for n, ((role, settings), vid) in enumerate(zip(specs, names), start=1):
-        vid = vid or _variant_id(settings)
-        vw = f"{where}: variant {vid!r}"
-        if vid in ids:
-            raise CaseError(f"{vw}: two variants have this id (the other: {ids[vid]}); give distinct values or ids")
-        ids[vid] = f"variant {n}"
-        own = tuple(f"{k}={toml_literal(v)}" for k, v in settings)
-        case = _validated_case(base_case, overrides + own, vw)
-        variants.append(Variant(vid, role, settings, overrides + own, case.digest()))
-    return Study(name=name, description=description, path=path.resolve(), base_case=base_case,
-                 overrides=overrides, kind=kind, parameters=tuple(parameters), variants=tuple(variants))
+    plan = _list_plan(head, base_data) if head.kind == "list" else _parameter_plan(head, base_data)
+    return Study(name=head.name, description=head.description, path=path.resolve(), base_case=head.base_case,
+                 overrides=head.overrides, kind=head.kind, parameters=plan.parameters,
+                 variants=_variants(head, base.digest(), plan))
 
 
 # --------------------------------------------------------------------------------------------

@@ -305,11 +305,11 @@ def test_a_second_study_into_the_same_folder_is_refused(tmp_path):
      r"parameter\[1\] \(key fan_holes\.ligamnt\)|'fan_holes\.ligamnt' is not a known key \(did you mean 'fan_holes\.ligament'\?\)"),
     ('[[parameter]]\nkey = "fan_holes.ligament"\nvalues = [-1.0]', r"fan_holes\.ligament"),
     ('[[parameter]]\nkey = "crank_bearing.model"\nvalues = ["rollers", "ball"]', r"crank_bearing\.model"),
-    ('[[parameter]]\nkey = "fan_holes.ligament"\nlow = 3.5\nhigh = 5.5', r"parameter\[1\]\.low: unknown key"),
-    ('[[parameter]]\nkey = "fan_holes.ligament"', r"parameter\[1\]\.values: missing"),
+    ('[[parameter]]\nkey = "fan_holes.ligament"\nlow = 3.5\nhigh = 5.5', r"'parameter\[1\]\.low' is not a known key; known keys: key, values, label"),
+    ('[[parameter]]\nkey = "fan_holes.ligament"', r"'parameter\[1\]\.values' is missing \(required: array of values\)"),
     ('[[parameter]]\nkey = "fan_holes.ligament"\nvalues = [3.5, 3.5]', r"parameter\[1\]\.values: a value appears twice"),
     ('[[variant]]\nset = { "fan_holes.ligament" = 4.0 }', r"variant: only a study of kind 'list'"),
-    ('[[parametre]]\nkey = "x"', r"study\.parametre: unknown key \(did you mean 'parameter'\?\)"),
+    ('[[parametre]]\nkey = "x"', r"'parametre' is not a known key \(did you mean 'parameter'\?\); known keys: name, "),
 ])
 def test_study_file_errors_name_the_key(tmp_path, body, message):
     path = _write(tmp_path / "bad.toml", _study_text("grid", body))
@@ -323,12 +323,34 @@ def test_study_file_errors_on_the_top_level(tmp_path):
     with pytest.raises(CaseError, match=r"base_case: no case file 'nowhere.toml'"):
         load_study(path)
     path = _write(tmp_path / "bad.toml", f'base_case = "{BASE_CASE.as_posix()}"\nkind = "tornado"\n')
-    with pytest.raises(CaseError, match=r"kind: expected one of 'grid', 'sensitivity', 'list', got 'tornado'"):
+    with pytest.raises(CaseError, match=r"'kind' must be one of 'grid', 'sensitivity', 'list', got 'tornado'"):
         load_study(path)
     path = _write(tmp_path / "bad.toml", f'base_case = "{BASE_CASE.as_posix()}"\n')
-    with pytest.raises(CaseError, match=r"study\.kind: missing"):
+    with pytest.raises(CaseError, match=r"'kind' is missing \(required: one of grid, sensitivity, list\)"):
         load_study(path)
 
+
+
+@pytest.mark.parametrize("top, body, message", [
+    ('kind = "gird"', "", r"'kind' must be one of 'grid', 'sensitivity', 'list', got 'gird' \(did you mean 'grid'\?\)"),
+    ('kind = "grid"\ndescription = 3', "", r"'description' must be a string, got 3"),
+    ('kind = "grid"\nname = "a b"', "", r"name: expected a non-empty name of letters, digits and \._=,\+-, got 'a b'"),
+    ('kind = "grid"', "parameter = [3]", r"'parameter\[1\]' must be a table, got int"),
+    ('kind = "grid"', '[[parameter]]\nkey = "fan_holes.ligament"\nvalues = [3.5]\nlabel = 3',
+     r"'parameter\[1\]\.label' must be a string, got 3"),
+    ('kind = "sensitivity"', '[[parameter]]\nkey = "fan_holes.ligament"\nlow = 3.5',
+     r"'parameter\[1\]\.high' is missing \(required: high value\)"),
+    ('kind = "list"', '[[variant]]\nid = "a"', r"'variant\[1\]\.set' is missing \(required: table of dotted case keys\)"),
+    ('kind = "list"', '[[variant]]\nset = { "fan_holes.ligament" = 4.0 }\nname = "x"',
+     r"'variant\[1\]\.name' is not a known key; known keys: id, set"),
+])
+def test_study_file_tables_are_read_by_the_schema(tmp_path, top, body, message):
+    """The study file's tables go through rvfem.schema.read_table: types, choices (with a "did you
+    mean"), unknown keys with the known ones, missing keys with their meaning."""
+    path = _write(tmp_path / "bad.toml", f'base_case = "{BASE_CASE.as_posix()}"\n{top}\n{body}\n')
+    with pytest.raises(CaseError, match=message) as info:
+        load_study(path)
+    assert "\n" not in str(info.value) and str(info.value).startswith(f"{path}: ")
 
 def test_set_errors_name_the_key(tmp_path, monkeypatch, capsys):
     path = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
