@@ -11,16 +11,16 @@ screen present them (docs/outputs.md, "Warnings").
 
 The limits, one constant each (sources in the docstrings and in docs/outputs.md):
 
-======================  =======================================================  ==============
+======================  =======================================================  ================
 code                    warns when                                               limit
-======================  =======================================================  ==============
+======================  =======================================================  ================
 ``load_ratio``          P/C = F_m/C of a bearing is above                        0.5
 ``life_under_1h``       a bearing life (L10h, duty-cycle service life) is under  1 h
-``hertz_pressure``      a roller–raceway Hertz peak pressure is above            4000 MPa
+``hertz_pressure``      a roller–raceway Hertz peak pressure is above            4000 MPa (steel)
 ``disc_stress_yield``   the disc's structural stress peak (von Mises) is above   1600 MPa
 ``large_displacement``  the largest disc deformation is above, of the element    10 %
                         size at the contacts
-======================  =======================================================  ==============
+======================  =======================================================  ================
 """
 
 from __future__ import annotations
@@ -35,6 +35,9 @@ __all__ = [
     "LOAD_RATIO_LIMIT",
     "MIN_LIFE_H",
     "HERTZ_PRESSURE_LIMIT_MPA",
+    "BEARING_STEEL_MODULUS_MPA",
+    "BEARING_STEEL_POISSONS_RATIO",
+    "hertz_pressure_limit_MPa",
     "PLACEHOLDER_YIELD_STRENGTH_MPA",
     "DISPLACEMENT_FRACTION_LIMIT",
     "ResultWarning",
@@ -61,6 +64,31 @@ ISO 76:2006, 3.1, defines the basic static load rating of radial roller bearings
 gives 4000 MPa at the centre of the most heavily loaded contact, where the total permanent
 deformation of roller and raceway is about 1/10 000 of the roller diameter. Above it the
 raceways deform plastically: Hertz's elastic theory and the rating life no longer hold."""
+
+BEARING_STEEL_MODULUS_MPA = 206000.0
+"""Young's modulus of bearing steel, MPa (with :data:`BEARING_STEEL_POISSONS_RATIO`): the material
+of the limit :data:`HERTZ_PRESSURE_LIMIT_MPA`."""
+
+BEARING_STEEL_POISSONS_RATIO = 0.3
+
+
+def hertz_pressure_limit_MPa(youngs_modulus_MPa: float = BEARING_STEEL_MODULUS_MPA,
+                             poissons_ratio: float = BEARING_STEEL_POISSONS_RATIO) -> float:
+    """The limit :data:`HERTZ_PRESSURE_LIMIT_MPA` for Hertz pressures computed with the given
+    material (both bodies of the contact, as :func:`rvfem.hertz.crank_bearing_hertz` has them).
+
+    ISO 76's 4000 MPa is a pressure on bearing steel. A case whose material is not steel (the
+    rigid-disc limit of ``rv40e_classical`` has 6 × steel's modulus, a numerical device) gets
+    pressures scaled by sqrt(E'/E'_steel), E' = E/(1 − ν²), for the same roller load; the limit is
+    scaled the same way, so that the check asks whether the roller load would exceed the static
+    capacity of a steel bearing. For bearing steel it is 4000 MPa.
+    """
+    def reduced(e: float, nu: float) -> float:
+        return e / (1.0 - nu * nu)
+
+    return HERTZ_PRESSURE_LIMIT_MPA * math.sqrt(
+        reduced(youngs_modulus_MPa, poissons_ratio) / reduced(BEARING_STEEL_MODULUS_MPA, BEARING_STEEL_POISSONS_RATIO))
+
 
 PLACEHOLDER_YIELD_STRENGTH_MPA = 1600.0
 """Yield strength of the disc material, MPa: a **placeholder** until the case gives strength data
@@ -125,6 +153,7 @@ def _sig(value: float, digits: int = 3) -> str:
 def check_limits(*, load_ratios: Iterable[tuple[str, float | None]] = (),
                  lives_h: Iterable[tuple[str, float | None]] = (),
                  hertz_MPa: Iterable[tuple[str, float | None]] = (),
+                 hertz_limit_MPa: float = HERTZ_PRESSURE_LIMIT_MPA,
                  disc_stress_MPa: float | None = None,
                  yield_strength_MPa: float = PLACEHOLDER_YIELD_STRENGTH_MPA,
                  deformation_mm: float | None = None,
@@ -139,6 +168,9 @@ def check_limits(*, load_ratios: Iterable[tuple[str, float | None]] = (),
         (where, life in hours): L10h of every bearing and model, duty-cycle service lives.
     hertz_MPa : iterable of (str, float)
         (where, Hertz peak pressure in MPa) of the roller–raceway contacts evaluated.
+    hertz_limit_MPa : float
+        Their limit (default :data:`HERTZ_PRESSURE_LIMIT_MPA`, bearing steel; see
+        :func:`hertz_pressure_limit_MPa` for another material).
     disc_stress_MPa : float, optional
         The disc's structural stress peak (von Mises), MPa.
     yield_strength_MPa : float
@@ -176,12 +208,14 @@ def check_limits(*, load_ratios: Iterable[tuple[str, float | None]] = (),
     pressures = _finite(hertz_MPa)
     if pressures:
         where, value = max(pressures, key=lambda x: x[1])
-        if value > HERTZ_PRESSURE_LIMIT_MPA:
+        if value > hertz_limit_MPa:
+            scaled = ("" if math.isclose(hertz_limit_MPa, HERTZ_PRESSURE_LIMIT_MPA) else
+                      f" ({HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa on bearing steel, scaled to the case's modulus)")
             out.append(ResultWarning(
                 "hertz_pressure",
-                f"Hertz pressure {value:.0f} MPa ({where}) > {HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa, the static limit "
-                "of roller bearings (ISO 76): the raceways deform plastically, elastic Hertz contact does not hold",
-                value, HERTZ_PRESSURE_LIMIT_MPA, "MPa"))
+                f"Hertz pressure {value:.0f} MPa ({where}) > {hertz_limit_MPa:.0f} MPa, the static limit of roller "
+                f"bearings (ISO 76){scaled}: the raceways deform plastically, elastic Hertz contact does not hold",
+                value, float(hertz_limit_MPa), "MPa"))
     if disc_stress_MPa is not None and math.isfinite(disc_stress_MPa) and disc_stress_MPa > yield_strength_MPa:
         source = ("placeholder for through-hardened bearing steel"
                   if yield_strength_MPa == PLACEHOLDER_YIELD_STRENGTH_MPA else "given")
@@ -251,8 +285,9 @@ def analysis_warnings(analysis) -> tuple[ResultWarning, ...]:
     structural = analysis.stress.structural
     snapshots = analysis.stress.snapshots
     deformation = max((float(np.max(np.hypot(*s.deformation.T), initial=0.0)) for s in snapshots), default=None)
-    ms = analysis.case.mesh
+    ms, mat = analysis.case.mesh, analysis.case.material
     return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
+                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio),
                         disc_stress_MPa=None if structural is None else structural.von_mises_MPa,
                         deformation_mm=deformation, element_size_mm=min(ms.size_flank, ms.size_bore))
 
@@ -270,4 +305,6 @@ def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:
                                   b.hertz_outer)
     if rigid_analysis.duty_cycle is not None:
         lives.append(("duty-cycle service life, rigid", rigid_analysis.duty_cycle.service_life_h))
-    return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures)
+    mat = rigid_analysis.case.material
+    return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
+                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio))

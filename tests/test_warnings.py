@@ -17,7 +17,7 @@ from rvfem.case import load_case
 from rvfem.validity import (DISPLACEMENT_FRACTION_LIMIT, HERTZ_PRESSURE_LIMIT_MPA, LOAD_RATIO_LIMIT, MIN_LIFE_H,
                             PLACEHOLDER_YIELD_STRENGTH_MPA, ResultWarning, check_limits)
 
-from conftest import CASES_DIR, CaseText
+from conftest import CASES_DIR, CaseText, coarse_case
 
 CRV80E = str(CASES_DIR / "crv80e.toml")
 SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))
@@ -114,7 +114,8 @@ def _fake_analysis(scale: float):
         hertz={"fe_rollers": SimpleNamespace(inner=contact, outer=contact)},
         stress=SimpleNamespace(structural=SimpleNamespace(von_mises_MPa=107.0 * scale),
                                snapshots=[SimpleNamespace(deformation=np.array([[0.0, 0.008 * scale], [0.0, 0.0]]))]),
-        case=SimpleNamespace(mesh=SimpleNamespace(size_flank=0.35, size_bore=0.4)),
+        case=SimpleNamespace(mesh=SimpleNamespace(size_flank=0.35, size_bore=0.4),
+                             material=SimpleNamespace(youngs_modulus=206000.0, poissons_ratio=0.3)),
     )
 
 
@@ -194,3 +195,39 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
     html = (out / "report.html").read_text(encoding="utf-8")
     assert "class='warnings'" in html and html.count("<li><code>") >= 5
     assert ResultWarning(**summary["warnings"][0]).code == "load_ratio"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", SHIPPED)
+def test_shipped_cases_do_not_warn(name, tmp_path):
+    """Every shipped case, coarse and at 30° steps, is inside every model's range."""
+    from rvfem.analysis import analyse
+
+    a = analyse(coarse_case(name), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
+    assert a.warnings == (), [w.message for w in a.warnings]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("changes", [{"loads": {"torque_Nm": 1e6}},
+                                     {"cycloid": {"pitch_error": {"amplitude": 1.0, "values": []}}}])
+def test_overload_cases_warn(changes, tmp_path):
+    """1e6 N·m and a 1 mm pitch error (the issue's examples): every limit is crossed."""
+    from rvfem.analysis import analyse
+
+    a = analyse(coarse_case("rv40e_fanholes", **changes), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
+    assert _codes(a.warnings) == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield",
+                                  "large_displacement"]
+
+
+def test_hertz_limit_scales_with_a_material_that_is_not_steel():
+    """ISO 76's 4000 MPa is on bearing steel; a material of 6 × steel's modulus (the rigid-disc limit
+    of rv40e_classical) presses sqrt(6) times harder for the same roller load, and so may its limit."""
+    from rvfem.validity import hertz_pressure_limit_MPa
+
+    assert hertz_pressure_limit_MPa() == HERTZ_PRESSURE_LIMIT_MPA
+    assert hertz_pressure_limit_MPa(206000.0, 0.3) == pytest.approx(4000.0, rel=1e-15)
+    limit = hertz_pressure_limit_MPa(1.2e6, 0.3)
+    assert limit == pytest.approx(4000.0 * math.sqrt(1.2e6 / 206000.0))
+    assert check_limits(hertz_MPa=[("x", 4041.0)], hertz_limit_MPa=limit) == ()
+    (w,) = check_limits(hertz_MPa=[("x", 1.01 * limit)], hertz_limit_MPa=limit)
+    assert w.limit == limit and "scaled to the case's modulus" in w.message
