@@ -1232,6 +1232,91 @@ def _figure(size: tuple[float, float], **subplots):
     return fig, fig.subplots(**subplots)
 
 
+def _response_figure(study: Study, p: Parameter, ok: Sequence[dict]):
+    """Grid: the largest bearing load against parameter ``p``, one curve per combination of the
+    other parameters, the handbook dotted."""
+    others = [q for q in study.parameters if q is not p]
+    fig, ax = _figure((6.4, 4.2))
+    groups: dict[tuple, list[dict]] = {}
+    for r in ok:
+        if r["role"] == "grid":
+            groups.setdefault(tuple(r[q.key] for q in others), []).append(r)
+    numeric = _numeric(p.values)
+    positions = {v: i for i, v in enumerate(p.values)}
+    for combo, members in sorted(groups.items(), key=lambda kv: repr(kv[0])):
+        members.sort(key=lambda r: positions.get(r[p.key], 0))
+        x = [r[p.key] if numeric else positions[r[p.key]] for r in members]
+        label = ", ".join(f"{q.label} = {_value_text(c)}" for q, c in zip(others, combo)) or "flexible"
+        line, = ax.plot(x, [r["max_load_N"] for r in members], "o-", label=label)
+        ax.plot(x, [r["handbook_max_load_N"] for r in members], ":", color=line.get_color(), lw=1)
+    if not numeric:
+        ax.set_xticks(range(len(p.values)), [str(v) for v in p.values])
+    ax.set_xlabel(p.label)
+    ax.set_ylabel("largest crank-bearing load, N")
+    ax.set_title(f"{study.name}: largest bearing load vs {p.label}\n(dotted: rigid handbook)", fontsize=10)
+    ax.grid(alpha=0.3)
+    if len(groups) <= 8:
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def _tornado_bars(study: Study, ok: Sequence[dict], base: dict) -> list[tuple]:
+    """Per parameter ``(span, parameter, [load % low, high], [L10h % low, high])``, smallest span
+    first (a side equal to the base value is the base itself)."""
+    bars = []
+    for p in study.parameters:
+        lo, hi = (base if p.values[i] == p.base_value else
+                  next((r for r in ok if r["role"] == role and r["varied"] == p.key), None)
+                  for i, role in enumerate(("low", "high")))
+        d = [r["max_vs_base_percent"] if r else float("nan") for r in (lo, hi)]
+        life = [100.0 * (r["life_ratio_vs_base"] - 1.0) if r and r["life_ratio_vs_base"] else float("nan")
+                for r in (lo, hi)]
+        span = max((abs(x) for x in d if not math.isnan(x)), default=0.0)
+        bars.append((span, p, d, life))
+    bars.sort(key=lambda b: b[0])
+    return bars
+
+
+def _tornado_figure(study: Study, ok: Sequence[dict], base: dict):
+    """Sensitivity: change of the largest load and of L10h against the base, per parameter."""
+    bars = _tornado_bars(study, ok, base)
+    fig, axes = _figure((10, 1.2 + 0.55 * len(bars)), nrows=1, ncols=2, sharey=True)
+    y = range(len(bars))
+    for ax, idx, title in ((axes[0], 2, "largest bearing load vs base, %"),
+                           (axes[1], 3, "L10h vs base, %")):
+        for yi, bar in zip(y, bars):
+            lo, hi = bar[idx]
+            ax.barh(yi, lo, color="tab:blue", height=0.6, label="low" if yi == 0 else None)
+            ax.barh(yi, hi, color="tab:red", height=0.6, alpha=0.8, label="high" if yi == 0 else None)
+        ax.axvline(0.0, color="k", lw=0.8)
+        ax.set_xlabel(title)
+        ax.grid(axis="x", alpha=0.3)
+    axes[0].set_yticks(list(y), [f"{b[1].label}\n{_value_text(b[1].values[0])} / {_value_text(b[1].values[1])}"
+                                 for b in bars], fontsize=8)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"{study.name}: one-at-a-time sensitivity around the base "
+                 f"(largest load {base['max_load_N']:.0f} N)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def _variants_figure(study: Study, rows: Sequence[dict]):
+    """Every variant: flexible largest load and F_m as bars, the handbook maximum as a tick."""
+    fig, ax = _figure((max(6.4, 0.45 * len(rows) + 2), 4.2))
+    x = range(len(rows))
+    ax.bar([i - 0.2 for i in x], [r["max_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, largest load")
+    ax.bar([i + 0.2 for i in x], [r["equivalent_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, F_m")
+    ax.plot(list(x), [r["handbook_max_load_N"] or float("nan") for r in rows], "k_", ms=14, label="handbook max")
+    ax.set_xticks(list(x), [r["id"] for r in rows], rotation=60, ha="right", fontsize=7)
+    ax.set_ylabel("crank-bearing load, N")
+    ax.set_title(f"{study.name}: all variants", fontsize=10)
+    ax.legend(fontsize=7)
+    ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
 def study_figures(study: Study, rows: Sequence[dict]) -> dict:
     """The plots of a study as :class:`matplotlib.figure.Figure` objects, by name.
 
@@ -1247,75 +1332,12 @@ def study_figures(study: Study, rows: Sequence[dict]) -> dict:
         return figures
     if study.kind == "grid":
         for p in study.parameters:
-            others = [q for q in study.parameters if q is not p]
-            fig, ax = _figure((6.4, 4.2))
-            groups: dict[tuple, list[dict]] = {}
-            for r in ok:
-                if r["role"] == "grid":
-                    groups.setdefault(tuple(r[q.key] for q in others), []).append(r)
-            numeric = _numeric(p.values)
-            positions = {v: i for i, v in enumerate(p.values)}
-            for combo, members in sorted(groups.items(), key=lambda kv: repr(kv[0])):
-                members.sort(key=lambda r: positions.get(r[p.key], 0))
-                x = [r[p.key] if numeric else positions[r[p.key]] for r in members]
-                label = ", ".join(f"{q.label} = {_value_text(c)}" for q, c in zip(others, combo)) or "flexible"
-                line, = ax.plot(x, [r["max_load_N"] for r in members], "o-", label=label)
-                ax.plot(x, [r["handbook_max_load_N"] for r in members], ":", color=line.get_color(), lw=1)
-            if not numeric:
-                ax.set_xticks(range(len(p.values)), [str(v) for v in p.values])
-            ax.set_xlabel(p.label)
-            ax.set_ylabel("largest crank-bearing load, N")
-            ax.set_title(f"{study.name}: largest bearing load vs {p.label}\n(dotted: rigid handbook)", fontsize=10)
-            ax.grid(alpha=0.3)
-            if len(groups) <= 8:
-                ax.legend(fontsize=7)
-            fig.tight_layout()
-            figures[f"response_{p.key}"] = fig
+            figures[f"response_{p.key}"] = _response_figure(study, p, ok)
     elif study.kind == "sensitivity":
-        by_id = {r["id"]: r for r in rows}
-        base = by_id.get("base")
+        base = {r["id"]: r for r in rows}.get("base")
         if base and base["status"] == "ok":
-            bars = []
-            for p in study.parameters:
-                lo, hi = (base if p.values[i] == p.base_value else
-                          next((r for r in ok if r["role"] == role and r["varied"] == p.key), None)
-                          for i, role in enumerate(("low", "high")))
-                d = [r["max_vs_base_percent"] if r else float("nan") for r in (lo, hi)]
-                life = [100.0 * (r["life_ratio_vs_base"] - 1.0) if r and r["life_ratio_vs_base"] else float("nan")
-                        for r in (lo, hi)]
-                span = max((abs(x) for x in d if not math.isnan(x)), default=0.0)
-                bars.append((span, p, d, life))
-            bars.sort(key=lambda b: b[0])
-            fig, axes = _figure((10, 1.2 + 0.55 * len(bars)), nrows=1, ncols=2, sharey=True)
-            y = range(len(bars))
-            for ax, idx, title in ((axes[0], 2, "largest bearing load vs base, %"),
-                                   (axes[1], 3, "L10h vs base, %")):
-                for yi, bar in zip(y, bars):
-                    lo, hi = bar[idx]
-                    ax.barh(yi, lo, color="tab:blue", height=0.6, label="low" if yi == 0 else None)
-                    ax.barh(yi, hi, color="tab:red", height=0.6, alpha=0.8, label="high" if yi == 0 else None)
-                ax.axvline(0.0, color="k", lw=0.8)
-                ax.set_xlabel(title)
-                ax.grid(axis="x", alpha=0.3)
-            axes[0].set_yticks(list(y), [f"{b[1].label}\n{_value_text(b[1].values[0])} / {_value_text(b[1].values[1])}"
-                                         for b in bars], fontsize=8)
-            axes[0].legend(fontsize=8)
-            fig.suptitle(f"{study.name}: one-at-a-time sensitivity around the base "
-                         f"(largest load {base['max_load_N']:.0f} N)", fontsize=10)
-            fig.tight_layout()
-            figures["tornado"] = fig
-    fig, ax = _figure((max(6.4, 0.45 * len(rows) + 2), 4.2))
-    x = range(len(rows))
-    ax.bar([i - 0.2 for i in x], [r["max_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, largest load")
-    ax.bar([i + 0.2 for i in x], [r["equivalent_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, F_m")
-    ax.plot(list(x), [r["handbook_max_load_N"] or float("nan") for r in rows], "k_", ms=14, label="handbook max")
-    ax.set_xticks(list(x), [r["id"] for r in rows], rotation=60, ha="right", fontsize=7)
-    ax.set_ylabel("crank-bearing load, N")
-    ax.set_title(f"{study.name}: all variants", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(axis="y", alpha=0.3)
-    fig.tight_layout()
-    figures["variants"] = fig
+            figures["tornado"] = _tornado_figure(study, ok, base)
+    figures["variants"] = _variants_figure(study, rows)
     return figures
 
 
