@@ -47,7 +47,9 @@ scheduler. The client checks that it sees each folder and says so if it does not
 Robustness: a variant that fails (bad geometry, contact not converging, worker lost) is recorded
 with its message and the study goes on; a rerun skips every variant whose folder holds a
 ``summary.json`` of the same case digest (resume); Ctrl-C cancels the futures and leaves no
-half-written variant folder; a lock file refuses a second study writing into the same folder.
+half-written variant folder (nor plots folder: both are written through
+:func:`rvfem.outputs.result_folder`); a lock file refuses a second study writing into the same
+folder.
 """
 
 from __future__ import annotations
@@ -78,6 +80,7 @@ from typing import Any, Callable, Sequence
 
 from .case import case_to_dict, load_case, parse_override
 from .errors import CaseError, OutputError, RvfemError
+from .outputs import result_folder
 from .schema import param, read_table
 
 log = logging.getLogger(__name__)
@@ -675,10 +678,12 @@ def _acquire_lock(out_dir: Path) -> Path:
     raise OutputError(f"cannot take the lock file {lock}")
 
 
-def _remove_partials(variants_dir: Path) -> None:
-    """Remove temporary folders ``.<id>.partial-*`` that a killed worker left behind."""
-    if variants_dir.is_dir():
-        for p in variants_dir.glob(".*.partial-*"):
+def _remove_partials(folder: Path) -> None:
+    """Remove the temporary folders ``.<name>.partial-*`` of :func:`rvfem.outputs.result_folder`
+    that a killed process left behind in ``folder`` (variant folders of a killed worker, the
+    plots of a killed study)."""
+    if folder.is_dir():
+        for p in folder.glob(".*.partial-*"):
             shutil.rmtree(p, ignore_errors=True)
 
 
@@ -695,9 +700,18 @@ def _existing_record(variant: Variant, folder: Path) -> dict | None:
 
 
 def _write_atomic(path: Path, text: str) -> None:
+    """Replace the file ``path`` by ``text`` in one step (a temporary file, then :func:`os.replace`).
+
+    For ``study.json``, ``study.csv`` and ``report.html``, single files beside the variant folders
+    that the workers write: :func:`rvfem.outputs.result_folder`, the package's atomic writer,
+    replaces whole folders (the variants' and ``plots/``), not one file among others.
+    """
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 # --------------------------------------------------------------------------------------------
@@ -928,6 +942,7 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
                 connect_timeout_s, started) -> StudyResult:
     variants_dir = out_dir / "variants"
     _remove_partials(variants_dir)
+    _remove_partials(out_dir)
     _write_atomic(out_dir / "study.json", json.dumps(_study_dict(study), indent=2, allow_nan=False) + "\n")
     records: dict[str, dict] = {}
     todo: list[Variant] = []
@@ -1346,13 +1361,16 @@ def _plot_file_name(name: str) -> str:
 
 
 def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
-    """Write :func:`study_figures` into ``folder`` as PNG files; name → path."""
-    folder.mkdir(exist_ok=True)
+    """Write :func:`study_figures` into ``folder`` as PNG files; name → path.
+
+    The folder is written as a whole through :func:`rvfem.outputs.result_folder`: it holds the
+    plots of one run, and an interrupted run leaves the earlier plots as they were.
+    """
     files: dict[str, Path] = {}
-    for name, fig in study_figures(study, rows).items():
-        path = folder / _plot_file_name(name)
-        fig.savefig(path, dpi=110)
-        files[name] = path
+    with result_folder(folder, overwrite=True) as tmp:
+        for name, fig in study_figures(study, rows).items():
+            fig.savefig(tmp / _plot_file_name(name), dpi=110)
+            files[name] = folder / _plot_file_name(name)
     return files
 
 

@@ -431,8 +431,11 @@ def _fake_summary(max_n: float, fm_n: float, life_h: float) -> dict:
             "stress": {"away_from_contacts": {"peak_von_mises_MPa": 40.0}}}
 
 
-def test_rows_and_plots_of_a_sensitivity_study(tmp_path):
-    """Deltas against the handbook and the base from known numbers; the tornado and bar charts."""
+def test_rows_and_plots_of_a_sensitivity_study(tmp_path, monkeypatch):
+    """Deltas against the handbook and the base from known numbers; the tornado and bar charts,
+    written as a whole folder (rvfem.outputs.result_folder): no stale plot, an interrupted run
+    leaves the earlier plots."""
+    from rvfem import study as study_module
     from rvfem.study import _plots, study_rows
 
     path = _write(tmp_path / "s.toml", _study_text("sensitivity", """
@@ -464,9 +467,22 @@ high = "rigid_bore"
     assert thin["fan_holes.ligament"] == 3.5 and thin["crank_bearing.model"] == "rollers"
     assert rows["fan_holes.ligament=5.5"]["max_load_N"] is None
     assert rows["fan_holes.ligament=5.5"]["error"] == "GeometryError: too thin"
+    (tmp_path / "plots").mkdir()
+    (tmp_path / "plots" / "response_old.png").write_bytes(b"stale")
     files = _plots(study, list(rows.values()), tmp_path / "plots")
     assert set(files) == {"tornado", "variants"}
     assert all(p.stat().st_size > 5000 for p in files.values())
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == ["tornado.png", "variants.png"]
+    before = {p.name: p.read_bytes() for p in files.values()}
+
+    def interrupted(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study_module, "study_figures", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        _plots(study, list(rows.values()), tmp_path / "plots")
+    assert {p.name: p.read_bytes() for p in (tmp_path / "plots").iterdir()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plots", "s.toml"]   # no temporary folder left
 
 
 def test_plots_are_figures_and_leave_the_backend_alone(tmp_path):
