@@ -50,7 +50,6 @@ import scipy.sparse as sp
 
 from ._arrays import readonly as _readonly
 from .errors import ContactError
-from .hertz import PALMGREN_COEFFICIENT
 
 log = logging.getLogger(__name__)
 
@@ -549,6 +548,12 @@ def _column_orbits(Q: sp.csr_matrix, order: int):
 # ------------------------------------------------------------------------------------------------
 # Contact laws
 # ------------------------------------------------------------------------------------------------
+
+
+PALMGREN_COEFFICIENT = 3.84e-5
+"""Palmgren's line-contact approach coefficient, steel on steel: δ = 3.84e-5·Q^0.9/L^0.8 (mm, N;
+Harris & Kotzalas, *Rolling Bearing Analysis*). The roller springs here and the Hertz evaluation
+(:func:`rvfem.hertz.palmgren_approach`) share it."""
 
 
 def palmgren_law(length: float, contacts: int = 2):
@@ -1165,9 +1170,12 @@ def initial_iterate(problem: ContactProblem, start: list | None, tol_gap: float)
 
 def penalty_scale(problem: ContactProblem, active: np.ndarray) -> float:
     """κ, N/mm: the gap rows' scale, the inverse median self-compliance of the active rigid
-    contacts (1e6 without any)."""
-    g_act = problem.G_cols(np.flatnonzero(active)) if active.any() else None
-    return 1.0 / float(np.median(np.diag(g_act[active]))) if g_act is not None else 1e6
+    contacts (1e6 without any, or on a rigid body)."""
+    if not active.any():
+        return 1e6
+    idx = np.flatnonzero(active)
+    compliance = float(np.median(np.diag(problem.G_cols(idx)[idx])))
+    return 1.0 / compliance if compliance > 0 else 1e6
 
 
 def newton_matrix(problem: ContactProblem, it: NewtonIterate, q: np.ndarray, dq: np.ndarray,

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .contact import PALMGREN_COEFFICIENT
 from ._arrays import first_max, max_load_index
 from .case import Case, CrankBearing
 
@@ -159,10 +160,6 @@ def hertz_peak_pressure(load_N: float, length_mm: float, half_width_mm: float) -
             return 0.0
         raise ValueError("half_width_mm and length_mm must be positive")
     return 2.0 * load_N / (math.pi * length_mm * half_width_mm)
-
-
-PALMGREN_COEFFICIENT = 3.84e-5
-"""Palmgren's line-contact approach coefficient, steel on steel: δ = 3.84e-5·Q^0.9/L^0.8 (mm, N)."""
 
 
 def palmgren_approach(load_N: float, length_mm: float) -> float:

@@ -331,8 +331,8 @@ class RigidPins:
 
 
 def _footprint_half_width(case) -> float:
-    """Half-width of the FE pin-load footprint, mm (``cycle.FOOTPRINT_ELEMENTS`` element sizes)."""
-    from .cycle import FOOTPRINT_ELEMENTS
+    """Half-width of the FE pin-load footprint, mm (``FOOTPRINT_ELEMENTS`` element sizes)."""
+    from .case import FOOTPRINT_ELEMENTS
 
     return FOOTPRINT_ELEMENTS * case.mesh.size_flank
 

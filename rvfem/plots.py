@@ -192,7 +192,7 @@ def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
               subtitle: str = "", closeup_title: str = "close-up", dpi: int = 150) -> Path:
     """The mesh: the whole disc (left) and a close-up (right), element edges thin, boundaries coloured.
 
-    The one picture of the mesh, used by ``rvfem mesh`` (:func:`rvfem.mesh.mesh_preview_png`) and
+    The one picture of the mesh, used by ``rvfem mesh`` (:func:`mesh_preview`) and
     by ``rvfem run`` (``images/mesh.png``).
 
     Parameters

@@ -68,6 +68,7 @@ from . import NOTICE
 from .case import Case
 from ._arrays import readonly
 from .errors import CaseError
+from .geometry.kinematics import load_cycle_angles
 
 __all__ = [
     "HandbookComponents",
@@ -244,33 +245,6 @@ class PinForces:
 # --------------------------------------------------------------------------------------------
 
 
-
-
-def load_cycle_angles(step_deg: float) -> np.ndarray:
-    """Uniformly spaced crank angles covering one full turn, endpoint excluded.
-
-    The one crank-angle sampler of rvfem: the handbook model, the finite-element load cycle and the
-    outputs all use these angles, so their curves line up sample by sample.
-
-    Parameters
-    ----------
-    step_deg : float
-        Requested step, degrees. The number of samples is n = round(360/step_deg), so the actual step
-        is 360°/n (equal to the request whenever it divides 360°; otherwise a notice is logged,
-        :data:`rvfem.NOTICE`).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        θ = 0, 2π/n, …, 2π(n − 1)/n, rad.
-    """
-    if not step_deg > 0:
-        raise ValueError(f"step_deg must be positive, got {step_deg!r}")
-    n = max(1, int(round(360.0 / step_deg)))
-    if not math.isclose(n * step_deg, 360.0, rel_tol=1e-9):
-        logger.info("the crank-angle step %g° does not divide 360°: it is adjusted to %.6g° (%d angles)", step_deg,
-                    360.0 / n, n, extra=NOTICE)
-    return np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
 
 
 def with_rating_life(summary: BearingLoadSummary, rating_N: float, bearing_speed_rpm: float) -> BearingLoadSummary:

@@ -21,7 +21,8 @@ from scipy.integrate import quad
 from rvfem.case import load_case
 from rvfem.errors import MeshError
 from rvfem.geometry import closest_points, disc_geometry
-from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, mesh_preview_png, read_msh
+from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, read_msh
+from rvfem.plots import mesh_preview
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 
@@ -203,7 +204,7 @@ def with_mod(case, equidistant):
 def test_preview_png_is_not_blank(fan_mesh, tmp_path):
     import matplotlib.image as mpimg
 
-    out = mesh_preview_png(fan_mesh, tmp_path / "preview.png")
+    out = mesh_preview(fan_mesh, tmp_path / "preview.png")
     img = mpimg.imread(out)
     assert img.ndim == 3 and img.shape[0] > 400 and img.shape[1] > 800
     rgb = img[..., :3]

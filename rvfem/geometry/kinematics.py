@@ -21,16 +21,22 @@ ring has turned by **+θ·(Zp − Zc)/Zp** (counter-clockwise for a counter-cloc
 
 from __future__ import annotations
 
+import logging
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from matplotlib.path import Path as _MplPath
 
+from .. import NOTICE
 from ..case import Case
 from .._arrays import readonly as _readonly
 from .profile import Profile, _c2xy, _u, build_profile, profile_eval
 
+log = logging.getLogger(__name__)
+
 __all__ = [
+    "load_cycle_angles",
     "pin_centres",
     "crank_centres",
     "PinContacts",
@@ -233,3 +239,30 @@ def pin_profile_contacts_many(geom_or_case, thetas) -> list[PinContacts]:
             param=_readonly(s_all[rows]),
         ))
     return out
+
+
+def load_cycle_angles(step_deg: float) -> np.ndarray:
+    """Uniformly spaced crank angles covering one full turn, endpoint excluded.
+
+    The one crank-angle sampler of rvfem: the handbook model, the finite-element load cycle and the
+    outputs all use these angles, so their curves line up sample by sample.
+
+    Parameters
+    ----------
+    step_deg : float
+        Requested step, degrees. The number of samples is n = round(360/step_deg), so the actual step
+        is 360°/n (equal to the request whenever it divides 360°; otherwise a notice is logged,
+        :data:`rvfem.NOTICE`).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        θ = 0, 2π/n, …, 2π(n − 1)/n, rad.
+    """
+    if not step_deg > 0:
+        raise ValueError(f"step_deg must be positive, got {step_deg!r}")
+    n = max(1, int(round(360.0 / step_deg)))
+    if not math.isclose(n * step_deg, 360.0, rel_tol=1e-9):
+        log.info("the crank-angle step %g° does not divide 360°: it is adjusted to %.6g° (%d angles)", step_deg,
+                    360.0 / n, n, extra=NOTICE)
+    return np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
