@@ -45,11 +45,11 @@ import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 from .errors import CaseError
 from .registry import bearing_model_names, pin_model_names
-from .schema import check_fields, file_fields, param, read_table, table_error
+from .schema import check_fields, closest, file_fields, param, read_table, table_error
 
 __all__ = [
     "Case",
@@ -76,7 +76,13 @@ __all__ = [
     "case_from_dict",
     "case_to_dict",
     "table_class",
+    "table_to_dict",
     "file_sha256",
+    "BUILTIN_HOLE_TABLES",
+    "register_hole_table",
+    "unregister_hole_table",
+    "hole_table_names",
+    "registered_hole_shapes",
 ]
 
 
@@ -346,6 +352,21 @@ class FanHoles:
     angle_offset_deg: float | None = param(None, **_ANGLE, default_doc="midway between the first two cranks",
                                            doc="centre line of the first hole")
 
+    def check(self, fail: Callable[[str, str], CaseError]) -> None:
+        """The checks between keys of the table; ``fail(key, message)`` is the error for one of its
+        keys (run by :class:`Case`, see :func:`register_hole_table`)."""
+        if self.outer_radius <= self.inner_radius:
+            raise fail("outer_radius", "must exceed inner_radius")
+        if (self.span_deg is None) == (self.ligament is None):
+            raise fail("span_deg", "or 'ligament': give exactly one of them")
+        if self.span_deg is not None and self.span_deg * self.count >= 360.0:
+            raise fail("span_deg", f"× count must stay below 360°, got {self.span_deg * self.count}°")
+
+    @property
+    def outline_length(self) -> float:
+        """Length of the outlines of all holes (unfilleted sectors), mm, for the mesh-size estimate."""
+        return self.count * 2.0 * (self.outer_radius + self.outer_radius - self.inner_radius)
+
 
 @dataclass(frozen=True)
 class RoundHoles:
@@ -356,6 +377,83 @@ class RoundHoles:
     count: int = param(low=1, high=60, default_from=_crank_count, default_doc="`cranks.count`",
                        doc="number of holes")
     angle_offset_deg: float | None = param(None, **_ANGLE, doc="angular position of the first hole")
+
+    @property
+    def outline_length(self) -> float:
+        """Length of the outlines of all holes, mm, for the mesh-size estimate."""
+        return self.count * 2.0 * math.pi * self.radius
+
+
+# --------------------------------------------------------------------------------------------
+# Hole tables. A kind of lightening hole is one hole shape (rvfem.geometry.holes.HoleShape) that
+# owns one table of the case file. The built-in tables are fields of Case; the table of a shape
+# registered later (rvfem.geometry.holes.register_hole_shape, from any module, a test module
+# included) is read into Case.other_holes and is a top-level table of the file like them.
+# --------------------------------------------------------------------------------------------
+
+BUILTIN_HOLE_TABLES = ("fan_holes", "round_holes")
+"""The hole tables that are fields of :class:`Case`, in the order their holes are numbered."""
+
+_BUILTIN_HOLE_CLASSES = {"fan_holes": FanHoles, "round_holes": RoundHoles}
+_HOLE_SHAPES: dict[str, type] = {}
+
+
+def register_hole_table(shape: type) -> None:
+    """Make ``shape.table`` (a frozen dataclass declared with :func:`~rvfem.schema.param`) the table
+    ``[shape.name]`` of the case format. Use :func:`rvfem.geometry.holes.register_hole_shape`,
+    which calls this.
+
+    The table class must have a property ``outline_length`` (the length of all its holes'
+    outlines, mm, for :func:`estimated_mesh_nodes`) and may have a method ``check(fail)`` with
+    the checks between its keys (``fail(key, message)`` returns the error to raise).
+
+    Raises
+    ------
+    ValueError
+        ``shape.name`` is not a valid table name, names another table of the case format, or is
+        registered by another shape.
+    TypeError
+        ``shape.table`` is not such a dataclass.
+    """
+    name, table = getattr(shape, "name", None), getattr(shape, "table", None)
+    if not (isinstance(name, str) and name.isidentifier()):
+        raise ValueError(f"a hole shape needs a table name (a Python identifier), got {name!r}")
+    if name in _BUILTIN_HOLE_CLASSES and table is not _BUILTIN_HOLE_CLASSES[name]:
+        raise ValueError(f"the table {name!r} is read as {_BUILTIN_HOLE_CLASSES[name].__name__}")
+    if name not in _BUILTIN_HOLE_CLASSES and name in {f.name for f in dataclasses.fields(Case)}:
+        raise ValueError(f"{name!r} is a table of the case format already")
+    if _HOLE_SHAPES.get(name, shape) is not shape:
+        raise ValueError(f"the hole table {name!r} is registered by {_HOLE_SHAPES[name].__qualname__} already")
+    if not (isinstance(table, type) and dataclasses.is_dataclass(table) and table.__dataclass_params__.frozen):
+        raise TypeError(f"the table of hole shape {name!r} must be a frozen dataclass, got {table!r}")
+    file_fields(table)     # every key declared with param (raises TypeError otherwise)
+    if not hasattr(table, "outline_length"):
+        raise TypeError(f"{table.__name__} (table {name!r}) needs a property 'outline_length'")
+    _HOLE_SHAPES[name] = shape
+
+
+def unregister_hole_table(name: str) -> None:
+    """Remove the table ``name`` of a registered hole shape from the case format (a built-in
+    table cannot be removed; an unknown name is ignored)."""
+    if name in BUILTIN_HOLE_TABLES:
+        raise ValueError(f"the built-in hole table {name!r} cannot be unregistered")
+    _HOLE_SHAPES.pop(name, None)
+
+
+def hole_table_names() -> tuple[str, ...]:
+    """The hole tables of the case format, in the order their holes are numbered: the built-in
+    ones, then those of the registered hole shapes in the order they were registered."""
+    return tuple(dict.fromkeys([*BUILTIN_HOLE_TABLES, *_HOLE_SHAPES]))
+
+
+def registered_hole_shapes() -> tuple[type, ...]:
+    """The registered hole shapes, in the order of :func:`hole_table_names`."""
+    return tuple(_HOLE_SHAPES[name] for name in hole_table_names() if name in _HOLE_SHAPES)
+
+
+def _other_hole_names() -> tuple[str, ...]:
+    """The registered hole tables that are not fields of :class:`Case`."""
+    return tuple(name for name in _HOLE_SHAPES if name not in BUILTIN_HOLE_TABLES)
 
 
 @dataclass(frozen=True)
@@ -576,7 +674,10 @@ class Case:
     """One reducer and one analysis, validated on construction (see the module docstring).
 
     All arguments are keywords. ``source`` names the file (or ``"<code>"``) in error messages;
-    ``overrides`` records the ``KEY=VALUE`` overrides applied on reading.
+    ``overrides`` records the ``KEY=VALUE`` overrides applied on reading. ``other_holes`` holds
+    the tables of the registered hole shapes that are not fields (:func:`register_hole_table`) as
+    ``(table name, table)`` pairs; :meth:`replace` sets them by name like fields, and
+    :meth:`hole_tables` lists every hole table of the case.
     """
 
     name: str = param(max_length=200, default_from=_file_stem, default_doc="file name without `.toml`",
@@ -595,13 +696,41 @@ class Case:
     description: str = param("", max_length=10000, doc="free text")
     source: str = param("<code>", compare=False, in_file=False)
     overrides: tuple[str, ...] = param((), compare=False, in_file=False)
+    other_holes: tuple[tuple[str, Any], ...] = param((), in_file=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "source", str(self.source))
         object.__setattr__(self, "overrides", tuple(self.overrides))
         check_fields(self, "", self.source)
+        _check_other_holes(self)
         for check in _CROSS_CHECKS:
             check(self)
+
+    def hole_tables(self) -> tuple[tuple[str, Any], ...]:
+        """``(table name, table)`` of every hole table the case has, in the order the holes are
+        numbered (:func:`hole_table_names`)."""
+        builtin = tuple((name, getattr(self, name)) for name in BUILTIN_HOLE_TABLES if getattr(self, name) is not None)
+        return builtin + self.other_holes
+
+    def hole_shapes(self) -> tuple[tuple[type, Any], ...]:
+        """``(hole shape, table)`` of every hole table the case has, in the order of
+        :meth:`hole_tables` (the shapes are :class:`rvfem.geometry.holes.HoleShape` classes,
+        registered when :mod:`rvfem.geometry` is imported).
+
+        Raises
+        ------
+        LookupError
+            A table's shape is not registered.
+        """
+        try:
+            return tuple((_HOLE_SHAPES[name], table) for name, table in self.hole_tables())
+        except KeyError as exc:
+            raise LookupError(f"no hole shape is registered for the table {exc.args[0]!r} "
+                              "(the built-in ones are registered by importing rvfem.geometry)") from None
+
+    def hole_table(self, name: str) -> Any:
+        """The hole table ``name`` of the case, or None if the case has none."""
+        return dict(self.hole_tables()).get(name)
 
     @property
     def short_amplitude_coefficient(self) -> float:
@@ -609,7 +738,12 @@ class Case:
         return self.cycloid.eccentricity * self.pins.count / self.pins.circle_radius
 
     def replace(self, **changes: Any) -> "Case":
-        """A copy with top-level fields replaced (validated again)."""
+        """A copy with top-level fields replaced (validated again); the table of a registered hole
+        shape is replaced by its name like a field (None removes it)."""
+        others = {name: changes.pop(name) for name in _other_hole_names() if name in changes}
+        if others:
+            tables = {**dict(changes.get("other_holes", self.other_holes)), **others}
+            changes["other_holes"] = tuple((name, t) for name, t in tables.items() if t is not None)
         return dataclasses.replace(self, **changes)
 
     def digest(self) -> str:
@@ -680,15 +814,37 @@ def _check_crank_bearing(case: Case) -> None:
                      "the rollers do not fit between the eccentric and the bore")
 
 
+def _check_other_holes(case: Case) -> None:
+    """Check the tables of :attr:`Case.other_holes` like the fields (each against its declaration)
+    and put them in the order of :func:`hole_table_names`."""
+    given = case.other_holes
+    pairs = list(given.items()) if isinstance(given, Mapping) else list(given)
+    names = _other_hole_names()
+    seen: set[str] = set()
+    for pair in pairs:
+        if not (isinstance(pair, tuple) and len(pair) == 2 and pair[0] in names):
+            known = ", ".join(names) or "none"
+            raise _error(case, "other_holes", f"must hold (table name, table) pairs of the registered hole shapes "
+                                              f"({known}), got {pair!r}")
+        name, table = pair
+        if name in seen:
+            raise _error(case, name, "is given twice")
+        seen.add(name)
+        if table is None:
+            continue
+        cls = _HOLE_SHAPES[name].table
+        if not isinstance(table, cls):
+            raise _error(case, name, f"must be a {cls.__name__}, got {table!r}")
+        check_fields(table, name, case.source)
+    ordered = tuple(sorted((p for p in pairs if p[1] is not None), key=lambda p: names.index(p[0])))
+    object.__setattr__(case, "other_holes", ordered)
+
+
 def _check_holes(case: Case) -> None:
-    fan = case.fan_holes
-    if fan is not None:
-        if fan.outer_radius <= fan.inner_radius:
-            raise _error(case, "fan_holes.outer_radius", "must exceed inner_radius")
-        if (fan.span_deg is None) == (fan.ligament is None):
-            raise _error(case, "fan_holes.span_deg", "or 'ligament': give exactly one of them")
-        if fan.span_deg is not None and fan.span_deg * fan.count >= 360.0:
-            raise _error(case, "fan_holes.span_deg", f"× count must stay below 360°, got {fan.span_deg * fan.count}°")
+    for name, table in case.hole_tables():
+        check = getattr(table, "check", None)
+        if check is not None:
+            check(lambda key, message, name=name: _error(case, f"{name}.{key}", message))
 
 
 MIN_DUTY_TORQUE_NM = 1.0e-3
@@ -750,11 +906,8 @@ def estimated_mesh_nodes(case: Case) -> dict[str, float]:
     bore = case.crank_bearing.bore_radius
     area = math.pi * outer ** 2 - math.pi * cyc.central_hole_radius ** 2 - case.cranks.count * math.pi * bore ** 2
     hole_length = 2.0 * math.pi * cyc.central_hole_radius
-    if case.fan_holes is not None:
-        fan = case.fan_holes
-        hole_length += fan.count * 2.0 * (fan.outer_radius + fan.outer_radius - fan.inner_radius)
-    if case.round_holes is not None:
-        hole_length += case.round_holes.count * 2.0 * math.pi * case.round_holes.radius
+    for _, table in case.hole_tables():
+        hole_length += table.outline_length
     density = 2.0 / math.sqrt(3.0)
 
     def band(length: float, size: float) -> float:
@@ -940,14 +1093,31 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     CaseError
         With the file (``source``) and the dotted key of the first problem found.
     """
-    return read_table(Case, data, "", source, extra={"source": source})
+    others = _other_hole_names()
+    if not others or not isinstance(data, dict):
+        return read_table(Case, data, "", source, extra={"source": source})
+    known = tuple(spec.name for spec in file_fields(Case)) + others
+    for name in data:
+        if name not in known:
+            hint = closest(name, known)
+            raise table_error(source, name, "is not a known key" + (f" (did you mean '{hint}'?)" if hint else "")
+                              + "; remove it or check the spelling")
+    values: dict[str, Any] = {"<source>": source}
+    case = read_table(Case, {k: v for k, v in data.items() if k not in others}, "", source, values,
+                      extra={"source": source})
+    tables = tuple((name, read_table(_HOLE_SHAPES[name].table, data[name], name, source, values))
+                   for name in others if name in data)
+    return dataclasses.replace(case, other_holes=tables) if tables else case
 
 
 def table_class(dotted: str) -> type:
     """The dataclass of the table at dotted key ``dotted`` ("" for the top level, e.g.
     ``"cycloid.modification"``, ``"loads.duty_cycle"``)."""
     cls: type = Case
-    for part in [p for p in dotted.split(".") if p]:
+    parts = [p for p in dotted.split(".") if p]
+    if parts and parts[0] in _other_hole_names():
+        cls, parts = _HOLE_SHAPES[parts[0]].table, parts[1:]
+    for part in parts:
         spec = {s.name: s for s in file_fields(cls)}.get(part)
         if spec is None or spec.item is None:
             raise KeyError(f"no table {dotted!r} in the case format")
@@ -1027,19 +1197,27 @@ def load_case(path: str | Path, overrides: Sequence[str] = ()) -> Case:
     return dataclasses.replace(case, overrides=overrides)
 
 
+_NOT_IN_FILE = ("source", "overrides", "other_holes")
+
+
+def table_to_dict(table: Any) -> Any:
+    """A table (a dataclass of the case format) as plain dicts and lists in the file's layout; keys
+    whose value is None are left out."""
+    if dataclasses.is_dataclass(table):
+        return {f.name: table_to_dict(getattr(table, f.name)) for f in dataclasses.fields(table)
+                if getattr(table, f.name) is not None and f.name not in _NOT_IN_FILE}
+    if isinstance(table, tuple):
+        return [table_to_dict(v) for v in table]
+    return table
+
+
 def case_to_dict(case: Case) -> dict:
-    """The case as a plain dict in the file's layout (round-trips through :func:`case_from_dict`)."""
-
-    def clean(obj: Any) -> Any:
-        if dataclasses.is_dataclass(obj):
-            return {f.name: clean(getattr(obj, f.name)) for f in dataclasses.fields(obj)
-                    if getattr(obj, f.name) is not None and f.name not in ("source", "overrides")}
-        if isinstance(obj, tuple):
-            return [clean(v) for v in obj]
-        return obj
-
-    data = clean(case)
+    """The case as a plain dict in the file's layout (round-trips through :func:`case_from_dict`);
+    the tables of registered hole shapes (:attr:`Case.other_holes`) are top-level tables."""
+    data = table_to_dict(case)
     data["loads"]["duty_cycle"] = data["loads"].get("duty_cycle", [])
+    for name, table in case.other_holes:
+        data[name] = table_to_dict(table)
     return data
 
 

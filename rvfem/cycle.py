@@ -1073,20 +1073,17 @@ def case_stage(system, second=None, second_disc: str = "same_as_first") -> Reduc
 def half_pitch_case(case):
     """Disc B's case for the exact model: cranks (and the holes that follow them) turned by −β.
 
-    Holes placed by an explicit ``angle_offset_deg`` are turned too; everything else is unchanged.
+    Every hole table is turned by its hole shape (:meth:`rvfem.geometry.HoleShape.turned`: holes
+    placed by an explicit ``angle_offset_deg`` are turned too); everything else is unchanged.
     Solved at θ + π − β and turned back by β, this is disc B with its teeth half a tooth pitch from
     disc A's against the bores and holes.
     """
-    import dataclasses
-
     beta = math.degrees(second_disc_phase(case))
     cranks = dataclasses.replace(case.cranks, angles_deg=tuple(a - beta for a in case.cranks.angles_deg))
     changes = {"cranks": cranks}
-    for table in ("fan_holes", "round_holes"):
-        holes = getattr(case, table)
-        if holes is not None and holes.angle_offset_deg is not None:
-            changes[table] = dataclasses.replace(holes, angle_offset_deg=holes.angle_offset_deg - beta)
-    return dataclasses.replace(case, **changes)
+    for shape, table in case.hole_shapes():
+        changes[shape.name] = shape.turned(table, beta)
+    return case.replace(**changes)
 
 
 @dataclass(frozen=True)

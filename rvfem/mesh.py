@@ -15,9 +15,10 @@ hole and the lightening holes, each held over a band and then growing linearly (
 ``size_interior``.
 
 Physical groups: curves ``profile``, ``central_hole``, ``bore_0`` …, ``hole_0`` … (fan holes
-first, then round holes) and the surface ``disc``. Bores and holes are numbered from 0 (Python
-indexing; ``bore_0`` is the bore of bearing 1), in the file as in :attr:`DiscMesh.boundaries`; what
-users read is numbered from 1 (:func:`rvfem.postprocess.user_feature_name`).
+first, then round holes, then the holes of registered hole shapes) and the surface ``disc``.
+Bores and holes are numbered from 0 (Python indexing; ``bore_0`` is the bore of bearing 1), in
+the file as in :attr:`DiscMesh.boundaries`; what users read is numbered from 1
+(:func:`rvfem.postprocess.user_feature_name`).
 
 Symmetric discs: when the disc maps onto itself under a rotation by 2π/N about its centre (N the
 number of cranks; :func:`symmetry_order`) and ``mesh.symmetric`` is true, only one 360°/N sector is
@@ -62,7 +63,7 @@ from scipy.spatial import cKDTree
 
 from . import NOTICE
 from ._arrays import chain_edges
-from .case import Case, case_to_dict
+from .case import Case, case_to_dict, registered_hole_shapes
 from .errors import MeshError
 from .geometry import SPLINE_POINTS_PER_SEGMENT, Arc, DiscGeometry, Feature, LineSegment, disc_geometry
 
@@ -246,8 +247,9 @@ def mesh_key(case: Case) -> str:
     """sha256 (hex) of the inputs that shape the mesh.
 
     Included: cycloid teeth, eccentricity, central hole, modifications and pitch errors; pin count,
-    pin-circle radius and pin radius; cranks; the bore radius; fan and round holes; the mesh sizes
-    and ``mesh.symmetric``; :data:`MESHER_VERSION`, the number of spline points per tooth space and
+    pin-circle radius and pin radius; cranks; the bore radius; the holes (each hole shape's
+    :meth:`~rvfem.geometry.HoleShape.mesh_key_part` of its table); the mesh sizes and
+    ``mesh.symmetric``; :data:`MESHER_VERSION`, the number of spline points per tooth space and
     the Gmsh version. Not included: thickness, material, loads, analysis options, bearing data
     other than the bore radius, ``mesh.min_wall`` (a check, not a shape) and the case name.
     """
@@ -258,15 +260,30 @@ def mesh_key(case: Case) -> str:
         "pins": {k: d["pins"][k] for k in ("count", "circle_radius", "radius")},
         "cranks": d["cranks"],
         "bore_radius": d["crank_bearing"]["bore_radius"],
-        "fan_holes": d.get("fan_holes"),
-        "round_holes": d.get("round_holes"),
         "mesh": {k: d["mesh"].get(k) for k in ("size_flank", "size_bore", "size_interior", "size_hole",
                                                "symmetric")},
         "mesher": MESHER_VERSION,
         "spline_points": SPLINE_POINTS_PER_SEGMENT,
         "gmsh": gmsh.__version__,
     }
+    shaping.update(_holes_key(case))
     return hashlib.sha256(json.dumps(shaping, sort_keys=True).encode()).hexdigest()
+
+
+def _holes_key(case: Case) -> dict:
+    """The holes' part of the mesh key: each registered hole shape's part of its table. The
+    built-in shapes (:attr:`~rvfem.geometry.HoleShape.always_in_mesh_key`) have a top-level entry,
+    None without a table, as in the keys of earlier versions (their cached meshes stay valid);
+    the other shapes appear under ``"holes"`` when the case has their table."""
+    out: dict = {}
+    for shape in registered_hole_shapes():
+        table = case.hole_table(shape.name)
+        part = None if table is None else shape.mesh_key_part(table)
+        if shape.always_in_mesh_key:
+            out[shape.name] = part
+        elif table is not None:
+            out.setdefault("holes", {})[shape.name] = part
+    return out
 
 
 def mesh_path(case: Case, cache_dir: str | os.PathLike = "meshes") -> Path:

@@ -14,6 +14,11 @@ on reading). One module per concern, every public name re-exported here
 :mod:`rvfem.geometry.features`
     The :class:`Feature` protocol, its implementations (:class:`Circle`, :class:`FanHole`) and the
     checked :class:`DiscGeometry` (:func:`disc_geometry`: overlaps, thin walls).
+:mod:`rvfem.geometry.holes`
+    The hole shapes: one :class:`HoleShape` class for each kind of lightening hole (its case
+    table, its holes, its part of the mesh key, its turn for disc B, its description), the
+    built-in :class:`FanHoleShape` and :class:`RoundHoleShape`, and :func:`register_hole_shape`
+    for more.
 
 The derivations are in docs/theory.md ("Kinematics", "Profile envelope and modifications").
 """
@@ -27,11 +32,14 @@ from .features import (
     DiscGeometry,
     FanHole,
     Feature,
+    HoleContext,
     LineSegment,
     Wall,
     disc_geometry,
     feature_text,
 )
+from .holes import (FanHoleShape, HoleShape, RoundHoleShape, default_angle_offset, hole_shape, register_hole_shape,
+                    unregister_hole_shape)
 from .kinematics import (PinContacts, closest_points, crank_centres, pin_centres, pin_profile_contacts,
                          pin_profile_contacts_many)
 from .profile import (
@@ -54,6 +62,14 @@ __all__ = [
     "LineSegment",
     "Arc",
     "FanHole",
+    "HoleContext",
+    "HoleShape",
+    "FanHoleShape",
+    "RoundHoleShape",
+    "register_hole_shape",
+    "unregister_hole_shape",
+    "hole_shape",
+    "default_angle_offset",
     "Wall",
     "DiscGeometry",
     "PinContacts",

@@ -4,12 +4,14 @@ Everything is in the disc's body frame (origin at the disc centre), lengths mm, 
 
 Features
 --------
-A central hole, N crank-bearing bores (radius ``crank_bearing.bore_radius``) at r0·u(α_i), optional
-fan-shaped holes (annular sectors with filleted corners) and round holes. Every one of them is a
-:class:`Feature`: a name, a closed outline of lines and arcs, an exact signed distance, samples, an
-exact area and a self-check. :class:`Circle` and :class:`FanHole` implement it; a new hole shape is
-one more frozen dataclass with the same members, and neither the checks here nor the mesher
-(:mod:`rvfem.mesh`) need to know its type.
+A central hole, N crank-bearing bores (radius ``crank_bearing.bore_radius``) at r0·u(α_i) and the
+lightening holes of the case's hole tables (fan-shaped holes, round holes, any registered hole
+shape). Every one of them is a :class:`Feature`: a name, a closed outline of lines and arcs, an
+exact signed distance, samples, an exact area and a self-check. :class:`Circle` and
+:class:`FanHole` implement it. A new kind of hole is one :class:`~rvfem.geometry.holes.HoleShape`
+(its case table and the features it adds, :mod:`rvfem.geometry.holes`) with one frozen dataclass
+of these members for its outline; neither the checks here nor the mesher (:mod:`rvfem.mesh`) need
+to know its type.
 
 :func:`disc_geometry` builds a :class:`DiscGeometry` and checks it (undercut, overlaps, thin walls)
 before anything is meshed; every problem is a :class:`~rvfem.errors.GeometryError` that says what
@@ -32,7 +34,6 @@ from typing import Protocol, Union
 
 import numpy as np
 from matplotlib.path import Path as _MplPath
-from scipy.optimize import brentq
 
 from ..case import Case
 from ..errors import GeometryError
@@ -41,6 +42,7 @@ from .profile import Profile, build_profile
 
 __all__ = [
     "Feature",
+    "HoleContext",
     "LineSegment",
     "Arc",
     "Circle",
@@ -78,7 +80,7 @@ def feature_text(name: str) -> str:
     return name
 
 
-def _length_text(x: float) -> str:
+def length_text(x: float) -> str:
     """A wall or an overlap for a message: mm with three decimals, or µm below 0.1 mm (so that a
     near-touch is not "0.000 mm")."""
     x = abs(x)
@@ -403,8 +405,9 @@ class DiscGeometry:
     bores : tuple of Circle
         ``bore_0`` … ``bore_{N−1}`` at r0·u(α_i).
     holes : tuple of Feature
-        Lightening holes ``hole_0`` …: the fan holes (:class:`FanHole`) first, then the round
-        holes (:class:`Circle`).
+        Lightening holes ``hole_0`` …, table by table in the order of
+        :func:`rvfem.case.hole_table_names`: the fan holes (:class:`FanHole`), the round holes
+        (:class:`Circle`), then the holes of registered hole shapes.
     walls : tuple of Wall
         The thinnest wall between every pair of features (and each feature and the profile),
         thinnest first.
@@ -430,109 +433,28 @@ class DiscGeometry:
         return a - sum(f.area for f in self.features)
 
 
-def _fan_hole(name: str, fan, angle: float, half_span: float) -> FanHole:
-    return FanHole(name, fan.inner_radius, fan.outer_radius, angle, half_span, fan.fillet_radius)
+@dataclass(frozen=True)
+class HoleContext:
+    """What a hole shape (:meth:`rvfem.geometry.holes.HoleShape.features`) is given besides its
+    table to place its holes.
 
+    Attributes
+    ----------
+    first_index : int
+        Index of its first hole: its holes are ``hole_<first_index>``, ``hole_<first_index + 1>``, …
+    bores : tuple of Circle
+        The crank-bearing bores.
+    profile : Profile
+        The tooth profile.
+    """
 
-def _default_offset(case: Case) -> float:
-    """Midway between the first two cranks (circular mean), rad."""
-    a = np.radians(case.cranks.angles_deg[:2])
-    return float(np.angle(np.exp(1j * a[0]) + np.exp(1j * a[1])))
+    first_index: int
+    bores: tuple[Circle, ...]
+    profile: Profile
 
-
-def _fan_holes(case: Case, bores: tuple[Circle, ...], profile: Profile) -> list[FanHole]:
-    fan = case.fan_holes
-    if fan is None:
-        return []
-    offset = _default_offset(case) if fan.angle_offset_deg is None else math.radians(fan.angle_offset_deg)
-    angles = [offset + 2 * math.pi * i / fan.count for i in range(fan.count)]
-    if fan.span_deg is not None:
-        holes = [_fan_hole(f"hole_{i}", fan, a, math.radians(fan.span_deg) / 2) for i, a in enumerate(angles)]
-        for h in holes:
-            h.validate()
-        return holes
-    if fan.outer_radius - fan.inner_radius <= 2 * fan.fillet_radius:
-        _fan_hole("hole_0", fan, angles[0], math.pi / fan.count).validate()   # raises the message
-    # span from the ligament: the widest hole whose wall to every bore is ≥ ligament
-    L = fan.ligament
-
-    def wall(half_span: float, angle: float) -> float:
-        return _hole_bore_wall(_fan_hole("probe", fan, angle, half_span), bores)
-
-    holes = []
-    for i, a in enumerate(angles):
-        lo = _min_valid_half_span(fan, a)
-        hi = math.pi / fan.count
-        if wall(lo, a) < L or wall(hi, a) >= L:
-            _fan_radii_outside_disc(case, profile)   # the hole is in the wrong place: say so first
-        if wall(lo, a) < L:
-            raise GeometryError(
-                f"{feature_text(f'hole_{i}')}: 'fan_holes.ligament' = {L:g} mm cannot be kept: even the narrowest "
-                f"hole with fillets of {fan.fillet_radius:g} mm leaves only {_length_text(wall(lo, a))} to "
-                "the nearest bore; reduce 'fan_holes.ligament', move the hole radially ('fan_holes.inner_radius', "
-                "'fan_holes.outer_radius') or shrink the bores ('crank_bearing.bore_radius')")
-        if wall(hi, a) >= L:
-            raise GeometryError(
-                f"{feature_text(f'hole_{i}')}: even at its widest (a span of {360.0 / fan.count:.4g}°, where "
-                f"neighbouring fan holes meet) it stays {_length_text(wall(hi, a))} from the bores, more than "
-                f"'fan_holes.ligament' = {L:g} mm, so the ligament cannot set the span; give 'fan_holes.span_deg' "
-                "instead")
-        half = brentq(lambda x: wall(x, a) - L, lo, hi, xtol=1e-12)
-        h = _fan_hole(f"hole_{i}", fan, a, half)
-        h.validate()
-        holes.append(h)
-    return holes
-
-
-def _fan_radii_outside_disc(case: Case, profile: Profile) -> None:
-    """Raise GeometryError if the fan holes' radii put them into the teeth or the central hole (for
-    any span); called where the span cannot follow from the ligament, to give the reason that
-    applies."""
-    fan, root = case.fan_holes, profile.root_radius
-    central = case.cycloid.central_hole_radius
-    if fan.outer_radius >= root:
-        raise GeometryError(
-            f"the fan holes at radii {fan.inner_radius:g}–{fan.outer_radius:g} mm cut the teeth (root radius "
-            f"{root:.3f} mm): 'fan_holes.outer_radius' must stay below {root - case.mesh.min_wall:.3f} mm "
-            "(the root radius less mesh.min_wall)")
-    if fan.inner_radius <= central:
-        raise GeometryError(
-            f"the fan holes at radii {fan.inner_radius:g}–{fan.outer_radius:g} mm overlap the central hole "
-            f"(radius {central:g} mm): 'fan_holes.inner_radius' must exceed {central + case.mesh.min_wall:g} mm "
-            "(cycloid.central_hole_radius plus mesh.min_wall)")
-
-
-def _min_valid_half_span(fan, angle: float) -> float:
-    """Smallest half-span for which the fillets fit (bisection on FanHole.validate)."""
-    lo, hi = 0.0, math.pi / fan.count
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        try:
-            _fan_hole("probe", fan, angle, mid).validate()
-            hi = mid
-        except GeometryError:
-            lo = mid
-    return hi
-
-
-def _hole_bore_wall(hole: Feature, bores) -> float:
-    """Smallest wall between a hole and the bores, mm: the hole's exact signed distance to each bore
-    centre minus the bore radius (negative when they overlap)."""
-    centres = np.array([b.centre for b in bores], dtype=float)
-    return float(np.min(hole.signed_distance(centres) - np.array([b.radius for b in bores])))
-
-
-def _round_holes(case: Case, first_index: int) -> list[Circle]:
-    rh = case.round_holes
-    if rh is None:
-        return []
-    offset = _default_offset(case) if rh.angle_offset_deg is None else math.radians(rh.angle_offset_deg)
-    out = []
-    for i in range(rh.count):
-        a = offset + 2 * math.pi * i / rh.count
-        out.append(Circle(f"hole_{first_index + i}", (rh.circle_radius * math.cos(a),
-                                                       rh.circle_radius * math.sin(a)), rh.radius))
-    return out
+    def name(self, i: int) -> str:
+        """Name of the shape's hole ``i`` (from 0): ``hole_<first_index + i>``."""
+        return f"hole_{self.first_index + i}"
 
 
 def _wall(a, b) -> Wall:
@@ -557,29 +479,37 @@ def _profile_wall(profile: Profile, f) -> Wall:
     return Wall("profile", f.name, float(d[i]), (float(pts[i, 0]), float(pts[i, 1])))
 
 
-def _feature_keys(case: Case, name: str, other: str) -> list[str]:
-    """The case keys that move or resize feature ``name`` away from feature ``other``."""
+def _feature_keys(owners: dict, name: str, other: str) -> list[str]:
+    """The case keys that move or resize feature ``name`` away from feature ``other``; ``owners``
+    maps a hole's name to its (hole shape, table)."""
     if name == "central_hole":
         return ["cycloid.central_hole_radius"]
     if name == "profile":
         return []
     if name.startswith("bore_"):
         return ["crank_bearing.bore_radius", "cranks.circle_radius"]
-    n_fans = case.fan_holes.count if case.fan_holes is not None else 0
-    if name.startswith("hole_") and int(name.split("_")[1]) < n_fans:
-        span = "fan_holes.ligament" if case.fan_holes.ligament is not None else "fan_holes.span_deg"
-        if other == "central_hole":
-            return ["fan_holes.inner_radius"]
-        if other == "profile":
-            return ["fan_holes.outer_radius"]
-        if other.startswith("bore_"):
-            return [span, "fan_holes.inner_radius", "fan_holes.outer_radius"]
-        return [span, "fan_holes.count"]
-    return ["round_holes.radius", "round_holes.circle_radius"]
+    shape, table = owners[name]
+    return list(shape.case_keys(table, other))
 
 
-def _pair_keys(case: Case, first: str, second: str) -> str:
-    return _keys_text(_feature_keys(case, second, first) + _feature_keys(case, first, second))
+def _pair_keys(owners: dict, first: str, second: str) -> str:
+    return _keys_text(_feature_keys(owners, second, first) + _feature_keys(owners, first, second))
+
+
+def _holes(case: Case, bores: tuple[Circle, ...], profile: Profile) -> tuple[tuple[Feature, ...], dict]:
+    """The lightening holes of every hole table of the case, numbered in table order, and the map
+    of a hole's name to its (hole shape, table)."""
+    holes: list = []
+    owners: dict = {}
+    for shape, table in case.hole_shapes():
+        made = tuple(shape.features(case, table, HoleContext(len(holes), bores, profile)))
+        expected = [f"hole_{len(holes) + i}" for i in range(len(made))]
+        if [f.name for f in made] != expected:
+            raise ValueError(f"hole shape {shape.__qualname__} named its holes {[f.name for f in made]}, "
+                             f"expected {expected} (HoleContext.name)")
+        owners.update((f.name, (shape, table)) for f in made)
+        holes.extend(made)
+    return tuple(holes), owners
 
 
 def disc_geometry(case: Case) -> DiscGeometry:
@@ -589,9 +519,10 @@ def disc_geometry(case: Case) -> DiscGeometry:
     features, numbered from 1 ("bore 1", "hole 2"), and the case keys to change):
 
     * the profile has no undercut (see :func:`build_profile`);
-    * fan holes: fillets fit, the ligament to the bores can be kept (or, where the span cannot
-      follow from it, why: holes in the teeth or in the central hole, or holes that never come
-      that close to a bore);
+    * each hole shape's own checks while it places its holes (:mod:`rvfem.geometry.holes`; fan
+      holes: fillets fit, the ligament to the bores can be kept or, where the span cannot follow
+      from it, why: holes in the teeth or in the central hole, or holes that never come that close
+      to a bore);
     * every feature lies inside the profile and no two features (or a feature and the profile)
       overlap;
     * no wall (feature–feature or feature–profile) is thinner than ``mesh.min_wall``; the message
@@ -619,8 +550,7 @@ def _disc_geometry(case: Case) -> DiscGeometry:
     central = Circle("central_hole", (0.0, 0.0), case.cycloid.central_hole_radius)
     bores = tuple(Circle(f"bore_{i}", (float(x), float(y)), case.crank_bearing.bore_radius)
                   for i, (x, y) in enumerate(crank_centres(case)))
-    fans = _fan_holes(case, bores, profile)
-    holes = tuple(fans) + tuple(_round_holes(case, len(fans)))
+    holes, owners = _holes(case, bores, profile)
     features = (central,) + bores + holes
     for f in features:
         f.validate()
@@ -634,7 +564,7 @@ def _disc_geometry(case: Case) -> DiscGeometry:
             raise GeometryError(
                 f"{feature_text(f.name)} lies entirely outside the cycloid profile (root radius "
                 f"{profile.root_radius:.3f} mm); check its position and size "
-                f"({_keys_text(_feature_keys(case, f.name, 'profile'))})")
+                f"({_keys_text(_feature_keys(owners, f.name, 'profile'))})")
 
     walls = [_profile_wall(profile, f) for f in features]
     for i, f in enumerate(features):
@@ -645,9 +575,9 @@ def _disc_geometry(case: Case) -> DiscGeometry:
     min_wall = case.mesh.min_wall
     first, second = feature_text(thinnest.first), feature_text(thinnest.second)
     near = f"near ({thinnest.location[0]:.2f}, {thinnest.location[1]:.2f}) mm"
-    keys = _pair_keys(case, thinnest.first, thinnest.second)
+    keys = _pair_keys(owners, thinnest.first, thinnest.second)
     if thinnest.thickness <= 0:
-        depth = "touches" if thinnest.thickness == 0 else f"by {_length_text(thinnest.thickness)}"
+        depth = "touches" if thinnest.thickness == 0 else f"by {length_text(thinnest.thickness)}"
         if thinnest.first == "profile":
             what = "touches the teeth" if thinnest.thickness == 0 else f"cuts into the teeth {depth}"
             msg = f"{second} {what} (root radius {profile.root_radius:.3f} mm)"
@@ -658,7 +588,7 @@ def _disc_geometry(case: Case) -> DiscGeometry:
         raise GeometryError(f"{msg} {near}; move or shrink {them} ({keys})")
     if thinnest.thickness < min_wall:
         raise GeometryError(
-            f"the wall between {first} and {second} is only {_length_text(thinnest.thickness)} thick "
+            f"the wall between {first} and {second} is only {length_text(thinnest.thickness)} thick "
             f"(mesh.min_wall = {min_wall} mm), {near}; move or shrink the features ({keys}), or lower "
             "'mesh.min_wall' if such a thin wall is intended")
     return DiscGeometry(case=case, profile=profile, central_hole=central, bores=bores,
