@@ -249,6 +249,238 @@ def _gauss(n: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (x + 1.0), 0.5 * w  # on [0, 1]
 
 
+def _footprint_arcs(
+    chain: BoundaryChain,
+    centres: np.ndarray,
+    half_widths: np.ndarray | float,
+    shape: str,
+) -> tuple[np.ndarray, np.ndarray, tuple[float, ...]]:
+    """Checked footprint centres and half-widths, and the shifts under which a chain is searched.
+
+    Parameters
+    ----------
+    chain : BoundaryChain
+    centres : array_like
+        ``(m,)`` arc length of the footprint centres, mm.
+    half_widths : array_like or float
+        ``(m,)`` or scalar footprint half-width a, mm.
+    shape : str
+        Name of the footprint density; only checked here.
+
+    Returns
+    -------
+    c : numpy.ndarray
+        ``(m,)`` float64 centres, mm; wrapped into [0, L) on a closed chain of length L.
+    a : numpy.ndarray
+        ``(m,)`` float64 half-widths, mm (a writable copy).
+    shifts : tuple of float
+        Arc-length shifts of the chain, mm: (−L, 0, L) on a closed chain, so that a footprint
+        crossing the seam s = 0 ≡ L also finds the edges on the other side of it; (0,) on an
+        open chain.
+
+    Raises
+    ------
+    ValueError
+        As :func:`footprint_weights`.
+    """
+    c = np.atleast_1d(np.asarray(centres, dtype=np.float64))
+    a = np.broadcast_to(np.asarray(half_widths, dtype=np.float64), c.shape).copy()
+    if c.ndim != 1:
+        raise ValueError("centres must be one-dimensional")
+    if (a <= 0.0).any():
+        raise ValueError("footprint half-widths must be positive")
+    if shape not in ("elliptic", "uniform"):
+        raise ValueError(f"unknown footprint shape {shape!r}")
+    length = chain.length
+    if chain.closed:
+        if (a >= 0.5 * length).any():
+            raise ValueError("footprint half-width must be less than half the loop length")
+        c = np.mod(c, length)
+        shifts = (-length, 0.0, length)
+    else:
+        if (c - a < -1e-12 * length).any() or (c + a > length * (1 + 1e-12)).any():
+            raise ValueError("footprint runs off the end of an open boundary chain")
+        shifts = (0.0,)
+    return c, a, shifts
+
+
+def _footprint_edges(
+    chain: BoundaryChain,
+    c: np.ndarray,
+    a: np.ndarray,
+    shifts: tuple[float, ...],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every pair of a footprint and a (shifted) chain edge whose arcs may overlap.
+
+    Edge k spans the arc lengths ``[s_k + h, s_{k+1} + h]`` under the shift h; footprint j spans
+    ``[c_j − a_j, c_j + a_j]``. Both are sorted intervals, so the candidate edges of a footprint
+    are one contiguous run found by two binary searches; pairs that merely touch are discarded
+    later by :func:`_footprint_pieces`.
+
+    Parameters
+    ----------
+    chain : BoundaryChain
+    c, a : numpy.ndarray
+        ``(m,)`` centres and half-widths from :func:`_footprint_arcs`, mm.
+    shifts : tuple of float
+        Arc-length shifts of the chain, mm (:func:`_footprint_arcs`).
+
+    Returns
+    -------
+    cols : numpy.ndarray
+        ``(n,)`` footprint (column) index of each pair.
+    eidx : numpy.ndarray
+        ``(n,)`` index of the pair's edge in ``chain.edges``.
+    shift : numpy.ndarray
+        ``(n,)`` the shift under which the pair was found, mm.
+    """
+    s0, s1 = chain.s[:-1], chain.s[1:]
+    lo, hi = c - a, c + a
+    col_l, edge_l, shift_l = [], [], []
+    for sh in shifts:
+        first = np.searchsorted(s1 + sh, lo, side="right")
+        last = np.searchsorted(s0 + sh, hi, side="left")
+        cnt = np.maximum(last - first, 0)
+        if cnt.sum() == 0:
+            continue
+        cols = np.repeat(np.arange(len(c)), cnt)
+        offs = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        col_l.append(cols)
+        edge_l.append(np.repeat(first, cnt) + offs)
+        shift_l.append(np.full(cnt.sum(), sh))
+    return np.concatenate(col_l), np.concatenate(edge_l), np.concatenate(shift_l)
+
+
+def _footprint_pieces(
+    chain: BoundaryChain,
+    c: np.ndarray,
+    a: np.ndarray,
+    cols: np.ndarray,
+    eidx: np.ndarray,
+    shift: np.ndarray,
+) -> tuple[np.ndarray, ...]:
+    """The overlap of each footprint and edge, relative to the footprint centre.
+
+    Working in v = s − c ∈ [−a, a] rather than in s gives neighbouring pieces of one footprint
+    bit-identical break points, so their weights telescope to 1 without cancellation error.
+
+    Parameters
+    ----------
+    chain : BoundaryChain
+    c, a : numpy.ndarray
+        ``(m,)`` centres and half-widths, mm.
+    cols, eidx, shift : numpy.ndarray
+        ``(n,)`` candidate pairs from :func:`_footprint_edges`.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(cols, eidx, aa, v_start, le, v0, v1)``, each ``(p,)`` for the p pairs that overlap on
+        an arc of positive length: column and edge index, the footprint's half-width a (mm), the
+        edge's start relative to the centre (mm), the edge's length (mm) and the overlap
+        ``[v0, v1]`` ⊂ [−a, a] (mm).
+    """
+    s0, s1 = chain.s[:-1], chain.s[1:]
+    cc, aa = c[cols], a[cols]
+    v_start = (s0[eidx] + shift) - cc                       # edge start, relative to the centre
+    v_end = (s1[eidx] + shift) - cc
+    le = s1[eidx] - s0[eidx]
+    v0 = np.maximum(-aa, v_start)
+    v1 = np.minimum(aa, v_end)
+    keep = v1 > v0
+    return tuple(x[keep] for x in (cols, eidx, aa, v_start, le, v0, v1))
+
+
+def _footprint_quadrature(
+    shape: str,
+    aa: np.ndarray,
+    v0: np.ndarray,
+    v1: np.ndarray,
+    n_quad: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss points and weights of the footprint density ρ over each piece ``[v0, v1]``.
+
+    * ``"elliptic"``, ρ(v) = 2/(π a) · √(1 − (v/a)²) ([2]_ eq. 4.43): with v = a sin θ,
+      ρ dv = (2/π) cos²θ dθ, which is smooth, so the ``n_quad`` Gauss–Legendre points are placed
+      in θ ∈ [arcsin(v0/a), arcsin(v1/a)] and the rule converges exponentially despite the
+      square-root edges of ρ at v = ±a;
+    * ``"uniform"``, ρ = 1/(2a): the points are placed in v directly.
+
+    Parameters
+    ----------
+    shape : {"elliptic", "uniform"}
+    aa : numpy.ndarray
+        ``(p,)`` half-width a of each piece's footprint, mm.
+    v0, v1 : numpy.ndarray
+        ``(p,)`` ends of the pieces relative to the footprint centre, mm (−a ≤ v0 < v1 ≤ a).
+    n_quad : int
+        Gauss points per piece.
+
+    Returns
+    -------
+    vq : numpy.ndarray
+        ``(p, n_quad)`` positions of the points relative to the footprint centre, mm.
+    wt : numpy.ndarray
+        ``(p, n_quad)`` weights ρ dv of the points (dimensionless): ∑ wt f(vq) ≈ ∫ ρ f dv over
+        the piece, and the weights of a whole footprint sum to 1.
+    """
+    tq, wq = _gauss(n_quad)
+    if shape == "elliptic":
+        th0 = np.arcsin(np.clip(v0 / aa, -1.0, 1.0))
+        th1 = np.arcsin(np.clip(v1 / aa, -1.0, 1.0))
+        th = th0[:, None] + tq[None] * (th1 - th0)[:, None]
+        vq = aa[:, None] * np.sin(th)
+        wt = (th1 - th0)[:, None] * wq[None] * (2.0 / np.pi) * np.cos(th) ** 2
+    else:
+        vq = v0[:, None] + tq[None] * (v1 - v0)[:, None]
+        wt = (v1 - v0)[:, None] * wq[None] / (2.0 * aa[:, None])
+    return vq, wt
+
+
+def _footprint_matrix(
+    model: FEModel,
+    chain: BoundaryChain,
+    cols: np.ndarray,
+    eidx: np.ndarray,
+    v_start: np.ndarray,
+    le: np.ndarray,
+    vq: np.ndarray,
+    wt: np.ndarray,
+    n_columns: int,
+) -> sp.csc_matrix:
+    """Consistent nodal weights W[i, j] = ∫ ρ_j φ_i ds from the quadrature of every piece.
+
+    The shape functions φ_i of the edge's nodes (:func:`_edge_shape`) are evaluated at the local
+    coordinate t = (v − v_start)/le ∈ [0, 1] of each point and weighted with ρ dv ([1]_ § 3.5);
+    the contributions of all pieces to a node are summed by the sparse constructor.
+
+    Parameters
+    ----------
+    model : FEModel
+    chain : BoundaryChain
+    cols, eidx, v_start, le : numpy.ndarray
+        ``(p,)`` column, edge index, edge start relative to the centre (mm) and edge length (mm)
+        of each piece (:func:`_footprint_pieces`).
+    vq, wt : numpy.ndarray
+        ``(p, n_quad)`` points (mm) and weights (dimensionless) from
+        :func:`_footprint_quadrature`.
+    n_columns : int
+        Number of footprints m.
+
+    Returns
+    -------
+    scipy.sparse.csc_matrix
+        ``(n_nodes, m)``.
+    """
+    t = np.clip((vq - v_start[:, None]) / le[:, None], 0.0, 1.0)
+    phi = _edge_shape(model.order, t)                      # (n_local, n_pieces, n_quad)
+    vals = np.einsum("lpq,pq->pl", phi, wt)                # (n_pieces, n_local)
+    nodes = _edge_nodes(model, chain.edges[eidx])          # (n_pieces, n_local)
+    rows = nodes.ravel()
+    cidx = np.broadcast_to(cols[:, None], nodes.shape).ravel()
+    return sp.csc_matrix((vals.ravel(), (rows, cidx)), shape=(model.n_nodes, n_columns))
+
+
 def footprint_weights(
     model: FEModel,
     chain: BoundaryChain,
@@ -270,6 +502,11 @@ def footprint_weights(
     is integrated separately with ``n_quad`` Gauss points; for the elliptic density in the
     variable θ = arcsin((s − c)/a), where ρ ds = (2/π) cos²θ dθ is smooth, so the quadrature
     converges exponentially despite the square-root edges of ρ.
+
+    The steps are parts of their own: the checked arcs (:func:`_footprint_arcs`), the edges each
+    arc may overlap (:func:`_footprint_edges`), the overlaps (:func:`_footprint_pieces`), the
+    quadrature of ρ over them (:func:`_footprint_quadrature`) and the consistent nodal weights
+    (:func:`_footprint_matrix`).
 
     Parameters
     ----------
@@ -300,71 +537,11 @@ def footprint_weights(
         For a non-positive half-width, a footprint running off an open chain, or a half-width
         of half the loop or more.
     """
-    c = np.atleast_1d(np.asarray(centres, dtype=np.float64))
-    a = np.broadcast_to(np.asarray(half_widths, dtype=np.float64), c.shape).copy()
-    if c.ndim != 1:
-        raise ValueError("centres must be one-dimensional")
-    if (a <= 0.0).any():
-        raise ValueError("footprint half-widths must be positive")
-    if shape not in ("elliptic", "uniform"):
-        raise ValueError(f"unknown footprint shape {shape!r}")
-    length = chain.length
-    if chain.closed:
-        if (a >= 0.5 * length).any():
-            raise ValueError("footprint half-width must be less than half the loop length")
-        c = np.mod(c, length)
-        shifts = (-length, 0.0, length)
-    else:
-        if (c - a < -1e-12 * length).any() or (c + a > length * (1 + 1e-12)).any():
-            raise ValueError("footprint runs off the end of an open boundary chain")
-        shifts = (0.0,)
-
-    s0, s1 = chain.s[:-1], chain.s[1:]
-    lo, hi = c - a, c + a
-    col_l, edge_l, shift_l = [], [], []
-    for sh in shifts:
-        first = np.searchsorted(s1 + sh, lo, side="right")
-        last = np.searchsorted(s0 + sh, hi, side="left")
-        cnt = np.maximum(last - first, 0)
-        if cnt.sum() == 0:
-            continue
-        cols = np.repeat(np.arange(len(c)), cnt)
-        offs = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        col_l.append(cols)
-        edge_l.append(np.repeat(first, cnt) + offs)
-        shift_l.append(np.full(cnt.sum(), sh))
-    cols = np.concatenate(col_l)
-    eidx = np.concatenate(edge_l)
-    shift = np.concatenate(shift_l)
-
-    # Work relative to the footprint centre, v = s − c ∈ [−a, a]: neighbouring pieces then share
-    # bit-identical break points and the weights telescope to 1 without cancellation error.
-    cc, aa = c[cols], a[cols]
-    v_start = (s0[eidx] + shift) - cc                       # edge start, relative to the centre
-    v_end = (s1[eidx] + shift) - cc
-    le = s1[eidx] - s0[eidx]
-    v0 = np.maximum(-aa, v_start)
-    v1 = np.minimum(aa, v_end)
-    keep = v1 > v0
-    cols, eidx, aa, v_start, le, v0, v1 = (x[keep] for x in (cols, eidx, aa, v_start, le, v0, v1))
-
-    tq, wq = _gauss(n_quad)
-    if shape == "elliptic":
-        th0 = np.arcsin(np.clip(v0 / aa, -1.0, 1.0))
-        th1 = np.arcsin(np.clip(v1 / aa, -1.0, 1.0))
-        th = th0[:, None] + tq[None] * (th1 - th0)[:, None]
-        vq = aa[:, None] * np.sin(th)
-        wt = (th1 - th0)[:, None] * wq[None] * (2.0 / np.pi) * np.cos(th) ** 2
-    else:
-        vq = v0[:, None] + tq[None] * (v1 - v0)[:, None]
-        wt = (v1 - v0)[:, None] * wq[None] / (2.0 * aa[:, None])
-    t = np.clip((vq - v_start[:, None]) / le[:, None], 0.0, 1.0)
-    phi = _edge_shape(model.order, t)                      # (n_local, n_pieces, n_quad)
-    vals = np.einsum("lpq,pq->pl", phi, wt)                # (n_pieces, n_local)
-    nodes = _edge_nodes(model, chain.edges[eidx])          # (n_pieces, n_local)
-    rows = nodes.ravel()
-    cidx = np.broadcast_to(cols[:, None], nodes.shape).ravel()
-    return sp.csc_matrix((vals.ravel(), (rows, cidx)), shape=(model.n_nodes, len(c)))
+    c, a, shifts = _footprint_arcs(chain, centres, half_widths, shape)
+    cols, eidx, shift = _footprint_edges(chain, c, a, shifts)
+    cols, eidx, aa, v_start, le, v0, v1 = _footprint_pieces(chain, c, a, cols, eidx, shift)
+    vq, wt = _footprint_quadrature(shape, aa, v0, v1, n_quad)
+    return _footprint_matrix(model, chain, cols, eidx, v_start, le, vq, wt, len(c))
 
 
 def load_operator(model: FEModel, weights: sp.spmatrix, directions: np.ndarray) -> sp.csc_matrix:
