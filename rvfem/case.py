@@ -942,9 +942,11 @@ def _check_mesh(case: Case) -> None:
 
 
 FOOTPRINT_ELEMENTS = 1.5
-"""Half-width of the pin and roller load footprints in element sizes; the same number as
-:data:`rvfem.cycle.FOOTPRINT_ELEMENTS`, which spreads the loads (a test keeps them equal; here so
-that reading a case does not import the solver)."""
+"""Half-width of the pin and roller load footprints in element sizes (mesh.size_flank at the
+profile, mesh.size_bore at the bores); the solver spreads the loads over it (:mod:`rvfem.cycle`),
+the case bounds the mesh sizes with it. The Hertz half-widths of these contacts (≈0.1 mm) are below
+one element at the default sizes, so the footprint spreads each force over a few elements; the
+bearing loads do not depend on it (global equilibrium), only the stress right under a contact."""
 
 BORE_FOOTPRINT_FRACTION = 0.25
 """Largest part of a bore's circumference a roller footprint (2·FOOTPRINT_ELEMENTS·size_bore wide)

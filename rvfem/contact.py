@@ -561,7 +561,7 @@ def palmgren_law(length: float, contacts: int = 2):
 
     δ = contacts · 3.84e-5 · Q^0.9 / L^0.8  (δ mm, Q N, L mm; Harris & Kotzalas, *Rolling Bearing
     Analysis*, line contact, one roller–raceway contact each; see
-    :func:`rvfem.evaluation.palmgren_approach`), inverted to
+    :func:`rvfem.hertz.palmgren_approach`), inverted to
     Q(δ) = (δ · L^0.8 / (contacts · 3.84e-5))^(1/0.9) for δ > 0, 0 otherwise.
 
     Returns a function ``law(delta) -> (Q, dQ/dδ)`` (arrays).

@@ -74,7 +74,7 @@ from threadpoolctl import threadpool_limits
 
 from . import contact, registry
 from ._arrays import max_load_index
-from .case import Case
+from .case import FOOTPRINT_ELEMENTS, Case
 from .contact import AngleSolution, Compliance, ContactSet, Interface
 from .crankshaft import crankshaft_influence
 from .errors import CaseError, ContactError
@@ -135,13 +135,6 @@ class OperatingPoint:
     def disc_torque_Nmm(self, case: Case) -> float:
         """The torque of one disc with the equal share T_out/discs, N·mm."""
         return self.torque_Nm * 1000.0 / case.loads.discs
-
-
-FOOTPRINT_ELEMENTS = 1.5
-"""Half-width of the pin and roller load footprints in element sizes (mesh.size_flank at the
-profile, mesh.size_bore at the bores). The Hertz half-widths of these contacts (≈0.1 mm) are below
-one element at the default sizes, so the footprint spreads each force over a few elements; the
-bearing loads do not depend on it (global equilibrium), only the stress right under a contact."""
 
 
 @dataclass(frozen=True)
@@ -258,30 +251,8 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     rigid = fem.rigid_body_modes(model)  # about the disc centre (the origin)
 
     t0 = time.perf_counter()
-    centres = crank_centres(case)
-    names = ["profile"] + [f"bore_{i}" for i in range(case.cranks.count)]
-    boundaries = {n: mesh.boundaries[n] for n in names}
-    half = {"profile": FOOTPRINT_ELEMENTS * case.mesh.size_flank}
-    for i in range(case.cranks.count):
-        half[f"bore_{i}"] = FOOTPRINT_ELEMENTS * case.mesh.size_bore
-    iface = contact.build_interface(model, boundaries, rigid,
-                                    {f"bore_{i}": centres[i] for i in range(len(centres))}, half,
-                                    {name: column_stride for name in boundaries})
-    symmetry = int(getattr(mesh, "symmetry", 1))
-    rotation = node_rotation = None
-    if symmetry > 1:
-        from .errors import MeshError
-        from .mesh import rotation_permutation
-
-        rotation = contact.column_rotation(iface, symmetry)
-        try:
-            node_rotation = rotation_permutation(model.node_coords, symmetry)
-        except MeshError:
-            rotation = None
-        if rotation is None:
-            log.warning("the mesh is marked %d-fold symmetric but its interface is not; solving the "
-                        "full disc", symmetry)
-            symmetry, node_rotation = 1, None
+    iface = _footprint_interface(case, mesh, model, rigid, column_stride)
+    rotation, node_rotation, symmetry = _interface_symmetry(iface, model, int(getattr(mesh, "symmetry", 1)))
     times["interface"] = time.perf_counter() - t0
     compliance = Compliance(factor.solve, iface.B, factor.batch, None if factor.concurrent else 1, rigid_modes=rigid,
                             vertex_dofs=model.node_dofs[:model.n_vertices].ravel(),
@@ -289,6 +260,42 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
                       stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
                       pin_stiffness_N_per_mm, times, bearings, pins, symmetry, node_rotation)
+
+
+def _footprint_interface(case: Case, mesh, model, rigid: np.ndarray, column_stride: int) -> Interface:
+    """The contact interface of the profile and the bores: load footprints of ±FOOTPRINT_ELEMENTS
+    element sizes (:func:`rvfem.contact.build_interface`), columns at every ``column_stride``-th
+    boundary vertex."""
+    centres = crank_centres(case)
+    names = ["profile"] + [f"bore_{i}" for i in range(case.cranks.count)]
+    boundaries = {n: mesh.boundaries[n] for n in names}
+    half = {"profile": FOOTPRINT_ELEMENTS * case.mesh.size_flank}
+    for i in range(case.cranks.count):
+        half[f"bore_{i}"] = FOOTPRINT_ELEMENTS * case.mesh.size_bore
+    return contact.build_interface(model, boundaries, rigid,
+                                   {f"bore_{i}": centres[i] for i in range(len(centres))}, half,
+                                   {name: column_stride for name in boundaries})
+
+
+def _interface_symmetry(iface: Interface, model, symmetry: int) -> tuple:
+    """(column rotation, node rotation, N) of a mesh marked N-fold symmetric; (None, None, 1) when
+    it is not, or when its interface turns out not to be (logged: the full disc is solved)."""
+    if symmetry <= 1:
+        return None, None, 1
+    from .errors import MeshError
+    from .mesh import rotation_permutation
+
+    rotation = contact.column_rotation(iface, symmetry)
+    node_rotation = None
+    try:
+        node_rotation = rotation_permutation(model.node_coords, symmetry)
+    except MeshError:
+        rotation = None
+    if rotation is None:
+        log.warning("the mesh is marked %d-fold symmetric but its interface is not; solving the "
+                    "full disc", symmetry)
+        return None, None, 1
+    return rotation, node_rotation, symmetry
 
 
 def pin_contacts(system: DiscSystem, theta: float, friction: float, pc=None):
@@ -900,6 +907,8 @@ class CycleResult:
         Bearing forces on disc A (at θ) and disc B (at θ + 180°), carrier frame, N.
     eccentric_displacement : ndarray (n, discs, N, 2) or None
         Eccentric displacements relative to the carrier (crankshaft deflection), mm.
+    crankshaft_influence : ndarray (discs, discs) or None
+        The stage's crankshaft influence matrix, mm/N (None: rigid eccentrics).
     """
 
     theta: np.ndarray
@@ -920,6 +929,7 @@ class CycleResult:
     disc_torque_Nmm: np.ndarray | None = None
     disc_bearing_forces: np.ndarray | None = None
     eccentric_displacement: np.ndarray | None = None
+    crankshaft_influence: np.ndarray | None = None
 
     @property
     def bearing_loads(self) -> np.ndarray:
@@ -1201,6 +1211,55 @@ def _turned_bearing_forces(result, k: int, order: int) -> np.ndarray:
 # ------------------------------------------------------------------------------------------------
 
 
+def _prefetch_stage(stage: ReducerStage, systems: list, thetas: np.ndarray, solve_at, source, step: float,
+                    op: OperatingPoint) -> None:
+    """Build the contacts of every angle a disc is solved at and of every angle disc A is turned to,
+    in one sweep per system, and compute the compliance columns the cycle will likely need
+    (:func:`likely_columns`) in one parallel sweep per system."""
+    wanted = [[] for _ in systems]
+    for i, swap, k in source:
+        own = _disc_angles(stage, float(thetas[i]))
+        if (swap, k) == (0, 0):
+            for d in range(len(systems)):
+                wanted[d].append(own[d])
+        else:
+            wanted[0].append(own[swap] + k * step)
+    for d, s in enumerate(systems):
+        contact_sets(s, wanted[d], op)           # the solved angles are among them (source[i] = i)
+    for s in {id(s): s for s in systems}.values():
+        ks = [k for k, t in enumerate(systems) if t is s]
+        sets = [contact_set(systems[k], _disc_angles(stage, float(thetas[i]))[k], op)[0]
+                for i in solve_at for k in ks]
+        s.compliance.ensure(likely_columns(s, sets, stage.carrier_torque_Nmm(op)))
+
+
+def _stage_angle(stage: ReducerStage, pair: PairResult, swap: int, k: int, theta: float, order: int,
+                 op: OperatingPoint) -> tuple:
+    """Disc A's result at θ and (bearing forces, torques, eccentric displacements) of the stage,
+    from the solved ``pair`` that symmetry maps onto θ: itself, its discs swapped (``swap``: the
+    mirrored pair at θ + π) and/or turned by ``k`` steps of 2π/N."""
+    src = pair.results[::-1] if swap else pair.results      # mirrored pair: disc B is disc A at θ + π
+    if (swap, k) == (0, 0):
+        return _first_and_loads(pair)
+    # disc A's solution turned by k steps (its contacts checked against the turned ones); disc B,
+    # which may land at θ + π − 2π when the discs are swapped (the same state, the cycle being
+    # 2π-periodic: roller_angles), enters only through its bearing forces and torque, turned and
+    # unchanged
+    system = stage.first
+    try:
+        step = 2.0 * math.pi / order
+        turned_theta = src[0].theta + k * step
+        first = turn_result(system, src[0], k, contact_set(system, turned_theta, op)[0], op)
+        loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
+                             [r.solution.residual["torque_Nmm"] for r in src])     # turning keeps torques
+    except ValueError as exc:
+        log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(theta))
+        first, loads = _first_and_loads(solve_pair(stage, theta, pair, op=op))
+    if abs(first.theta - theta) > 1e-9:
+        raise RuntimeError(f"symmetry plan lands at {first.theta} instead of {theta}")
+    return first, loads
+
+
 def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoint, progress=None):
     """Solve the stage at every crank angle at the operating point ``op``, each pair started from
     the ones before it (:func:`solve_from_last`). One disc is a stage with one body.
@@ -1229,26 +1288,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoin
     step = 2.0 * math.pi / order
 
     t0 = time.perf_counter()
-
-    def cset(k, theta):
-        return contact_set(systems[k], theta, op)[0]
-
-    # the contacts of every angle a disc is solved at and of every angle disc A is turned to,
-    # built in one sweep per system
-    wanted = [[] for _ in systems]
-    for j, (i, swap, k) in enumerate(source):
-        own = _disc_angles(stage, float(thetas[i]))
-        if (swap, k) == (0, 0):
-            for d in range(len(systems)):
-                wanted[d].append(own[d])
-        else:
-            wanted[0].append(own[swap] + k * step)
-    for d, s in enumerate(systems):
-        contact_sets(s, wanted[d], op)           # the solved angles are among them (source[i] = i)
-    for s in {id(s): s for s in systems}.values():
-        ks = [k for k, t in enumerate(systems) if t is s]
-        s.compliance.ensure(likely_columns(s, [cset(k, _disc_angles(stage, float(thetas[i]))[k])
-                                               for i in solve_at for k in ks], stage.carrier_torque_Nmm(op)))
+    _prefetch_stage(stage, systems, thetas, solve_at, source, step, op)
     t_prefetch = time.perf_counter() - t0
     log.info("stage compliance prefetch %.2f s", t_prefetch)
     pairs: list[PairResult] = []
@@ -1258,25 +1298,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoin
             progress(len(pairs) * n // len(solve_at), n)
     results, torque, forces, w = [], [], [], []
     for j, (i, swap, k) in enumerate(source):
-        src = pairs[i].results
-        if swap:
-            src = src[::-1]                      # mirrored pair: disc B is disc A at θ + π
-        if (swap, k) == (0, 0):
-            first, loads = _first_and_loads(pairs[i])
-        else:
-            # disc A's solution turned by k steps (its contacts checked against the turned ones);
-            # disc B, which may land at θ_j + π − 2π when the discs are swapped (the same state,
-            # the cycle being 2π-periodic: roller_angles), enters only through its bearing forces
-            # and torque, turned and unchanged
-            try:
-                first = turn_result(systems[0], src[0], k, cset(0, src[0].theta + k * step), op)
-                loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
-                                     [r.solution.residual["torque_Nmm"] for r in src])     # turning keeps torques
-            except ValueError as exc:
-                log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(thetas[j]))
-                first, loads = _first_and_loads(solve_pair(stage, float(thetas[j]), pairs[i], op=op))
-            if abs(first.theta - thetas[j]) > 1e-9:
-                raise RuntimeError(f"symmetry plan lands at {first.theta} instead of {thetas[j]}")
+        first, loads = _stage_angle(stage, pairs[i], swap, k, float(thetas[j]), order, op)
         results.append(first)
         forces.append(loads[0])
         torque.append(loads[1])
@@ -1287,6 +1309,7 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoin
         "eccentric_displacement": np.array(w),
         "pair_solves": len(solve_at),
         "stage": stage.describe(),
+        "crankshaft_influence": stage.influence,
         "prefetch_seconds": t_prefetch,
     }
     return results, extras
@@ -1318,8 +1341,8 @@ def likely_columns(system: DiscSystem, sets: list[ContactSet], torque: float) ->
 
 def cycle_angles(case: Case) -> np.ndarray:
     """Crank angles of a full revolution at the case's step (endpoint excluded), rad
-    (:func:`rvfem.rigid.load_cycle_angles`)."""
-    from .rigid import load_cycle_angles
+    (:func:`rvfem.geometry.load_cycle_angles`)."""
+    from .geometry import load_cycle_angles
 
     return load_cycle_angles(case.analysis.angle_step_deg)
 

@@ -75,7 +75,6 @@ __all__ = [
     "mesh_case",
     "mesh_geometry",
     "read_msh",
-    "mesh_preview_png",
     "rotation_permutation",
     "symmetry_order",
     "QUALITY_MEASURE",
@@ -965,26 +964,3 @@ def mesh_case(case: Case, cache_dir: str | os.PathLike = "meshes", *, use_cache:
         except MeshError:
             pass     # unreadable cache entry: re-mesh; the new file replaces it atomically
     return mesh_geometry(geom, path)
-
-
-def mesh_preview_png(mesh: DiscMesh, path: str | os.PathLike, *, title: str | None = None,
-                     dpi: int = 150) -> Path:
-    """Write an off-screen PNG of the mesh: the whole disc and a close-up of the rim under bore 1
-    and the teeth next to it, boundaries coloured (:func:`rvfem.plots.mesh_plot`, matplotlib Agg;
-    no display needed). Returns the path."""
-    from .plots import mesh_plot
-
-    x, y = mesh.points[:, 0], mesh.points[:, 1]
-    # close-up: around the point of bore_0 farthest from the centre (rim under the bore)
-    if "bore_0" in mesh.boundaries:
-        b = mesh.boundary_nodes("bore_0")
-        c = mesh.points[b[np.argmax(np.hypot(x[b], y[b]))]]
-        c = c * (1 + 3.0 / np.hypot(*c))
-    else:
-        c = mesh.points[mesh.boundary_nodes("profile")[0]]
-    return mesh_plot(path, mesh.points, mesh.triangles, mesh.boundaries,
-                     closeup_centre=(float(c[0]), float(c[1])), title=title or f"{mesh.path.stem}",
-                     subtitle=f"{mesh.n_nodes} nodes, {mesh.n_elements} triangles (P1), "
-                              f"min {mesh.quality_measure} = {mesh.min_quality:.3f}",
-                     closeup_title="close-up: rim under bore_0 and teeth", dpi=dpi)
-

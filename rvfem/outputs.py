@@ -563,8 +563,6 @@ def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
 
 
 def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
-    from .crankshaft import crankshaft_influence
-
     cy, case = a.cycle, a.case
     share = None
     disc_b = None
@@ -572,7 +570,7 @@ def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
         s = cy.disc_torque_Nmm[:, 0] / case.loads.disc_torque_Nmm
         share = {"min": float(s.min()), "max": float(s.max())}
         disc_b = float(np.linalg.norm(cy.disc_bearing_forces[:, 1], axis=-1).max())
-    f = crankshaft_influence(case) if a.attribution.final == "crankshafts" else None
+    f = cy.crankshaft_influence if a.attribution.final == "crankshafts" else None
     w = cy.eccentric_displacement
     return {"reducer_stage": {
         "model": cy.stage,

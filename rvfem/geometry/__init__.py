@@ -40,7 +40,7 @@ from .features import (
 )
 from .holes import (FanHoleShape, HoleShape, RoundHoleShape, default_angle_offset, hole_shape, register_hole_shape,
                     unregister_hole_shape)
-from .kinematics import (PinContacts, closest_points, crank_centres, pin_centres, pin_profile_contacts,
+from .kinematics import (PinContacts, load_cycle_angles, closest_points, crank_centres, pin_centres, pin_profile_contacts,
                          pin_profile_contacts_many)
 from .profile import (
     PITCH_BLEND_FRACTION,
@@ -56,6 +56,7 @@ from .profile import (
 )
 
 __all__ = [
+    "load_cycle_angles",
     "Profile",
     "Feature",
     "Circle",
