@@ -243,6 +243,166 @@ def plane_stress_stiffness(scalar_basis: Any, vector_element_dofs: np.ndarray, l
     return k_int
 
 
+def _check_material(order: int, youngs_modulus: float, poissons_ratio: float, thickness: float) -> None:
+    """Reject an unknown element order and non-physical material data.
+
+    Parameters
+    ----------
+    order : int
+        Element order; 1 or 2.
+    youngs_modulus : float
+        E, MPa; positive.
+    poissons_ratio : float
+        ν; 0 ≤ ν < 0.5 (ν = 0.5, the incompressible limit, makes λ infinite).
+    thickness : float
+        b, mm; positive.
+
+    Raises
+    ------
+    ValueError
+        Naming the first offending value.
+    """
+    if order not in (1, 2):
+        raise ValueError(f"element order must be 1 or 2, got {order!r}")
+    if not (youngs_modulus > 0.0):
+        raise ValueError(f"Young's modulus must be positive, got {youngs_modulus!r} MPa")
+    if not (0.0 <= poissons_ratio < 0.5):
+        raise ValueError(f"Poisson's ratio must be in [0, 0.5), got {poissons_ratio!r}")
+    if not (thickness > 0.0):
+        raise ValueError(f"thickness must be positive, got {thickness!r} mm")
+
+
+def _check_triangle_areas(points: np.ndarray, triangles: np.ndarray) -> None:
+    """Reject degenerate (zero-area) triangles.
+
+    Twice the signed area of triangle (a, b, c) is the cross product
+    2A = (b − a)_x (c − a)_y − (b − a)_y (c − a)_x (mm²), positive counter-clockwise. A triangle
+    is degenerate when |2A| ≤ 10⁻¹⁴ · D², D the largest extent of the points along x or y (mm),
+    i.e. its area is at round-off level relative to the mesh's size.
+
+    Parameters
+    ----------
+    points : numpy.ndarray
+        ``(n, 2)`` float64 vertex coordinates, mm.
+    triangles : numpy.ndarray
+        ``(m, 3)`` integer vertex indices, in range.
+
+    Raises
+    ------
+    MeshError
+        With the count of degenerate triangles and the index of the first.
+    """
+    a, b, c = (points[triangles[:, k]] for k in range(3))
+    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    scale2 = np.ptp(points, axis=0).max() ** 2
+    bad = np.abs(area2) <= 1e-14 * scale2
+    if bad.any():
+        raise MeshError(f"{int(bad.sum())} degenerate (zero-area) triangles, e.g. #{int(np.flatnonzero(bad)[0])}")
+
+
+def _checked_mesh(points: np.ndarray, triangles: np.ndarray) -> MeshTri:
+    """The scikit-fem triangle mesh of checked vertex and triangle arrays.
+
+    Parameters
+    ----------
+    points : array_like
+        ``(n, 2)`` vertex coordinates, mm, n ≥ 3; every vertex must belong to a triangle.
+    triangles : array_like of int
+        ``(m, 3)`` vertex indices of the triangles (either orientation), m ≥ 1.
+
+    Returns
+    -------
+    skfem.MeshTri
+        Vertices numbered as ``points`` (float64), triangles as int64.
+
+    Raises
+    ------
+    MeshError
+        For malformed arrays, indices out of range, unused vertices or degenerate triangles
+        (:func:`_check_triangle_areas`).
+    """
+    points = np.asarray(points, dtype=np.float64)
+    triangles = np.asarray(triangles)
+    if points.ndim != 2 or points.shape[1] != 2 or len(points) < 3:
+        raise MeshError(f"points must have shape (n, 2) with n >= 3, got {points.shape}")
+    if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) < 1:
+        raise MeshError(f"triangles must have shape (m, 3), got {triangles.shape}")
+    if not np.issubdtype(triangles.dtype, np.integer):
+        raise MeshError("triangles must hold integer vertex indices")
+    if triangles.min() < 0 or triangles.max() >= len(points):
+        raise MeshError("triangle vertex index out of range")
+    used = np.zeros(len(points), dtype=bool)
+    used[triangles.ravel()] = True
+    if not used.all():
+        raise MeshError(
+            f"{int((~used).sum())} vertices belong to no triangle (e.g. vertex "
+            f"{int(np.flatnonzero(~used)[0])}); remove them before building the model"
+        )
+    _check_triangle_areas(points, triangles)
+    return MeshTri(
+        np.ascontiguousarray(points.T),
+        np.ascontiguousarray(triangles.T.astype(np.int64)),
+    )
+
+
+def _node_maps(mesh: MeshTri, dofs: Dofs, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Edges, Lagrange node coordinates and the node → DOF map of the vector element.
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTri
+    dofs : skfem.assembly.Dofs
+        DOFs of ``ElementVector`` of the scalar P1 or P2 element on ``mesh``.
+    order : int
+        1 or 2.
+
+    Returns
+    -------
+    edges : numpy.ndarray
+        ``(n_edges, 2)`` int64 vertex indices of every mesh edge (scikit-fem's facets).
+    node_coords : numpy.ndarray
+        ``(n_nodes, 2)`` coordinates, mm: the vertices, then for P2 the edge midpoints
+        (a + b)/2 in the order of ``edges``.
+    node_dofs : numpy.ndarray
+        ``(n_nodes, 2)`` int64 global x and y DOF of every node.
+    """
+    edges = np.ascontiguousarray(mesh.facets.T.astype(np.int64))
+    if order == 1:
+        node_coords = mesh.p.T.copy()
+        node_dofs = dofs.nodal_dofs.T.astype(np.int64)
+    else:
+        mid = 0.5 * (mesh.p[:, mesh.facets[0]] + mesh.p[:, mesh.facets[1]])
+        node_coords = np.vstack([mesh.p.T, mid.T])
+        node_dofs = np.vstack([dofs.nodal_dofs.T, dofs.facet_dofs.T]).astype(np.int64)
+    if not np.array_equal(np.sort(node_dofs.ravel()), np.arange(dofs.N)):
+        raise AssertionError("node/DOF map does not cover the DOFs exactly once")  # pragma: no cover
+    return edges, node_coords, node_dofs
+
+
+def _stress_recovery_basis(mesh: MeshTri, scalar: Any) -> Any:
+    """Scalar basis evaluated where stresses are recovered: each triangle's vertices and centroid.
+
+    The four local points are the reference triangle's vertices (0, 0), (1, 0), (0, 1) and its
+    centroid (1/3, 1/3); the weights (1/8 each, summing to the reference area 1/2) are never used
+    for integration.
+
+    Parameters
+    ----------
+    mesh : skfem.MeshTri
+    scalar : skfem.Element
+        The scalar P1 or P2 triangle of the model.
+
+    Returns
+    -------
+    skfem.CellBasis
+    """
+    # Local points (reference triangle vertices 0, 1, 2 and the centroid) for stress recovery.
+    xi = np.array([[0.0, 1.0, 0.0, 1.0 / 3.0], [0.0, 0.0, 1.0, 1.0 / 3.0]])
+    # A scalar basis: the gradient of a displacement component is that of its scalar field, and the
+    # vector basis (2× the functions, half of each zero) would hold 4× the data (77 MB on P2)
+    return Basis(mesh, scalar, quadrature=(xi, np.full(4, 0.125)))
+
+
 def build_model(
     points: np.ndarray,
     triangles: np.ndarray,
@@ -285,65 +445,19 @@ def build_model(
     (:func:`plane_stress_constants`), assembled by :func:`plane_stress_stiffness`.
     scikit-fem's default quadrature (degree 2·order) integrates it exactly on straight-sided
     triangles.
+
+    The parts: :func:`_check_material`, :func:`_checked_mesh` (with
+    :func:`_check_triangle_areas`), :func:`plane_stress_stiffness`, :func:`_node_maps` and
+    :func:`_stress_recovery_basis`.
     """
-    if order not in (1, 2):
-        raise ValueError(f"element order must be 1 or 2, got {order!r}")
-    if not (youngs_modulus > 0.0):
-        raise ValueError(f"Young's modulus must be positive, got {youngs_modulus!r} MPa")
-    if not (0.0 <= poissons_ratio < 0.5):
-        raise ValueError(f"Poisson's ratio must be in [0, 0.5), got {poissons_ratio!r}")
-    if not (thickness > 0.0):
-        raise ValueError(f"thickness must be positive, got {thickness!r} mm")
-
-    points = np.asarray(points, dtype=np.float64)
-    triangles = np.asarray(triangles)
-    if points.ndim != 2 or points.shape[1] != 2 or len(points) < 3:
-        raise MeshError(f"points must have shape (n, 2) with n >= 3, got {points.shape}")
-    if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) < 1:
-        raise MeshError(f"triangles must have shape (m, 3), got {triangles.shape}")
-    if not np.issubdtype(triangles.dtype, np.integer):
-        raise MeshError("triangles must hold integer vertex indices")
-    if triangles.min() < 0 or triangles.max() >= len(points):
-        raise MeshError("triangle vertex index out of range")
-    used = np.zeros(len(points), dtype=bool)
-    used[triangles.ravel()] = True
-    if not used.all():
-        raise MeshError(
-            f"{int((~used).sum())} vertices belong to no triangle (e.g. vertex "
-            f"{int(np.flatnonzero(~used)[0])}); remove them before building the model"
-        )
-    a, b, c = (points[triangles[:, k]] for k in range(3))
-    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-    scale2 = np.ptp(points, axis=0).max() ** 2
-    bad = np.abs(area2) <= 1e-14 * scale2
-    if bad.any():
-        raise MeshError(f"{int(bad.sum())} degenerate (zero-area) triangles, e.g. #{int(np.flatnonzero(bad)[0])}")
-
-    mesh = MeshTri(
-        np.ascontiguousarray(points.T),
-        np.ascontiguousarray(triangles.T.astype(np.int64)),
-    )
+    _check_material(order, youngs_modulus, poissons_ratio, thickness)
+    mesh = _checked_mesh(points, triangles)
     scalar = _scalar_element(order)
     dofs = Dofs(mesh, ElementVector(scalar))
     lam, mu = plane_stress_constants(youngs_modulus, poissons_ratio)
     stiffness = plane_stress_stiffness(Basis(mesh, scalar), dofs.element_dofs, lam * thickness, mu * thickness)
-
-    edges = np.ascontiguousarray(mesh.facets.T.astype(np.int64))
-    if order == 1:
-        node_coords = mesh.p.T.copy()
-        node_dofs = dofs.nodal_dofs.T.astype(np.int64)
-    else:
-        mid = 0.5 * (mesh.p[:, mesh.facets[0]] + mesh.p[:, mesh.facets[1]])
-        node_coords = np.vstack([mesh.p.T, mid.T])
-        node_dofs = np.vstack([dofs.nodal_dofs.T, dofs.facet_dofs.T]).astype(np.int64)
-    if not np.array_equal(np.sort(node_dofs.ravel()), np.arange(dofs.N)):
-        raise AssertionError("node/DOF map does not cover the DOFs exactly once")  # pragma: no cover
-
-    # Local points (reference triangle vertices 0, 1, 2 and the centroid) for stress recovery.
-    xi = np.array([[0.0, 1.0, 0.0, 1.0 / 3.0], [0.0, 0.0, 1.0, 1.0 / 3.0]])
-    # A scalar basis: the gradient of a displacement component is that of its scalar field, and the
-    # vector basis (2× the functions, half of each zero) would hold 4× the data (77 MB on P2)
-    stress_basis = Basis(mesh, scalar, quadrature=(xi, np.full(4, 0.125)))
+    edges, node_coords, node_dofs = _node_maps(mesh, dofs, order)
+    stress_basis = _stress_recovery_basis(mesh, scalar)
 
     return FEModel(
         mesh=mesh,
