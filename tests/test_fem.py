@@ -26,6 +26,10 @@ from skfem import FacetBasis, LinearForm, asm
 
 from rvfem import fem
 from rvfem.errors import MeshError
+from rvfem.fem import loads as fe_loads
+from rvfem.fem import model as fe_model
+from skfem import ElementTriP1, ElementTriP2, ElementVector
+from skfem.assembly import Dofs
 # the structured meshes, the Lamé closed form and the Dirichlet-Lamé error norms are the ones the
 # verification manual reports (one implementation for both)
 from rvfem.verification import lame_dirichlet_errors, quads_to_triangles
@@ -272,6 +276,46 @@ def test_build_model_rejects_bad_input():
         fem.build_model(pts, tris, E, NU, THICK, order=3)
     with pytest.raises(ValueError, match="Poisson"):
         fem.build_model(pts, tris, E, 0.5, THICK)
+
+
+def test_build_model_parts_check_material_and_mesh():
+    for args, msg in [((3, E, NU, THICK), "order"), ((1, 0.0, NU, THICK), "Young"),
+                      ((1, E, -0.1, THICK), "Poisson"), ((1, E, NU, float("nan")), "thickness")]:
+        with pytest.raises(ValueError, match=msg):
+            fe_model._check_material(*args)
+    fe_model._check_material(2, E, 0.0, THICK)                        # ν = 0 is allowed
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+    tris = np.array([[0, 1, 2], [1, 3, 2]], dtype=np.int32)
+    mesh = fe_model._checked_mesh(pts.tolist(), tris)
+    assert np.array_equal(mesh.p.T, pts) and mesh.t.shape == (3, 2)
+    fe_model._check_triangle_areas(pts, tris[:, ::-1])               # clockwise is fine
+    # a sliver of twice-area 1e-15 on a mesh of extent 1: |2A| ≤ 1e-14·D²
+    sliver = np.vstack([pts, [[0.5, 0.5 + 1e-15]]])
+    with pytest.raises(MeshError, match="1 degenerate.*#1"):
+        fe_model._check_triangle_areas(sliver, np.array([[0, 1, 2], [1, 4, 2]]))
+    with pytest.raises(MeshError, match="integer"):
+        fe_model._checked_mesh(pts, tris.astype(float))
+    with pytest.raises(MeshError, match="out of range"):
+        fe_model._checked_mesh(pts, tris + 1)
+    with pytest.raises(MeshError, match=r"shape \(m, 3\)"):
+        fe_model._checked_mesh(pts, tris[:, :2])
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_node_maps_and_stress_recovery_points(order):
+    pts, tris, _, _ = annulus(5.0, 9.0, 2, 12)
+    m = fem.build_model(pts, tris, E, NU, THICK, order)
+    scalar = ElementTriP1() if order == 1 else ElementTriP2()
+    edges, coords, dofs = fe_model._node_maps(m.mesh, Dofs(m.mesh, ElementVector(scalar)), order)
+    assert edges.dtype == dofs.dtype == np.int64 and edges.flags.c_contiguous
+    assert np.array_equal(edges, m.edges) and np.array_equal(coords, m.node_coords)
+    assert np.array_equal(dofs, m.node_dofs)
+    sb = fe_model._stress_recovery_basis(m.mesh, scalar)
+    tri = m.mesh.t
+    xy = np.moveaxis(np.asarray(sb.global_coordinates()), 0, -1)   # (n_el, 4, 2)
+    p = m.mesh.p.T
+    assert np.allclose(xy[:, :3], np.stack([p[tri[k]] for k in range(3)], axis=1), rtol=0, atol=1e-13)
+    assert np.allclose(xy[:, 3], p[tri].mean(axis=0), rtol=0, atol=1e-13)
 
 
 def test_node_numbering_vertices_first_then_p2_midpoints():
@@ -640,6 +684,98 @@ def test_footprint_validation():
         fem.footprint_weights(m, half, [0.1], 0.5)
     with pytest.raises(ValueError, match="positive"):
         fem.footprint_weights(m, rim, [1.0], 0.0)
+
+
+# the parts of footprint_weights, each against what it promises
+
+
+def test_footprint_arcs_wrap_a_loop_and_check_an_open_chain():
+    pts, tris, inner, outer = annulus(5.0, 9.0, 2, 12)
+    m = fem.build_model(pts, tris, E, NU, THICK, 1)
+    (rim,) = fem.boundary_chains(m, outer)
+    (half,) = fem.boundary_chains(m, outer[:6])
+    L = rim.length
+    c, a, shifts = fe_loads._footprint_arcs(rim, [-1.0, 2.0, L + 3.0], 0.5, "elliptic")
+    assert np.array_equal(c, np.mod([-1.0, 2.0, L + 3.0], L)) and shifts == (-L, 0.0, L)
+    assert np.array_equal(a, [0.5, 0.5, 0.5]) and a.flags.writeable and a.dtype == np.float64
+    c, a, shifts = fe_loads._footprint_arcs(half, 1.0, [0.5], "uniform")
+    assert np.array_equal(c, [1.0]) and shifts == (0.0,)
+    with pytest.raises(ValueError, match="one-dimensional"):
+        fe_loads._footprint_arcs(rim, [[1.0]], 0.5, "elliptic")
+    with pytest.raises(ValueError, match="unknown footprint shape"):
+        fe_loads._footprint_arcs(rim, [1.0], 0.5, "box")
+
+
+def test_footprint_edges_and_pieces_tile_each_footprint_across_the_seam():
+    pts, tris, inner, outer = annulus(5.0, 9.0, 2, 24)
+    m = fem.build_model(pts, tris, E, NU, THICK, 1)
+    (rim,) = fem.boundary_chains(m, outer)
+    k = len(rim.edges)
+    # across the seam s = 0 ≡ L, inside one edge, exactly on a vertex, over several edges
+    c, a, shifts = fe_loads._footprint_arcs(rim, [0.1, 3.0, rim.s[5], 20.0],
+                                            [0.8, 0.2, 1.0, 4.0], "elliptic")
+    cols, eidx, shift = fe_loads._footprint_edges(rim, c, a, shifts)
+    assert {0, k - 1} <= set(eidx[cols == 0].tolist())             # both sides of the seam
+    assert set(shift[(cols == 0) & (eidx == k - 1)].tolist()) == {-rim.length}
+    cols, eidx, aa, v_start, le, v0, v1 = fe_loads._footprint_pieces(rim, c, a, cols, eidx, shift)
+    assert np.all(v1 > v0) and np.array_equal(aa, a[cols])
+    assert np.array_equal(le, rim.s[eidx + 1] - rim.s[eidx])
+    assert np.all(v0 >= v_start) and np.all(v1 <= v_start + le + 1e-14)
+    for j in range(len(c)):
+        order = np.argsort(v0[cols == j])
+        lo, hi = v0[cols == j][order], v1[cols == j][order]
+        # pieces meet at bit-identical break points and cover [−a, a] exactly
+        assert lo[0] == -a[j] and hi[-1] == a[j] and np.array_equal(hi[:-1], lo[1:])
+    assert np.count_nonzero(cols == 2) == 2                            # centred on a vertex
+    assert np.count_nonzero(cols == 1) == 1                            # inside one edge
+
+
+@pytest.mark.parametrize("shape", ["elliptic", "uniform"])
+def test_footprint_quadrature_integrates_the_density_in_closed_form(shape):
+    a = np.array([0.7, 0.7, 2.0, 2.0, 1.3])
+    v0 = np.array([-0.7, -0.2, -2.0, 0.5, -1.3])
+    v1 = np.array([-0.2, 0.7, 2.0, 1.9, 1.3])
+    vq, wt = fe_loads._footprint_quadrature(shape, a, v0, v1, 10)
+    assert vq.shape == wt.shape == (5, 10)
+    assert np.all((vq >= v0[:, None]) & (vq <= v1[:, None]))
+    if shape == "elliptic":
+        # ρ = 2/(πa)·√(1 − (v/a)²), v = a sin θ: ∫ρ dv = (θ + sin θ cos θ)/π,
+        # ∫vρ dv = −2a cos³θ/(3π) between the ends (Johnson eq. 4.43)
+        th0, th1 = np.arcsin(v0 / a), np.arcsin(v1 / a)
+        f = lambda t: (t + np.sin(t) * np.cos(t)) / np.pi            # noqa: E731
+        g = lambda t: -2.0 * a * np.cos(t) ** 3 / (3.0 * np.pi)       # noqa: E731
+        force, moment = f(th1) - f(th0), g(th1) - g(th0)
+    else:
+        force, moment = (v1 - v0) / (2 * a), (v1**2 - v0**2) / (4 * a)
+    assert np.allclose(wt.sum(axis=1), force, rtol=0, atol=1e-14)          # measured 4.8e-15
+    assert np.allclose((wt * vq).sum(axis=1), moment, rtol=0, atol=5e-16)  # measured 1.7e-16 mm
+    assert wt[2].sum() == pytest.approx(1.0, abs=1e-14)                     # a whole footprint
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_footprint_matrix_puts_a_point_load_on_the_edge_nodes(order):
+    """A single quadrature point of weight 1 at local coordinate t gives the nodes of its edge
+    the values of their shape functions there: (1 − t, t) for P1, and for P2 the quadratic
+    (1 − t)(1 − 2t), t(2t − 1), 4t(1 − t) with the midpoint node."""
+    pts, tris, inner, outer = annulus(5.0, 9.0, 2, 12)
+    m = fem.build_model(pts, tris, E, NU, THICK, order)
+    (rim,) = fem.boundary_chains(m, outer)
+    t = 0.3
+    e = 4
+    le = rim.s[e + 1] - rim.s[e]
+    w = fe_loads._footprint_matrix(m, rim, np.array([1]), np.array([e]), np.array([-0.5]),
+                                   np.array([le]), np.array([[-0.5 + t * le]]), np.array([[1.0]]), 2)
+    assert w.shape == (m.n_nodes, 2) and w[:, 0].nnz == 0
+    a_, b_ = rim.edges[e]
+    col = w[:, 1].toarray().ravel()
+    if order == 1:
+        expected = {a_: 1 - t, b_: t}
+    else:
+        mid = m.n_vertices + fem.edge_indices(m, rim.edges[e:e + 1])[0]
+        expected = {a_: (1 - t) * (1 - 2 * t), b_: t * (2 * t - 1), mid: 4 * t * (1 - t)}
+    assert np.count_nonzero(col) == len(expected)
+    for node, value in expected.items():
+        assert col[node] == pytest.approx(value, abs=1e-15)
 
 
 @pytest.mark.parametrize("order", [1, 2])

@@ -313,7 +313,7 @@ def _checked_mesh(points: np.ndarray, triangles: np.ndarray) -> MeshTri:
     Returns
     -------
     skfem.MeshTri
-        Vertices numbered as ``points`` (float64), triangles as int64.
+        Vertices numbered as ``points``.
 
     Raises
     ------
