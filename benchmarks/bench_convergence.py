@@ -9,7 +9,7 @@ load of bearing 0 and their change from the previous (coarser) mesh. The validat
 
 With ``--stress`` it measures instead the convergence of the structural stress peak (the
 ``peak_von_mises_MPa`` of ``rvfem run``: P2 re-solve, away from the contacts) under refinement of
-the holes: the whole analysis (``rvfem.analysis.analyse``, as ``rvfem run`` makes it) with
+the holes: the whole analysis (``rvfem.app.analysis.analyse``, as ``rvfem run`` makes it) with
 ``mesh.size_hole`` multiplied by each of ``--hole-factors`` (default 1, 1/2, 1/4 of the case's),
 the other sizes unchanged. Per mesh it prints the reported peak with its own error estimate, the
 P1 cycle's peak, and the P2 peak maximised over every crank angle within ``--window`` degrees of
@@ -36,8 +36,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rvfem import compare, cycle, postprocess  # noqa: E402
-from rvfem.case import case_from_dict, case_to_dict, load_case  # noqa: E402
+from rvfem.evaluate import compare  # noqa: E402
+from rvfem.solve import cycle  # noqa: E402
+from rvfem.evaluate import postprocess  # noqa: E402
+from rvfem.case.definition import case_from_dict, case_to_dict, load_case  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 
 
@@ -64,7 +66,7 @@ def run(case, order, step, bearing_model, mesh_dir):
 def stress_row(path, size_hole, step, mesh_dir, window_deg):
     """The structural peak of ``rvfem run`` on the case with ``mesh.size_hole = size_hole``, and
     the P2 peak maximised over the crank angles within ``window_deg`` of it."""
-    from rvfem.analysis import analyse
+    from rvfem.app.analysis import analyse
 
     t0 = time.perf_counter()
     analysis = analyse(path, overrides=(f"mesh.size_hole={size_hole!r}",), angle_step_deg=step,

@@ -4,7 +4,7 @@ On ``cases/rv40e_fanholes.toml`` at its default mesh (or the case given), measur
 
 1. the mesh (cached after the first run) and the system set-up: assembly of K, factorisation on
    the 3-DOF support, footprint interface;
-2. the 360-angle load cycle at 1° with the condensed solver (:func:`rvfem.cycle.load_cycle`):
+2. the 360-angle load cycle at 1° with the condensed solver (:func:`rvfem.solve.cycle.load_cycle`):
    interface compliance columns computed once (in one parallel sweep over the columns the cycle
    will need) and reused by every angle, small dense active-set systems per angle;
 3. a handful of angles solved *naively*: each angle factorises K afresh and back-substitutes the
@@ -45,8 +45,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rvfem import contact, crankshaft, cycle, fem  # noqa: E402
-from rvfem.case import load_case  # noqa: E402
+from rvfem import fem  # noqa: E402
+from rvfem.solve import contact  # noqa: E402
+from rvfem.fem import crankshaft  # noqa: E402
+from rvfem.solve import cycle  # noqa: E402
+from rvfem.case.definition import load_case  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 
 
@@ -153,7 +156,7 @@ def _role(pid: int) -> str:
         cmd = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
     except OSError:
         return "other"
-    if "rvfem.render import _serve" in cmd:
+    if "rvfem.outputs.render import _serve" in cmd:
         return "render worker"
     if "rvfem._child import _serve" in cmd:
         return "P2 model process"
@@ -167,7 +170,7 @@ def run_stages(case_path: str) -> tuple[float, dict, dict]:
     count the benchmark's own memory, which a forked child shows until it executes the
     interpreter), and their sum (an upper bound of what the run holds at once)."""
     with tempfile.TemporaryDirectory() as tmp:
-        cmd = [sys.executable, "-m", "rvfem.cli", "run", case_path, "-o", str(Path(tmp) / "out")]
+        cmd = [sys.executable, "-m", "rvfem.app.cli", "run", case_path, "-o", str(Path(tmp) / "out")]
         t0 = time.perf_counter()
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         peak, roles = {}, {}

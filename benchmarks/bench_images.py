@@ -1,7 +1,7 @@
-"""Benchmark: wall time of the image set of ``rvfem run`` (:func:`rvfem.outputs.write_images`).
+"""Benchmark: wall time of the image set of ``rvfem run`` (:func:`rvfem.outputs.summary.write_images`).
 
 Analyses the case once (``cases/rv40e_fanholes.toml`` at its default mesh, or the case given)
-with :func:`rvfem.analysis.analyse`, checks off-screen rendering once (as ``rvfem run`` does in its
+with :func:`rvfem.app.analysis.analyse`, checks off-screen rendering once (as ``rvfem run`` does in its
 "check" stage, before the clock), then writes the image set into a fresh folder ``--repeat`` times
 and reports
 
@@ -18,12 +18,12 @@ and reports
 The first repeat pays the imports (PyVista, VTK, matplotlib) and the first OpenGL context, as a
 real run does; ``--warm`` renders the set once untimed beforehand to see the steady state.
 
-``--worker`` times the set as ``rvfem run`` draws it: by a :class:`rvfem.render.RenderWorker`
+``--worker`` times the set as ``rvfem run`` draws it: by a :class:`rvfem.outputs.render.RenderWorker`
 (a child process, started, checked and warmed up before the clock, as during a run's analysis),
 the stress images, the mesh picture and the plots; the CPU time then includes the child's whole
 life (its start and warm-up too), and the own times of the calls (made in the child) are not
 recorded. One difference: ``rvfem run`` has the mesh picture drawn during its load cycle
-(:func:`rvfem.outputs.start_mesh_picture`), here it is submitted with the images.
+(:func:`rvfem.outputs.summary.start_mesh_picture`), here it is submitted with the images.
 
 Run from the repository root::
 
@@ -63,12 +63,13 @@ def _cpu_s() -> float:
 def _timed_calls():
     """Time the calls that draw or write one image, by file name: ``{"draw": {...}, "png": {...}}``.
 
-    "draw" is the stress image's own call (:meth:`rvfem.render.StressRenderer.write`, which
-    hands its PNG to a background writer, or :func:`rvfem.render.stress_image` of earlier
-    versions, which writes it) and the mesh picture (:func:`rvfem.plots.mesh_plot`, in its own
+    "draw" is the stress image's own call (:meth:`rvfem.outputs.render.StressRenderer.write`, which
+    hands its PNG to a background writer, or :func:`rvfem.outputs.render.stress_image` of earlier
+    versions, which writes it) and the mesh picture (:func:`rvfem.outputs.plots.mesh_plot`, in its own
     thread); "png" is the background PNG writer.
     """
-    from rvfem import plots, render
+    from rvfem.outputs import plots
+    from rvfem.outputs import render
 
     times: dict[str, dict[str, float]] = {"draw": {}, "png": {}}
     targets = [(plots, "mesh_plot", 0, "draw"), (render, "_write_png", 0, "png")]
@@ -99,7 +100,8 @@ def _timed_calls():
 
 
 def _one_set(analysis, folder: Path, worker: bool = False, lead_s: float = 3.0) -> dict:
-    from rvfem import outputs, render
+    from rvfem.outputs import summary as outputs
+    from rvfem.outputs import render
 
     if folder.exists():
         shutil.rmtree(folder)
@@ -148,8 +150,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="with --worker: seconds between starting the worker and the images (default 3)")
     args = parser.parse_args(argv)
 
-    from rvfem.analysis import analyse
-    from rvfem.render import check_rendering
+    from rvfem.app.analysis import analyse
+    from rvfem.outputs.render import check_rendering
 
     load_before = os.getloadavg()
     t = time.perf_counter()

@@ -6,7 +6,7 @@ sharing the carrier → crankshafts as beams (when the case has ``[crank_support
 minimum and equivalent load, their deltas against the handbook and the life ratio; the torque
 share of one disc over the cycle; and, with ``--half-pitch``, the difference between modelling
 disc B as disc A at θ + 180° and the exact disc B whose teeth sit half a tooth pitch from disc A's
-against the bores and holes (a second mesh and compliance; see :mod:`rvfem.cycle`).
+against the bores and holes (a second mesh and compliance; see :mod:`rvfem.solve.cycle`).
 
 Run: ``python benchmarks/bench_reducer.py [CASE ...] [--step 1] [--half-pitch] [--set KEY=VALUE ...]``.
 """
@@ -24,8 +24,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from rvfem import attribution, crankshaft, cycle  # noqa: E402
-from rvfem.case import load_case  # noqa: E402
+from rvfem.evaluate import attribution  # noqa: E402
+from rvfem.fem import crankshaft  # noqa: E402
+from rvfem.solve import cycle  # noqa: E402
+from rvfem.case.definition import load_case  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 
 

@@ -48,13 +48,13 @@ def _study_file(folder: Path, n: int, step: float) -> Path:
 def _run(study_path: Path, workers: int, out: Path, cache: Path) -> dict:
     from distributed import Client
 
-    from rvfem.study import load_study, local_cluster, run_study
+    from rvfem.app.study import load_study, local_cluster, run_study
 
     study = load_study(study_path)
     t0 = time.perf_counter()
     with local_cluster(workers) as cluster, Client(cluster) as client:
-        client.run(__import__, "rvfem.run")  # warm the workers: imports are paid once per worker
-        client.run(__import__, "rvfem.study")
+        client.run(__import__, "rvfem.app.run")  # warm the workers: imports are paid once per worker
+        client.run(__import__, "rvfem.app.study")
         startup = time.perf_counter() - t0
         t1 = time.perf_counter()
         result = run_study(study, out, client=client, cache_dir=cache, plots=False)
@@ -74,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
     args = parser.parse_args(argv)
 
-    from rvfem.case import load_case
+    from rvfem.case.definition import load_case
     from rvfem.mesh import mesh_case
 
     load_before = os.getloadavg()

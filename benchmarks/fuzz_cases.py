@@ -5,14 +5,14 @@ Each input is a shipped case file mutated at random: keys deleted, misspelled or
 replaced by wrong types, zero, negative, nan, ±inf, huge, tiny or denormal numbers; lists made too
 short or too long; optional tables (holes, duty cycle, crank support) added with random values;
 or the text itself damaged (duplicate tables, truncation, garbage or invalid UTF-8 bytes, lines
-deleted). Both commands run in-process (:func:`rvfem.cli.main`) and every run is classified:
+deleted). Both commands run in-process (:func:`rvfem.app.cli.main`) and every run is classified:
 
 ``exit 0``
     valid input; ``rigid --json`` printed strict JSON (no NaN/Infinity);
 ``exit 2``
     refused with one line on stderr that names a key (``'...'``) or the cause;
 ``traceback``
-    an exception escaped :func:`rvfem.cli.main` (a bug);
+    an exception escaped :func:`rvfem.app.cli.main` (a bug);
 ``bad exit``
     any other exit code;
 ``bad message``
@@ -49,9 +49,9 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from rvfem.case import table_class  # noqa: E402
-from rvfem.cli import main as rvfem_main  # noqa: E402
-from rvfem.schema import file_fields  # noqa: E402
+from rvfem.case.definition import table_class  # noqa: E402
+from rvfem.app.cli import main as rvfem_main  # noqa: E402
+from rvfem.case.schema import file_fields  # noqa: E402
 
 CASES_DIR = ROOT / "cases"
 SHIPPED = {p.stem: p.read_text(encoding="utf-8") for p in sorted(CASES_DIR.glob("*.toml"))}
@@ -364,7 +364,7 @@ def _strict_json(text: str) -> Any:
 
 
 def run_cli(argv: list[str]) -> tuple[int | None, str, str, str | None]:
-    """``rvfem.cli.main(argv)`` in-process: (exit code, stdout, stderr, traceback or None)."""
+    """``rvfem.app.cli.main(argv)`` in-process: (exit code, stdout, stderr, traceback or None)."""
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:

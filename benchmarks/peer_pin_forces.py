@@ -21,7 +21,7 @@ k·(2π·Zc/Zp)/8; rvfem's crank angle θ = φ·Zp/Zc = k·45° loads the same p
     approach of Johnson, *Contact Mechanics*, eq. 4.45, at the pin's classical force; the gap of
     each pin is the distance of its centre to a 2000-point polyline of the modified profile less
     the pin radius, negative gaps clamped to zero;
-(b) a locked-crank rigid disc with rvfem's ``hertz`` pin law (:func:`rvfem.contact.hertz_pin_law`,
+(b) a locked-crank rigid disc with rvfem's ``hertz`` pin law (:func:`rvfem.solve.contact.hertz_pin_law`,
     the flank curvature at each contact, the exact gaps of :func:`rvfem.geometry.pin_profile_contacts`):
     one rotation ψ about the disc centre, Σ Q_j(ψ·h_j − g_j)·h_j = T_disc;
 (c) the same with rvfem's ``palmgren`` pin law (one coefficient for every pin);
@@ -73,9 +73,9 @@ from scipy.optimize import brentq
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from rvfem import contact  # noqa: E402
-from rvfem.case import load_case  # noqa: E402
-from rvfem.cycle import FOOTPRINT_ELEMENTS  # noqa: E402
+from rvfem.solve import contact  # noqa: E402
+from rvfem.case.definition import load_case  # noqa: E402
+from rvfem.solve.cycle import FOOTPRINT_ELEMENTS  # noqa: E402
 from rvfem.geometry import disc_geometry, pin_profile_contacts, profile_curvature  # noqa: E402
 
 #: (label, ΔRrp equidistant mm, ΔRp shift mm)
@@ -176,7 +176,7 @@ def rvfem_angle(case, phi: float) -> float:
 def rigid_disc_pins(geometry, theta: float) -> Pins:
     """Pin arms, gaps and flank curvatures at crank angle θ.
 
-    rvfem's disc torque (:mod:`rvfem.contact`, moment about the disc centre) loads the pins with
+    rvfem's disc torque (:mod:`rvfem.solve.contact`, moment about the disc centre) loads the pins with
     h = P × n > 0 (P the contact point, n the profile's outward normal); the FE check (d) loads
     the same pins.
     """
@@ -220,7 +220,7 @@ def hertz_law(case, pins: Pins):
 
 
 def _hertz_params(case, curvature) -> dict:
-    """Parameters of :func:`rvfem.contact.hertz_pin_approach` as :class:`rvfem.models.HertzPins`
+    """Parameters of :func:`rvfem.solve.contact.hertz_pin_approach` as :class:`rvfem.solve.models.HertzPins`
     passes them."""
     return dict(length=case.cycloid.thickness, pin_radius=case.pins.radius,
                 flank_curvature=np.asarray(curvature, dtype=float),
@@ -379,7 +379,7 @@ def fe_distributions(case, thetas, mesh_dir: str, disc_scale: float = 1e3) -> li
     ``disc_scale`` multiplies the disc's Young's modulus in the FE (1000: the rigid-disc check of
     (b); 1: the real disc). The pin law keeps the case's elastic constants either way.
     """
-    from rvfem import cycle
+    from rvfem.solve import cycle
     from rvfem.mesh import mesh_case
 
     system = cycle.build_system(case, mesh_case(case, mesh_dir), bearing_model="rigid_bore",

@@ -1,7 +1,7 @@
 """rvfem: crank-bearing loads of RV reducers with a flexible cycloid disc.
 
 The package is a set of plain functions over plain data (see docs/theory.md): a validated
-:class:`~rvfem.case.Case` goes in, tables of bearing loads, lives and stresses come out. Units are
+:class:`~rvfem.case.definition.Case` goes in, tables of bearing loads, lives and stresses come out. Units are
 mm, N, MPa, rpm and hours throughout; angles are radians inside the code and degrees in case files.
 
 The front door: the few functions a notebook needs, importable from the package itself::
@@ -21,7 +21,7 @@ The front door: the few functions a notebook needs, importable from the package 
 
 They are imported on first use (:pep:`562`), so ``import rvfem`` stays light (no NumPy, SciPy or
 Gmsh) and the package's modules can import it without a circle. Everything else lives in its own
-module (:mod:`rvfem.case`, :mod:`rvfem.cycle`, :mod:`rvfem.outputs`, ...).
+module (:mod:`rvfem.case.definition`, :mod:`rvfem.solve.cycle`, :mod:`rvfem.outputs.summary`, ...).
 """
 
 from __future__ import annotations
@@ -43,17 +43,17 @@ where a sector was possible, and why (``log.info("...", extra=NOTICE)``). Librar
 never prints; the command line shows these records as one "note" line each."""
 
 _FRONT_DOOR = MappingProxyType({
-    "load_case": "case",           # read and validate a case file (with KEY=VALUE overrides)
-    "mesh_case": "mesh",           # mesh the disc of a case (cached)
-    "analyse_rigid": "analysis",   # rigid handbook loads, rating, life, Hertz pressures
-    "analyse": "analysis",         # the whole analysis: rigid and flexible, lives, stresses
-    "run_case": "run",             # the main job: analysis and result folder (rvfem run)
-    "build_system": "cycle",       # one disc model: stiffness factorised, contact columns
-    "OperatingPoint": "cycle",     # what varies between solves of one model: torque, friction
-    "solve_angle": "cycle",        # one crank angle
-    "load_cycle": "cycle",         # a crank revolution
-    "load_study": "study",         # read and validate a design study
-    "run_study": "study",          # run its variants on Dask (rvfem study)
+    "load_case": "case.definition",           # read and validate a case file (with KEY=VALUE overrides)
+    "mesh_case": "mesh",                      # mesh the disc of a case (cached)
+    "analyse_rigid": "app.analysis",          # rigid handbook loads, rating, life, Hertz pressures
+    "analyse": "app.analysis",                # the whole analysis: rigid and flexible, lives, stresses
+    "run_case": "app.run",                    # the main job: analysis and result folder (rvfem run)
+    "build_system": "solve.cycle",            # one disc model: stiffness factorised, contact columns
+    "OperatingPoint": "solve.cycle",          # what varies between solves of one model: torque, friction
+    "solve_angle": "solve.cycle",             # one crank angle
+    "load_cycle": "solve.cycle",              # a crank revolution
+    "load_study": "app.study",                # read and validate a design study
+    "run_study": "app.study",                 # run its variants on Dask (rvfem study)
 })
 """The names importable from ``rvfem`` itself and the module each comes from (imported on first
 use)."""

@@ -1,8 +1,8 @@
-"""``python -m rvfem``: the ``rvfem`` command line (:func:`rvfem.cli.main`)."""
+"""``python -m rvfem``: the ``rvfem`` command line (:func:`rvfem.app.cli.main`)."""
 
 import sys
 
-from .cli import main
+from rvfem.app.cli import main
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())

@@ -3,9 +3,11 @@ ordering of mesh edges and giving freed memory back."""
 
 from __future__ import annotations
 
+import ctypes
+
 import numpy as np
 
-from .errors import MeshError
+from rvfem.errors import MeshError
 
 
 def readonly(a, dtype=None) -> np.ndarray:
@@ -24,7 +26,6 @@ def release_freed_memory() -> None:
     assembly and factorisation that is about 90 MB of the default disc's run, at the time its
     peak is reached; the call takes a few milliseconds and changes no state.
     """
-    import ctypes
 
     try:
         ctypes.CDLL(None).malloc_trim(0)       # the C library already loaded into the process

@@ -1,7 +1,7 @@
 """A child Python process that runs functions for its parent: pickled calls over its standard input,
 pickled results over its standard output.
 
-It is started with ``python -c`` (as the render worker is, :class:`rvfem.render.RenderWorker`), not
+It is started with ``python -c`` (as the render worker is, :class:`rvfem.outputs.render.RenderWorker`), not
 with :mod:`multiprocessing`, whose "spawn" start method imports the parent's main module again in
 the child: a user's script without an ``if __name__ == "__main__"`` guard would run a second time.
 The framing helpers (:func:`frame`, :func:`send`, :func:`receive`, :func:`picklable`,

@@ -18,7 +18,7 @@ Physical groups: curves ``profile``, ``central_hole``, ``bore_0`` …, ``hole_0`
 first, then round holes, then the holes of registered hole shapes) and the surface ``disc``.
 Bores and holes are numbered from 0 (Python indexing; ``bore_0`` is the bore of bearing 1), in
 the file as in :attr:`DiscMesh.boundaries`; what users read is numbered from 1
-(:func:`rvfem.postprocess.user_feature_name`).
+(:func:`rvfem.evaluate.postprocess.user_feature_name`).
 
 Symmetric discs: when the disc maps onto itself under a rotation by 2π/N about its centre (N the
 number of cranks; :func:`symmetry_order`) and ``mesh.symmetric`` is true, only one 360°/N sector is
@@ -46,6 +46,7 @@ Gmsh's global state is only ever touched inside :func:`gmsh_session`.
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import hashlib
 import json
 import logging
@@ -61,11 +62,18 @@ import gmsh
 import numpy as np
 from scipy.spatial import cKDTree
 
-from . import NOTICE
-from ._arrays import chain_edges
-from .case import Case, case_to_dict, registered_hole_shapes
-from .errors import MeshError
-from .geometry import SPLINE_POINTS_PER_SEGMENT, Arc, DiscGeometry, Feature, LineSegment, disc_geometry
+from rvfem import NOTICE
+from rvfem._arrays import chain_edges
+from rvfem.case.definition import Case, case_to_dict, registered_hole_shapes
+from rvfem.errors import MeshError
+from rvfem.geometry import (
+    SPLINE_POINTS_PER_SEGMENT,
+    Arc,
+    DiscGeometry,
+    Feature,
+    LineSegment,
+    disc_geometry,
+)
 
 __all__ = [
     "DiscMesh",
@@ -199,7 +207,6 @@ def _ignore_sigpipe_again() -> None:
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGPIPE, signal.SIG_IGN)
         return
-    import ctypes
 
     try:
         ctypes.CDLL(None).signal(int(signal.SIGPIPE), ctypes.c_void_p(1))          # SIG_IGN

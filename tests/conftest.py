@@ -57,7 +57,7 @@ def coarse_case(name: str, **changes):
     """A shipped case on a coarse mesh (0.6 mm at the flanks and bores, 4 mm inside) with the given
     tables updated (``coarse_case("rv40e_solid", crank_bearing={"stiffness_law": "linear", ...})``):
     fast enough for the science-core tests."""
-    from rvfem.case import case_from_dict, case_to_dict, load_case
+    from rvfem.case.definition import case_from_dict, case_to_dict, load_case
 
     data = case_to_dict(load_case(CASES_DIR / f"{name}.toml"))
     data["mesh"].update(size_flank=0.6, size_bore=0.6, size_interior=4.0)

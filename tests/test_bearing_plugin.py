@@ -15,8 +15,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from rvfem import cli, contact, registry
-from rvfem.models import ContactGroup
+from rvfem.app import cli
+from rvfem.solve import contact
+from rvfem.case import registry
+from rvfem.solve.models import ContactGroup
 
 from conftest import CASES_DIR
 

@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from rvfem.case import Case, case_from_dict, case_to_dict, load_case
+from rvfem.case.definition import Case, case_from_dict, case_to_dict, load_case
 from rvfem.errors import CaseError, RvfemError
 
 from conftest import CASES_DIR
@@ -355,10 +355,11 @@ import copy  # noqa: E402
 import dataclasses  # noqa: E402
 import re  # noqa: E402
 
-from rvfem import case as case_module  # noqa: E402
-from rvfem import registry  # noqa: E402
-from rvfem.case import CrankSupport, estimated_mesh_nodes, table_class  # noqa: E402
-from rvfem.schema import file_fields, render_case_format  # noqa: E402
+from rvfem.case import definition as case_module  # noqa: E402
+from rvfem.case import registry  # noqa: E402
+from rvfem.case.definition import CrankSupport, estimated_mesh_nodes, table_class  # noqa: E402
+from rvfem.case.format_doc import render_case_format  # noqa: E402
+from rvfem.case.schema import file_fields  # noqa: E402
 
 from conftest import ROOT  # noqa: E402
 
@@ -374,7 +375,7 @@ def test_docs_tables_are_generated_from_the_schema():
     path = ROOT / "docs" / "case-format.md"
     text = path.read_text(encoding="utf-8")
     assert render_case_format(text) == text, (
-        "docs/case-format.md is stale; regenerate it with: python -m rvfem.schema docs/case-format.md")
+        "docs/case-format.md is stale; regenerate it with: python -m rvfem.case.format_doc docs/case-format.md")
 
 
 def _all_tables(cls=Case, prefix=""):
@@ -688,7 +689,7 @@ def test_p2_mesh_estimate_counts_edge_nodes(case_text, tmp_path):
 
 
 def test_two_tooth_difference_case_is_valid_and_outside_the_handbook(case_text, tmp_path):
-    from rvfem.rigid import handbook_applicable
+    from rvfem.evaluate.rigid import handbook_applicable
 
     case_text.set("cycloid", "teeth", "38")
     case = load_case(case_text.write(tmp_path))

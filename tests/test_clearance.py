@@ -8,7 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvfem import attribution, contact, cycle
+from rvfem.evaluate import attribution
+from rvfem.solve import contact
+from rvfem.solve import cycle
 from rvfem.mesh import mesh_case
 
 from conftest import CASES_DIR, coarse_case
@@ -98,7 +100,7 @@ def test_a_preload_raises_the_smallest_bearing_load_of_the_fan_hole_disc(mesh_di
 
 
 def test_newton_step_of_a_mechanism_is_none_and_of_a_consistent_system_is_the_solution():
-    """:func:`rvfem.contact._reduced_step` on 2×2 systems: a zero row with a nonzero residual is a
+    """:func:`rvfem.solve.contact._reduced_step` on 2×2 systems: a zero row with a nonzero residual is a
     mechanism (None); a regular one gives −J⁻¹r."""
     J = np.array([[2.0, 0.0], [0.0, 0.0]])
     r = np.array([1.0, 3.0])

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 import rvfem
-from rvfem import __version__, cli
+from rvfem import __version__
+from rvfem.app import cli
 
 from conftest import CASES_DIR, documented_keys, written_keys
 
@@ -127,21 +128,21 @@ def test_every_subcommand_is_registered_once():
 
 def test_entry_point_in_a_subprocess(case_text, tmp_path):
     """The installed module run as a program: verbose logging, a bad case, no traceback."""
-    ok = subprocess.run([sys.executable, "-m", "rvfem.cli", "-vv", "rigid", CRV80E],
+    ok = subprocess.run([sys.executable, "-m", "rvfem.app.cli", "-vv", "rigid", CRV80E],
                         capture_output=True, text=True, timeout=60)
     assert ok.returncode == 0 and "5576.9" in ok.stdout
-    assert "DEBUG rvfem.rigid" in ok.stderr
+    assert "DEBUG rvfem.evaluate.rigid" in ok.stderr
     path = case_text.set("pins", "count", "39").write(tmp_path)
-    bad = subprocess.run([sys.executable, "-m", "rvfem.cli", "rigid", str(path)],
+    bad = subprocess.run([sys.executable, "-m", "rvfem.app.cli", "rigid", str(path)],
                          capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2
     assert bad.stdout == "" and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
 
 
 def test_rigid_is_computed_by_the_library(capsys):
-    """``rvfem rigid --json`` prints what rvfem.analysis.analyse_rigid computes, nothing else."""
-    from rvfem.analysis import analyse_rigid
-    from rvfem.case import load_case
+    """``rvfem rigid --json`` prints what rvfem.app.analysis.analyse_rigid computes, nothing else."""
+    from rvfem.app.analysis import analyse_rigid
+    from rvfem.case.definition import load_case
 
     result = analyse_rigid(load_case(CRV80E))
     assert cli.main(["rigid", CRV80E, "--json"]) == 0
@@ -179,7 +180,7 @@ def test_bad_set_is_one_line_naming_the_key(command, tmp_path, capsys):
 
 
 def test_bearing_model_choices_come_from_the_registry():
-    from rvfem.registry import bearing_model_names
+    from rvfem.case.registry import bearing_model_names
 
     parser = cli.build_parser()
     run = next(a for a in parser._subparsers._group_actions[0].choices["run"]._actions
@@ -188,12 +189,12 @@ def test_bearing_model_choices_come_from_the_registry():
 
 
 def test_internal_error_is_one_line_with_a_log_file(monkeypatch, capsys):
-    import rvfem.analysis
+    import rvfem.app.cli
 
     def broken(case, theta=None):
         raise ZeroDivisionError("float division by zero")
 
-    monkeypatch.setattr(rvfem.analysis, "analyse_rigid", broken)
+    monkeypatch.setattr(rvfem.app.cli, "analyse_rigid", broken)
     assert cli.main(["rigid", CRV80E]) == 1
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "Traceback" not in err
@@ -216,9 +217,9 @@ def test_json_output_is_strict_json_with_null_for_non_finite(monkeypatch, capsys
     """A zero torque gives zero bearing loads and an infinite life: null, never Infinity."""
     import dataclasses
 
-    import rvfem.analysis
+    import rvfem.app.analysis
 
-    real = rvfem.analysis.analyse_rigid
+    real = rvfem.app.analysis.analyse_rigid
 
     def infinite_life(case, theta=None):
         result = real(case, theta)
@@ -227,7 +228,7 @@ def test_json_output_is_strict_json_with_null_for_non_finite(monkeypatch, capsys
                     *result.bearings[1:])
         return dataclasses.replace(result, bearings=bearings)
 
-    monkeypatch.setattr(rvfem.analysis, "analyse_rigid", infinite_life)
+    monkeypatch.setattr(rvfem.app.cli, "analyse_rigid", infinite_life)
     assert cli.main(["rigid", CRV80E, "--json"]) == 0
     text = capsys.readouterr().out
     assert "Infinity" not in text and "NaN" not in text
@@ -242,7 +243,7 @@ def test_run_progress_draws_stages_and_the_cycle(tty):
     """The progress display of ``rvfem run`` (a tqdm bar on a terminal, plain lines otherwise)."""
     import io
 
-    from rvfem.run import STAGES
+    from rvfem.app.run import STAGES
 
     stream = io.StringIO()
     progress = cli._RunProgress(stream, tty)
@@ -263,8 +264,8 @@ def test_run_progress_draws_stages_and_the_cycle(tty):
 
 
 def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
-    from rvfem.case import file_sha256, load_case
-    from rvfem.outputs import RIGID_SCHEMA_VERSION
+    from rvfem.case.definition import file_sha256, load_case
+    from rvfem.outputs.summary import RIGID_SCHEMA_VERSION
 
     duty = str(Path(__file__).resolve().parents[1] / "cases" / "crv80e_duty.toml")
     written = set()
@@ -297,8 +298,8 @@ def test_run_stages_are_numbered_in_the_order_they_start(images, duty):
     import io
     import re
 
-    from rvfem.case import load_case
-    from rvfem.run import STAGES, run_stages
+    from rvfem.case.definition import load_case
+    from rvfem.app.run import STAGES, run_stages
 
     case = load_case(CASES_DIR / ("crv80e_duty.toml" if duty else "rv40e_fanholes.toml"))
     stages = run_stages(case, images=images)
@@ -334,7 +335,7 @@ def test_cycle_progress_gives_the_true_percentage():
 @pytest.mark.parametrize("argv", [["-v", "rigid", CRV80E], ["rigid", CRV80E, "-v"], ["rigid", "-v", CRV80E]])
 def test_verbose_before_or_after_the_subcommand(argv, capsys):
     assert cli.main(argv) == 0
-    assert "INFO rvfem.rigid" in capsys.readouterr().err
+    assert "INFO rvfem.evaluate.rigid" in capsys.readouterr().err
 
 
 def test_verbose_counts_on_both_sides(monkeypatch):

@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from rvfem import contact, fem
+from rvfem import fem
+from rvfem.solve import contact
 from rvfem.errors import ContactError
-from rvfem.verification import squeezed_cylinder_mesh
+from rvfem.app.verification import squeezed_cylinder_mesh
 
 R, L, E, NU = 10.0, 1.0, 2.0e5, 0.3
 H_CONTACT = 0.03  # element size in the contact zones, mm
@@ -167,8 +168,8 @@ def test_reverse_torque_is_the_mirror_image_of_forward_torque(tmp_path, pin_mode
     the contact solve uses the sign of the torque (cold start, likely columns, carrier equation)."""
     import dataclasses
 
-    from rvfem import cycle
-    from rvfem.case import case_from_dict, case_to_dict, load_case
+    from rvfem.solve import cycle
+    from rvfem.case.definition import case_from_dict, case_to_dict, load_case
     from rvfem.mesh import mesh_case
 
     from conftest import CASES_DIR

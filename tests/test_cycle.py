@@ -11,8 +11,11 @@ import math
 import numpy as np
 import pytest
 
-from rvfem import compare, contact, cycle, rigid
-from rvfem.case import case_from_dict, case_to_dict
+from rvfem.evaluate import compare
+from rvfem.solve import contact
+from rvfem.solve import cycle
+from rvfem.evaluate import rigid
+from rvfem.case.definition import case_from_dict, case_to_dict
 from rvfem.errors import ContactError
 from rvfem.mesh import mesh_case
 

@@ -1,4 +1,4 @@
-"""Speed, ISO 281 rating and life, duty cycle (rvfem.iso281) and Hertz contact (rvfem.hertz) against
+"""Speed, ISO 281 rating and life, duty cycle (rvfem.evaluate.iso281) and Hertz contact (rvfem.evaluate.hertz) against
 published numbers and closed forms."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from rvfem.case import DutyRow, load_case
-from rvfem.hertz import (
+from rvfem.case.definition import DutyRow, load_case
+from rvfem.evaluate.hertz import (
     composite_modulus,
     crank_bearing_hertz,
     hertz_half_width,
@@ -18,7 +18,7 @@ from rvfem.hertz import (
     reduced_radius,
     stribeck_max_roller_load,
 )
-from rvfem.iso281 import (
+from rvfem.evaluate.iso281 import (
     bearing_speed_rpm,
     case_duty_cycle_life,
     constant_load_life_hours,
@@ -28,7 +28,7 @@ from rvfem.iso281 import (
     life_ratio,
     rating_life_hours,
 )
-from rvfem.rigid import handbook_bearing_loads, summarize_bearing_loads
+from rvfem.evaluate.rigid import handbook_bearing_loads, summarize_bearing_loads
 
 from conftest import CASES_DIR
 
@@ -230,12 +230,3 @@ def test_case_duty_cycle_uses_the_shortest_life():
     assert d == duty_cycle_life(rows, 6008.0, 15.0, 784.0)
     # a quarter of the time at twice the rated torque: damage rate 0.25·2^(10/3) + 0.75
     assert d.service_life_h == pytest.approx(6008.0 / (0.25 * 2 ** (10 / 3) + 0.75), rel=1e-12)
-
-
-def test_former_module_name_still_exports_the_formulas():
-    import rvfem.contact  # noqa: F401  (imports PALMGREN_COEFFICIENT from rvfem.evaluation)
-    from rvfem import evaluation, hertz, iso281
-
-    assert evaluation.PALMGREN_COEFFICIENT is hertz.PALMGREN_COEFFICIENT == 3.84e-5
-    assert evaluation.rating_life_hours is iso281.rating_life_hours
-    assert evaluation.hertz_line_contact is hertz.hertz_line_contact

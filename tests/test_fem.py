@@ -32,9 +32,9 @@ from skfem import ElementTriP1, ElementTriP2, ElementVector
 from skfem.assembly import Dofs
 # the structured meshes, the Lamé closed form and the Dirichlet-Lamé error norms are the ones the
 # verification manual reports (one implementation for both)
-from rvfem.verification import lame_dirichlet_errors, quads_to_triangles
-from rvfem.verification import kirsch_stress, lame_solution as lame
-from rvfem.verification import structured_annulus as annulus
+from rvfem.app.verification import lame_dirichlet_errors, quads_to_triangles
+from rvfem.app.verification import kirsch_stress, lame_solution as lame
+from rvfem.app.verification import structured_annulus as annulus
 
 E, NU, THICK = 2.1e5, 0.3, 10.0
 

@@ -13,17 +13,17 @@ from conftest import ROOT
 
 #: The front door and the module each name lives in.
 HOMES = {
-    "load_case": "rvfem.case",
+    "load_case": "rvfem.case.definition",
     "mesh_case": "rvfem.mesh",
-    "analyse_rigid": "rvfem.analysis",
-    "analyse": "rvfem.analysis",
-    "run_case": "rvfem.run",
-    "build_system": "rvfem.cycle",
-    "OperatingPoint": "rvfem.cycle",
-    "solve_angle": "rvfem.cycle",
-    "load_cycle": "rvfem.cycle",
-    "load_study": "rvfem.study",
-    "run_study": "rvfem.study",
+    "analyse_rigid": "rvfem.app.analysis",
+    "analyse": "rvfem.app.analysis",
+    "run_case": "rvfem.app.run",
+    "build_system": "rvfem.solve.cycle",
+    "OperatingPoint": "rvfem.solve.cycle",
+    "solve_angle": "rvfem.solve.cycle",
+    "load_cycle": "rvfem.solve.cycle",
+    "load_study": "rvfem.app.study",
+    "run_study": "rvfem.app.study",
 }
 
 
@@ -57,18 +57,19 @@ def test_import_rvfem_is_light():
     loaded = _python("import rvfem, sys; print(sorted(m for m in sys.modules "
                      "if m.startswith('rvfem.') or m.split('.')[0] in ('numpy', 'scipy', 'gmsh', 'matplotlib')))")
     assert loaded == "[]"
-    assert _python("import rvfem, sys; print('rvfem.cycle' in sys.modules)") == "False"
+    assert _python("import rvfem, sys; print('rvfem.solve.cycle' in sys.modules)") == "False"
 
 
 def test_first_use_imports_the_home_module_only():
     assert _python("import rvfem, sys; rvfem.load_case; "
-                   "print('rvfem.case' in sys.modules, 'rvfem.cycle' in sys.modules, 'rvfem.study' in sys.modules)"
+                   "print('rvfem.case.definition' in sys.modules, 'rvfem.solve.cycle' in sys.modules, 'rvfem.app.study' in sys.modules)"
                    ) == "True False False"
 
 
 def test_submodules_still_import_from_the_package():
-    """``from rvfem import cycle`` finds the submodule (the lazy ``__getattr__`` does not hide it),
+    """``from rvfem.solve import cycle`` finds the submodule (the lazy ``__getattr__`` does not hide it),
     and ``from rvfem import *`` gives the front door."""
-    assert _python("from rvfem import cycle, study; print(cycle.__name__, study.__name__)") == "rvfem.cycle rvfem.study"
+    assert _python("from rvfem.solve import cycle; from rvfem.app import study; print(cycle.__name__, study.__name__)") == \
+        "rvfem.solve.cycle rvfem.app.study"
     assert _python("from rvfem import *; print(load_study.__module__, OperatingPoint.__module__)") \
-        == "rvfem.study rvfem.cycle"
+        == "rvfem.app.study rvfem.solve.cycle"

@@ -20,7 +20,7 @@ from scipy.integrate import quad
 from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial import cKDTree
 
-from rvfem.case import load_case
+from rvfem.case.definition import load_case
 from rvfem.errors import GeometryError
 from rvfem.geometry import (
     FanHole,
@@ -442,7 +442,7 @@ def test_error_hole_cuts_a_bore(fan):
 
 
 def test_error_round_hole_cuts_the_profile(solid):
-    from rvfem.case import RoundHoles
+    from rvfem.case.definition import RoundHoles
     case = solid.replace(round_holes=RoundHoles(radius=3.0, circle_radius=58.0, count=3))
     with pytest.raises(GeometryError, match=r"hole [1-3] cuts into the teeth by 0\.\d{3} mm .*'round_holes\.radius'"):
         disc_geometry(case)

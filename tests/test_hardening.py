@@ -7,7 +7,7 @@ import re
 
 import pytest
 
-from rvfem import cli
+from rvfem.app import cli
 
 from conftest import CASES_DIR
 
@@ -92,8 +92,9 @@ def test_duty_cycle_life_of_a_zero_life_is_zero_not_a_division_by_zero(monkeypat
     import dataclasses
     from types import SimpleNamespace
 
-    from rvfem import analysis, iso281
-    from rvfem.case import load_case
+    from rvfem.app import analysis
+    from rvfem.evaluate import iso281
+    from rvfem.case.definition import load_case
 
     case = load_case(CASES_DIR / "crv80e_duty.toml")
     monkeypatch.setattr(iso281, "crank_bearing_rating", lambda bearing: 1e-300)
@@ -110,8 +111,8 @@ def test_duty_cycle_life_of_a_zero_life_is_zero_not_a_division_by_zero(monkeypat
 def test_the_coarsest_boundary_sizes_allowed_still_build_the_contact_model(tmp_path):
     """At the largest `size_bore` and `size_flank` the case accepts, the load footprints are built
     (`size_bore = 45` used to fail there with an internal error)."""
-    from rvfem import cycle
-    from rvfem.case import load_case, max_element_sizes
+    from rvfem.solve import cycle
+    from rvfem.case.definition import load_case, max_element_sizes
     from rvfem.mesh import mesh_case
 
     case = load_case(CASES_DIR / "rv40e_solid.toml", ["mesh.size_interior=6.0"])

@@ -18,11 +18,11 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from rvfem.case import load_case
+from rvfem.case.definition import load_case
 from rvfem.errors import MeshError
 from rvfem.geometry import closest_points, disc_geometry
 from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, read_msh
-from rvfem.plots import mesh_preview
+from rvfem.outputs.plots import mesh_preview
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 
@@ -287,7 +287,7 @@ def test_default_fanholes_case_size_and_quality(tmp_path):
 
 @pytest.mark.slow
 def test_cli_mesh_subcommand(tmp_path, capsys):
-    from rvfem.cli import main
+    from rvfem.app.cli import main
 
     text = (CASES / "rv40e_fanholes.toml").read_text()
     text = text.replace("size_flank = 0.35", "size_flank = 0.8").replace("size_bore = 0.4", "size_bore = 0.8")
@@ -320,7 +320,7 @@ def test_two_processes_building_the_same_mesh_share_one_complete_file(tmp_path):
     as the mesh both of them built."""
     script = (
         "import sys, time, pathlib\n"
-        "from rvfem.case import load_case\n"
+        "from rvfem.case.definition import load_case\n"
         "from rvfem.mesh import mesh_case\n"
         "import dataclasses\n"
         "case = load_case(sys.argv[1])\n"

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from rvfem import contact, registry
-from rvfem.case import load_case
+from rvfem.solve import contact
+from rvfem.case import registry
+from rvfem.case.definition import load_case
 from rvfem.geometry import build_profile, pin_profile_contacts, profile_curvature, trochoid_curvature
 
 from conftest import CASES_DIR
@@ -132,7 +133,8 @@ def test_classical_model_through_its_case_file_gives_the_textbook_distribution(t
     """cases/rv40e_classical.toml (linear pins, stiff disc, rigid bearings, μ = 0, T/2 on one disc)
     reproduces the classical distribution: peak 406.7 N on the RV-40E stage, 19-20 loaded pins,
     and every pin force within 0.5 % of the peak. The distribution repeats every pin pitch (9°)."""
-    from rvfem import cycle, rigid
+    from rvfem.solve import cycle
+    from rvfem.evaluate import rigid
     from rvfem.mesh import mesh_case
 
     case = load_case(CASES_DIR / "rv40e_classical.toml")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from rvfem import contact
+from rvfem.solve import contact
 
 # interface columns of a rigid toy body: unit forces +x, −x, +y, −y on it (no moment)
 RESULTANTS = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0]])
@@ -86,7 +86,7 @@ def test_friction_loads_along_the_known_slip_direction():
 
 
 def test_newton_matrix_is_the_derivative_of_its_residual():
-    """The Jacobian built apart (:func:`rvfem.contact.newton_matrix`) against central differences of
+    """The Jacobian built apart (:func:`rvfem.solve.contact.newton_matrix`) against central differences of
     the residual it returns, on a two-spring, one-contact body with a carrier and smooth (closed)
     spring laws."""
     law = contact.palmgren_law(9.0, contacts=2)
@@ -113,7 +113,7 @@ def test_newton_matrix_is_the_derivative_of_its_residual():
 
 def test_a_mechanism_is_stepped_onto_its_springs_and_an_empty_one_is_an_error():
     """Every spring open and nothing else holding the body: the regularised step moves it onto a
-    spring (:func:`rvfem.contact.newton_step`); with no spring at all the problem is a mechanism."""
+    spring (:func:`rvfem.solve.contact.newton_step`); with no spring at all the problem is a mechanism."""
     law = contact.palmgren_law(9.0, contacts=2)
     body = _body([0, 1, 1], [False, False, False], [0, 0, 0], [-0.01, -0.01, 0.0], [1.0, -1.0, 0.0],
                  [(np.array([0, 1]), law), (np.array([2]), contact.linear_law(1e9, bilateral=True))])

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rvfem import cycle, fem
+from rvfem import fem
+from rvfem.solve import cycle
 from rvfem.mesh import mesh_case
 
 from conftest import coarse_case

@@ -7,8 +7,8 @@ import math
 
 import pytest
 
-from rvfem.outputs import _life, _sig, warning_lines
-from rvfem.report import toml_text
+from rvfem.outputs.summary import _life, _sig, warning_lines
+from rvfem.outputs.report import toml_text
 
 
 @pytest.mark.parametrize("value, fmt, text", [

@@ -1,10 +1,10 @@
-"""Tests of the helpers of rvfem.postprocess against brute-force references."""
+"""Tests of the helpers of rvfem.evaluate.postprocess against brute-force references."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from rvfem import postprocess
+from rvfem.evaluate import postprocess
 
 
 def test_contact_band_mask_equals_brute_force_distances():

@@ -9,8 +9,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from rvfem import crankshaft, cycle, rigid
-from rvfem.case import case_from_dict, case_to_dict, load_case
+from rvfem.fem import crankshaft
+from rvfem.solve import cycle
+from rvfem.evaluate import rigid
+from rvfem.case.definition import case_from_dict, case_to_dict, load_case
 from rvfem.mesh import mesh_case
 
 from conftest import CASES_DIR, coarse_case as coarse
@@ -164,7 +166,7 @@ def test_mirrored_pairs_equal_direct_pair_solves(fan_system):
 
 @pytest.mark.slow
 def test_mirrored_and_turned_pairs_with_rollers_equal_direct_pair_solves(fan_pair_cycle):
-    """Exact with rollers too: their cages take one revolution's phases (rvfem.models.roller_angles)."""
+    """Exact with rollers too: their cages take one revolution's phases (rvfem.solve.models.roller_angles)."""
     stage, result = fan_pair_cycle
     for j in (20, 35):
         direct = cycle.solve_pair(stage, float(THETA[j]))

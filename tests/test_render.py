@@ -1,6 +1,6 @@
-"""Off-screen stress images (:mod:`rvfem.render`) on a small synthetic disc.
+"""Off-screen stress images (:mod:`rvfem.outputs.render`) on a small synthetic disc.
 
-A series of images drawn with one :class:`~rvfem.render.StressRenderer` must look exactly like the
+A series of images drawn with one :class:`~rvfem.outputs.render.StressRenderer` must look exactly like the
 same images drawn one by one with a plotter of their own (nothing of one image is left in the
 next), with one rendered frame per image; the anti-aliasing fallback, the background PNG writer's
 errors and the repeated shapes are checked too. The images are small so that the module takes a
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from conftest import structured_annulus
-from rvfem import render
+from rvfem.outputs import render
 from rvfem.errors import RenderError
 
 pytestmark = pytest.mark.slow
@@ -115,7 +115,7 @@ def test_a_warm_up_leaves_nothing_in_the_images(scenes, tmp_path):
 def test_fxaa_that_does_not_render_falls_back_to_msaa(scenes, tmp_path, monkeypatch, caplog):
     full, _ = scenes[0]
     monkeypatch.setattr(render, "_background_fraction", lambda image: 0.0)
-    with caplog.at_level(logging.WARNING, logger="rvfem.render"), \
+    with caplog.at_level(logging.WARNING, logger="rvfem.outputs.render"), \
             render.StressRenderer(SIZE, anti_aliasing="fxaa") as renderer:
         path = renderer.write(tmp_path / "fallback.png", full)
         assert renderer.anti_aliasing == "msaa" and renderer.frames == 2
@@ -236,7 +236,7 @@ def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
 
 
 def test_a_failed_check_stops_a_run_before_the_load_cycle(monkeypatch, tmp_path):
-    from rvfem import run
+    from rvfem.app import run
 
     monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
     monkeypatch.setattr(render, "_probe_result", None)

@@ -10,11 +10,11 @@ import shutil
 import pytest
 
 from conftest import ROOT
-from rvfem import cli
-from rvfem.cli_study import COMPARE, STUDY
+from rvfem.app import cli
+from rvfem.app.cli_study import COMPARE, STUDY
 from rvfem.errors import OutputError
-from rvfem.result_compare import compare_results, read_result
-from rvfem.run import run_case
+from rvfem.app.result_compare import compare_results, read_result
+from rvfem.app.run import run_case
 
 COARSE = ["mesh.size_flank=1.2", "mesh.size_bore=1.5", "mesh.size_interior=6.0", "mesh.size_hole=2.0",
           "analysis.angle_step_deg=30"]
@@ -30,7 +30,7 @@ def _main(argv, monkeypatch) -> int:
 
 @pytest.fixture(scope="module")
 def solid_result(tmp_path_factory):
-    from rvfem.case import load_case
+    from rvfem.case.definition import load_case
 
     tmp = tmp_path_factory.mktemp("compare")
     case = load_case(ROOT / "cases" / "rv40e_solid.toml", COARSE)
@@ -106,7 +106,7 @@ def test_comparison_figure_leaves_the_backend_alone(solid_result, tmp_path):
     import matplotlib
     from matplotlib.figure import Figure
 
-    from rvfem.result_compare import comparison_figure, comparison_plot
+    from rvfem.app.result_compare import comparison_figure, comparison_plot
 
     before = matplotlib.get_backend()
     matplotlib.use("svg")   # stands for a notebook's inline backend

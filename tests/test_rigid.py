@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from rvfem.case import load_case
+from rvfem.case.definition import load_case
 from rvfem.errors import CaseError
-from rvfem.rigid import (
+from rvfem.evaluate.rigid import (
     classical_pin_forces,
     equivalent_load,
     handbook_bearing_loads,
@@ -353,7 +353,7 @@ def test_reversed_bearing_forces_balance_the_reversed_pins(rv40e):
 
 
 def test_handbook_applicable_says_why_not(rv40e):
-    from rvfem.rigid import handbook_applicable
+    from rvfem.evaluate.rigid import handbook_applicable
 
     assert handbook_applicable(rv40e) == (True, "")
     ok, reason = handbook_applicable(rv40e.replace(cycloid=dataclasses.replace(rv40e.cycloid, teeth=38)))
@@ -361,8 +361,8 @@ def test_handbook_applicable_says_why_not(rv40e):
 
 
 def test_duty_cycle_rows_with_reversed_torque_count_with_their_magnitude(rv40e):
-    from rvfem.case import DutyRow
-    from rvfem.iso281 import case_duty_cycle_life
+    from rvfem.case.definition import DutyRow
+    from rvfem.evaluate.iso281 import case_duty_cycle_life
 
     rows = (DutyRow(0.5, 15.0, 412.0), DutyRow(0.5, 15.0, 300.0))
     fwd = rv40e.replace(loads=dataclasses.replace(rv40e.loads, duty_cycle=rows))
@@ -384,7 +384,7 @@ def two_teeth():
 
 
 def test_references_of_one_and_two_tooth_differences(rv40e, two_teeth):
-    from rvfem.rigid import references
+    from rvfem.evaluate.rigid import references
 
     one = references(rv40e)
     assert one.handbook.defined and one.classical_pin_forces.defined and one.equal_share.defined
@@ -417,8 +417,8 @@ def test_classical_pin_forces_need_a_one_tooth_difference_not_equal_cranks(rv40e
 def test_rigid_evaluation_of_a_two_tooth_difference_is_not_defined(two_teeth):
     """NaN loads in the layout of the handbook curves, no bearing rows, the reason; the torque share
     F1 = T_disc/(N·r0) and k = e·Zp/Rp, which do not depend on the pin forces, are numbers."""
-    from rvfem.analysis import analyse_rigid
-    from rvfem.rigid import undefined_loads
+    from rvfem.app.analysis import analyse_rigid
+    from rvfem.evaluate.rigid import undefined_loads
 
     result = analyse_rigid(two_teeth)
     assert not result.defined and result.bearings == () and result.duty_cycle is None
@@ -464,8 +464,8 @@ def test_two_teeth_rigid_limit_keeps_the_equal_share_but_not_the_classical_distr
     FE departs from the touching-pin distribution by most of the peak pin force (a pin entering over
     a trimmed tip corner through a micrometre gap takes load the rigid distribution does not give
     it), while the FE bearing forces stay the equal share of the FE pin resultant."""
-    from rvfem.compare import equal_share_forces
-    from rvfem.cycle import build_system, load_cycle, single_disc_stage
+    from rvfem.evaluate.compare import equal_share_forces
+    from rvfem.solve.cycle import build_system, load_cycle, single_disc_stage
     from rvfem.mesh import mesh_case
 
     from conftest import coarse_case

@@ -20,15 +20,17 @@ import meshio
 import numpy as np
 import pytest
 
-from rvfem import cli, outputs, render
-from rvfem.analysis import analyse
-from rvfem.case import file_sha256, load_case
-from rvfem.compare import rigid_vs_flexible
-from rvfem.cycle import build_system, load_cycle
+from rvfem.app import cli
+from rvfem.outputs import summary as outputs
+from rvfem.outputs import render
+from rvfem.app.analysis import analyse
+from rvfem.case.definition import file_sha256, load_case
+from rvfem.evaluate.compare import rigid_vs_flexible
+from rvfem.solve.cycle import build_system, load_cycle
 from rvfem.errors import OutputError, RenderError
 from rvfem.mesh import mesh_case
-from rvfem.run import IMAGE_SIZE, run_case
-from rvfem.vtkio import CELL_FIELDS, POINT_FIELDS
+from rvfem.app.run import IMAGE_SIZE, run_case
+from rvfem.outputs.vtkio import CELL_FIELDS, POINT_FIELDS
 
 from conftest import CaseText, documented_keys, written_keys
 
@@ -90,7 +92,7 @@ def summary(cli_run) -> dict:
 
 @pytest.fixture(scope="module")
 def api(coarse_case_file, cache_dir):
-    """The same analysis through the library functions, independently of rvfem.run."""
+    """The same analysis through the library functions, independently of rvfem.app.run."""
     case = load_case(coarse_case_file)
     system = build_system(case, mesh_case(case, cache_dir))
     cycle = load_cycle(system)
@@ -407,12 +409,12 @@ def test_interrupted_overwrite_keeps_the_previous_results(coarse_case_file, cach
 
 
 def test_cli_interrupt_exits_130(coarse_case_file, cache_dir, tmp_path, monkeypatch, capsys):
-    import rvfem.cycle
+    import rvfem.solve.cycle
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(rvfem.cycle, "load_cycle", interrupted)
+    monkeypatch.setattr(rvfem.solve.cycle, "load_cycle", interrupted)
     out = tmp_path / "out"
     assert cli.main(["run", str(coarse_case_file), "-o", str(out), "--cache-dir", str(cache_dir),
                      "--no-images"]) == 130
@@ -587,7 +589,7 @@ OPAQUE_KEYS = {"case.overrides", "case.defaults_used", "images", "plots", "timin
 
 
 def test_summary_keys_are_the_documented_ones(summary, duty_run, two_teeth_run):
-    from rvfem.validity import check_limits
+    from rvfem.evaluate.validity import check_limits
 
     # no shipped case warns: the keys of a warning come from one made here
     warning = check_limits(load_ratios=[("bearing 1, flexible", 0.6)])[0].as_dict()
@@ -671,10 +673,10 @@ def test_p2_recovery_matches_a_full_p2_cycle(coarse_case_file, cache_dir):
 @pytest.mark.slow
 def test_p2_model_in_its_child_process_gives_what_it_gives_here(coarse_case_file, cache_dir):
     """The P2 re-solve of a run is made in a child process from the angles' column loads
-    (rvfem.cycle.AngleLoads); the same re-solve with the P2 model built in this process, from the
+    (rvfem.solve.cycle.AngleLoads); the same re-solve with the P2 model built in this process, from the
     cycle's results themselves, gives the same peak (to round-off: the two factorisations may
     round differently) and the same P1 value."""
-    from rvfem.analysis import _recover_structural_peak
+    from rvfem.app.analysis import _recover_structural_peak
 
     a = analyse(coarse_case_file, cache_dir=cache_dir, attribute=False)
     here = _recover_structural_peak(a.system, a.cycle, a.mesh, a.stress.band_mm, a.stress.away_from_contacts)
@@ -694,7 +696,7 @@ def test_features_are_numbered_from_one(summary):
         elif stem == "hole":
             assert at["feature_label"] == f"lightening hole {number}"
         assert at["feature"] not in ("bore_0", "hole_0")
-    from rvfem.postprocess import feature_label, user_feature_name
+    from rvfem.evaluate.postprocess import feature_label, user_feature_name
 
     for name in ("bore_0", "bore_2", "hole_0", "hole_5"):
         number = user_feature_name(name).rpartition("_")[2]
@@ -755,7 +757,7 @@ def _main_module(spec_name):
     ("ipykernel_launcher", "/tmp/x/rvfem/ipykernel_launcher.py", None),
     (None, "/tmp/x/rvfem/.venv/bin/rvfem", "rvfem rigid c.toml"),  # the console script
     ("rvfem.__main__", "/tmp/x/site-packages/rvfem/__main__.py", "rvfem rigid c.toml"),   # python -m rvfem
-    ("rvfem.cli", "/tmp/x/site-packages/rvfem/cli.py", "rvfem rigid c.toml"),             # python -m rvfem.cli
+    ("rvfem.app.cli", "/tmp/x/site-packages/rvfem/cli.py", "rvfem rigid c.toml"),             # python -m rvfem.app.cli
 ])
 def test_command_line_is_decided_by_the_entry_point(spec_name, argv0, expected, monkeypatch):
     monkeypatch.setitem(sys.modules, "__main__", _main_module(spec_name))
@@ -764,7 +766,7 @@ def test_command_line_is_decided_by_the_entry_point(spec_name, argv0, expected, 
 
 
 def test_duty_cycle_at_every_torque_is_palmgren_miner_of_the_fe_loads(duty_run):
-    from rvfem.iso281 import rating_life_hours
+    from rvfem.evaluate.iso281 import rating_life_hours
 
     out, s, screen = duty_run
     fe = s["duty_cycle"]["flexible_fe"]
@@ -789,7 +791,7 @@ def test_duty_cycle_at_every_torque_is_palmgren_miner_of_the_fe_loads(duty_run):
 
 
 def test_repository_files_are_found_from_any_folder(tmp_path, monkeypatch):
-    from rvfem.analysis import default_cache_dir, repository_path
+    from rvfem.app.analysis import default_cache_dir, repository_path
     from rvfem.errors import CaseError
 
     root = Path(__file__).resolve().parents[1]
@@ -810,7 +812,7 @@ def test_report_links_further_field_images_instead_of_embedding_them(cli_run, su
     stress peaks) embedded: the report stays light."""
     import shutil
 
-    from rvfem.report import key_field_angles, write_report
+    from rvfem.outputs.report import key_field_angles, write_report
 
     folder = tmp_path / "copy"
     shutil.copytree(cli_run, folder)

@@ -17,12 +17,12 @@ from pathlib import Path
 import pytest
 
 from conftest import ROOT, assert_figures_shown
-from rvfem import cli
-from rvfem.case import load_case
-from rvfem.cli_study import COMPARE, STUDY
+from rvfem.app import cli
+from rvfem.case.definition import load_case
+from rvfem.app.cli_study import COMPARE, STUDY
 from rvfem.errors import CaseError, OutputError
-from rvfem.run import run_case
-from rvfem.study import LOCK_NAME, load_study, read_study_csv, run_study
+from rvfem.app.run import run_case
+from rvfem.app.study import LOCK_NAME, load_study, read_study_csv, run_study
 
 BIN = Path(sys.executable).parent
 BASE_CASE = ROOT / "cases" / "rv40e_fanholes.toml"
@@ -58,8 +58,8 @@ def _main(argv, monkeypatch) -> int:
 # A runner for subprocesses: `rvfem` with the study subcommands (until they are in cli.SUBCOMMANDS).
 RUNNER = """
 import sys
-from rvfem import cli
-from rvfem.cli_study import COMPARE, STUDY
+from rvfem.app import cli
+from rvfem.app.cli_study import COMPARE, STUDY
 names = {s.name for s in cli.SUBCOMMANDS}
 subs = cli.SUBCOMMANDS + tuple(c for c in (COMPARE, STUDY) if c.name not in names)
 build = cli.build_parser
@@ -291,7 +291,7 @@ def test_a_second_study_into_the_same_folder_is_refused(tmp_path):
     assert lock.exists()
     # a lock left by a process that no longer runs is taken over (here: nothing to compute is not
     # reachable without a cluster, so only the lock logic is checked)
-    from rvfem.study import _acquire_lock
+    from rvfem.app.study import _acquire_lock
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
@@ -345,7 +345,7 @@ def test_study_file_errors_on_the_top_level(tmp_path):
      r"'variant\[1\]\.name' is not a known key; known keys: id, set"),
 ])
 def test_study_file_tables_are_read_by_the_schema(tmp_path, top, body, message):
-    """The study file's tables go through rvfem.schema.read_table: types, choices (with a "did you
+    """The study file's tables go through rvfem.case.schema.read_table: types, choices (with a "did you
     mean"), unknown keys with the known ones, missing keys with their meaning."""
     path = _write(tmp_path / "bad.toml", f'base_case = "{BASE_CASE.as_posix()}"\n{top}\n{body}\n')
     with pytest.raises(CaseError, match=message) as info:
@@ -410,7 +410,7 @@ def test_notebook_runs_from_its_own_folder(tmp_path, monkeypatch):
 
 
 def test_an_unreachable_scheduler_is_one_line(tmp_path):
-    from rvfem.study import ClusterError
+    from rvfem.app.study import ClusterError
 
     study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
     address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
@@ -433,10 +433,10 @@ def _fake_summary(max_n: float, fm_n: float, life_h: float) -> dict:
 
 def test_rows_and_plots_of_a_sensitivity_study(tmp_path, monkeypatch):
     """Deltas against the handbook and the base from known numbers; the tornado and bar charts,
-    written as a whole folder (rvfem.outputs.result_folder): no stale plot, an interrupted run
+    written as a whole folder (rvfem.outputs.summary.result_folder): no stale plot, an interrupted run
     leaves the earlier plots."""
-    from rvfem import study as study_module
-    from rvfem.study import _plots, study_rows
+    from rvfem.app import study as study_module
+    from rvfem.app.study import _plots, study_rows
 
     path = _write(tmp_path / "s.toml", _study_text("sensitivity", """
 [[parameter]]
@@ -499,7 +499,7 @@ import sys
 import matplotlib
 matplotlib.use("svg")     # stands for a notebook's inline backend
 from matplotlib.figure import Figure
-from rvfem.study import load_study, study_figures, _plots
+from rvfem.app.study import load_study, study_figures, _plots
 study = load_study({str(study_file)!r})
 rows = []
 for v in study.variants:
@@ -523,8 +523,8 @@ print("ok")
 def test_long_variant_ids_stay_distinct_and_readable(tmp_path, capsys):
     """Ids longer than MAX_ID_LENGTH are shortened with a hash of the full text; the table and the
     variant list print ids whole, so two crank-support variants never look the same."""
-    from rvfem.cli_study import _format_rows, _print_variants
-    from rvfem.study import MAX_ID_LENGTH, short_id
+    from rvfem.app.cli_study import _format_rows, _print_variants
+    from rvfem.app.study import MAX_ID_LENGTH, short_id
 
     path = _write(tmp_path / "s.toml", _study_text("grid", """
 [[parameter]]
@@ -565,7 +565,7 @@ values = [1.0, 3.0]
 
 
 def test_compute_time_counts_every_case_once():
-    from rvfem.study import _compute_time
+    from rvfem.app.study import _compute_time
 
     records = {"base": {"wall_time_s": 10.0}, "a": {"wall_time_s": 5.0},
                "same": {"wall_time_s": 10.0, "same_as": "base"}, "cancelled": {"wall_time_s": float("nan")},

@@ -10,7 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from rvfem import contact, cycle
+from rvfem.solve import contact
+from rvfem.solve import cycle
 from rvfem.mesh import mesh_case
 
 from conftest import coarse_case as coarse

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from rvfem import verification
-from rvfem.verification import Check, Section, render
+from rvfem.app import verification
+from rvfem.app.verification import Check, Section, render
 
 from conftest import ROOT, assert_figures_shown
 
@@ -88,7 +88,7 @@ def test_committed_manual_is_current_and_every_check_passes():
             assert c.passed, f"{s.title}: {c.quantity}: error {c.error:.3g} > tolerance {c.tolerance:.3g}"
     text = render(sections)
     assert MANUAL.read_text(encoding="utf-8") == text, (
-        "docs/verification.md is stale: regenerate it with python -m rvfem.verification docs/verification.md")
+        "docs/verification.md is stale: regenerate it with python -m rvfem.app.verification docs/verification.md")
 
 
 # ------------------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""The ``.vtu`` writer (:mod:`rvfem.vtkio`) on a small synthetic disc.
+"""The ``.vtu`` writer (:mod:`rvfem.outputs.vtkio`) on a small synthetic disc.
 
 At meshio's zlib level and strategy the files are meshio's, byte for byte (but for meshio's comment
 line); at the writer's own they read back with exactly the same arrays. The mesh encoded once
@@ -14,7 +14,7 @@ import meshio
 import numpy as np
 import pytest
 
-from rvfem import vtkio
+from rvfem.outputs import vtkio
 
 from conftest import structured_annulus
 
@@ -43,7 +43,7 @@ def disc():
 
 
 def _meshio_file(path, points, triangles, snapshot):
-    """The file as meshio writes it (the writer before :mod:`rvfem.vtkio` had its own)."""
+    """The file as meshio writes it (the writer before :mod:`rvfem.outputs.vtkio` had its own)."""
     nodal, element = snapshot.stress.nodal, snapshot.stress.element
     names = ("sxx", "syy", "sxy", "von_mises", "s1", "s2")
     xyz = lambda a: np.column_stack([a, np.zeros(len(a))])  # noqa: E731

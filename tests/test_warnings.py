@@ -1,4 +1,4 @@
-"""Warnings for results outside their model's range (:mod:`rvfem.validity`): the limits on
+"""Warnings for results outside their model's range (:mod:`rvfem.evaluate.validity`): the limits on
 synthetic numbers, the rigid evaluation of every shipped case (none warns) and at overload, and one
 overloaded ``rvfem run`` through the command line (slow)."""
 
@@ -11,10 +11,11 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from rvfem import cli, validity
-from rvfem.analysis import analyse_rigid
-from rvfem.case import load_case
-from rvfem.validity import (DISPLACEMENT_FRACTION_LIMIT, HERTZ_PRESSURE_LIMIT_MPA, LOAD_RATIO_LIMIT, MIN_LIFE_H,
+from rvfem.app import cli
+from rvfem.evaluate import validity
+from rvfem.app.analysis import analyse_rigid
+from rvfem.case.definition import load_case
+from rvfem.evaluate.validity import (DISPLACEMENT_FRACTION_LIMIT, HERTZ_PRESSURE_LIMIT_MPA, LOAD_RATIO_LIMIT, MIN_LIFE_H,
                             PLACEHOLDER_YIELD_STRENGTH_MPA, ResultWarning, check_limits)
 
 from conftest import CASES_DIR, CaseText, coarse_case
@@ -201,7 +202,7 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
 @pytest.mark.parametrize("name", SHIPPED)
 def test_shipped_cases_do_not_warn(name, tmp_path):
     """Every shipped case, coarse and at 30° steps, is inside every model's range."""
-    from rvfem.analysis import analyse
+    from rvfem.app.analysis import analyse
 
     a = analyse(coarse_case(name), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
     assert a.warnings == (), [w.message for w in a.warnings]
@@ -212,7 +213,7 @@ def test_shipped_cases_do_not_warn(name, tmp_path):
                                      {"cycloid": {"pitch_error": {"amplitude": 1.0, "values": []}}}])
 def test_overload_cases_warn(changes, tmp_path):
     """1e6 N·m and a 1 mm pitch error (the issue's examples): every limit is crossed."""
-    from rvfem.analysis import analyse
+    from rvfem.app.analysis import analyse
 
     a = analyse(coarse_case("rv40e_fanholes", **changes), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
     assert _codes(a.warnings) == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield",
@@ -222,7 +223,7 @@ def test_overload_cases_warn(changes, tmp_path):
 def test_hertz_limit_scales_with_a_material_that_is_not_steel():
     """ISO 76's 4000 MPa is on bearing steel; a material of 6 × steel's modulus (the rigid-disc limit
     of rv40e_classical) presses sqrt(6) times harder for the same roller load, and so may its limit."""
-    from rvfem.validity import hertz_pressure_limit_MPa
+    from rvfem.evaluate.validity import hertz_pressure_limit_MPa
 
     assert hertz_pressure_limit_MPa() == HERTZ_PRESSURE_LIMIT_MPA
     assert hertz_pressure_limit_MPa(206000.0, 0.3) == pytest.approx(4000.0, rel=1e-15)

@@ -25,8 +25,13 @@ docs/theory.md.
 
 from __future__ import annotations
 
-from .loads import BoundaryChain, boundary_chains, footprint_weights, load_operator
-from .model import (
+from rvfem.fem.loads import (
+    BoundaryChain,
+    boundary_chains,
+    footprint_weights,
+    load_operator,
+)
+from rvfem.fem.model import (
     FEModel,
     build_model,
     edge_indices,
@@ -34,7 +39,7 @@ from .model import (
     plane_stress_constants,
     plane_stress_stiffness,
 )
-from .solve import (
+from rvfem.fem.solve import (
     SOLVER_PREFERENCE,
     Factorization,
     available_solvers,
@@ -44,7 +49,7 @@ from .solve import (
     remove_rigid_motion,
     rigid_body_modes,
 )
-from .stress import (
+from rvfem.fem.stress import (
     StressFields,
     StressState,
     displacement_gradients,

@@ -32,11 +32,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial import cKDTree
 
-from .._arrays import chain_edges
-from .._arrays import readonly as _readonly
-from ..errors import MeshError
-from .model import FEModel, edge_indices, edge_outward_normals
+from rvfem._arrays import chain_edges
+from rvfem._arrays import readonly as _readonly
+from rvfem.errors import MeshError
+from rvfem.fem.model import FEModel, edge_indices, edge_outward_normals
 
 __all__ = [
     "BoundaryChain",
@@ -113,8 +114,6 @@ class BoundaryChain:
 
     @functools.cached_property
     def _vertex_tree(self):
-        from scipy.spatial import cKDTree
-
         return cKDTree(self.points[:-1])
 
     @functools.cached_property

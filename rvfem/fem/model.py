@@ -40,12 +40,19 @@ from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, BilinearForm, ElementTriP1, ElementTriP2, ElementVector, MeshTri
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementTriP1,
+    ElementTriP2,
+    ElementVector,
+    MeshTri,
+)
 from skfem.assembly import Dofs
 from skfem.models.elasticity import lame_parameters
 
-from .._arrays import readonly as _readonly
-from ..errors import MeshError
+from rvfem._arrays import readonly as _readonly
+from rvfem.errors import MeshError
 
 __all__ = [
     "FEModel",

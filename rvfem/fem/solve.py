@@ -38,8 +38,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .._arrays import readonly as _readonly
-from .model import FEModel
+from rvfem._arrays import readonly as _readonly
+from rvfem.fem.model import FEModel
 
 __all__ = [
     "SOLVER_PREFERENCE",

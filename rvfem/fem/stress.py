@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .._arrays import readonly as _readonly
-from .model import FEModel, plane_stress_constants
+from rvfem._arrays import readonly as _readonly
+from rvfem.fem.model import FEModel, plane_stress_constants
 
 __all__ = [
     "StressState",

@@ -25,7 +25,7 @@ The derivations are in docs/theory.md ("Kinematics", "Profile envelope and modif
 
 from __future__ import annotations
 
-from .features import (
+from rvfem.geometry.features import (
     WALL_SPACING,
     Arc,
     Circle,
@@ -38,11 +38,25 @@ from .features import (
     disc_geometry,
     feature_text,
 )
-from .holes import (FanHoleShape, HoleShape, RoundHoleShape, default_angle_offset, hole_shape, register_hole_shape,
-                    unregister_hole_shape)
-from .kinematics import (PinContacts, load_cycle_angles, closest_points, crank_centres, pin_centres, pin_profile_contacts,
-                         pin_profile_contacts_many)
-from .profile import (
+from rvfem.geometry.holes import (
+    FanHoleShape,
+    HoleShape,
+    RoundHoleShape,
+    default_angle_offset,
+    hole_shape,
+    register_hole_shape,
+    unregister_hole_shape,
+)
+from rvfem.geometry.kinematics import (
+    PinContacts,
+    closest_points,
+    crank_centres,
+    load_cycle_angles,
+    pin_centres,
+    pin_profile_contacts,
+    pin_profile_contacts_many,
+)
+from rvfem.geometry.profile import (
     PITCH_BLEND_FRACTION,
     SAMPLES_PER_SEGMENT,
     SPLINE_POINTS_PER_SEGMENT,

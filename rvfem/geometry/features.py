@@ -35,10 +35,10 @@ from typing import Protocol, Union
 import numpy as np
 from matplotlib.path import Path as _MplPath
 
-from ..case import Case
-from ..errors import GeometryError
-from .kinematics import crank_centres
-from .profile import Profile, build_profile
+from rvfem.case.definition import Case
+from rvfem.errors import GeometryError
+from rvfem.geometry.kinematics import crank_centres
+from rvfem.geometry.profile import Profile, build_profile
 
 __all__ = [
     "Feature",
@@ -406,7 +406,7 @@ class DiscGeometry:
         ``bore_0`` … ``bore_{N−1}`` at r0·u(α_i).
     holes : tuple of Feature
         Lightening holes ``hole_0`` …, table by table in the order of
-        :func:`rvfem.case.hole_table_names`: the fan holes (:class:`FanHole`), the round holes
+        :func:`rvfem.case.definition.hole_table_names`: the fan holes (:class:`FanHole`), the round holes
         (:class:`Circle`), then the holes of registered hole shapes.
     walls : tuple of Wall
         The thinnest wall between every pair of features (and each feature and the profile),

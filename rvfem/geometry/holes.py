@@ -4,9 +4,9 @@ A hole shape owns everything rvfem knows about one kind of lightening hole:
 
 ``name``, ``table``
     Its table of the case file (``[fan_holes]``) and the frozen dataclass it is read into, every
-    key declared with :func:`rvfem.schema.param`. The dataclass has a property ``outline_length``
+    key declared with :func:`rvfem.case.schema.param`. The dataclass has a property ``outline_length``
     (the length of all its holes' outlines, mm, for the mesh-size estimate) and may have a method
-    ``check(fail)`` with the checks between its keys (:func:`rvfem.case.register_hole_table`).
+    ``check(fail)`` with the checks between its keys (:func:`rvfem.case.definition.register_hole_table`).
 :meth:`HoleShape.features`
     The holes it cuts out of the disc, as :class:`~rvfem.geometry.Feature` objects named
     ``hole_<i>`` (:class:`~rvfem.geometry.HoleContext` gives the first index).
@@ -15,7 +15,7 @@ A hole shape owns everything rvfem knows about one kind of lightening hole:
     cached mesh).
 :meth:`HoleShape.turned`
     Its table for disc B of the half-pitch model, turned by −β
-    (:func:`rvfem.cycle.half_pitch_case`).
+    (:func:`rvfem.solve.cycle.half_pitch_case`).
 :meth:`HoleShape.describe`
     One line for the report and the screen, under the heading ``label``.
 :meth:`HoleShape.case_keys`
@@ -25,7 +25,7 @@ A hole shape owns everything rvfem knows about one kind of lightening hole:
 :func:`register_hole_shape` makes a shape known to the case reader (its table becomes a
 top-level table of the case file), to :func:`~rvfem.geometry.disc_geometry`, to the mesh cache key
 and to disc B; no other module names the kinds of holes. The holes are numbered in the order of
-:func:`rvfem.case.hole_table_names`: the fan holes, the round holes, then the registered shapes.
+:func:`rvfem.case.definition.hole_table_names`: the fan holes, the round holes, then the registered shapes.
 
 Example
 -------
@@ -49,11 +49,25 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy.optimize import brentq
 
-from ..case import (Case, FanHoles, RoundHoles, register_hole_table, registered_hole_shapes, table_to_dict,
-                    unregister_hole_table)
-from ..errors import GeometryError
-from .features import Circle, FanHole, Feature, HoleContext, feature_text, length_text
-from .profile import Profile
+from rvfem.case.definition import (
+    Case,
+    FanHoles,
+    RoundHoles,
+    register_hole_table,
+    registered_hole_shapes,
+    table_to_dict,
+    unregister_hole_table,
+)
+from rvfem.errors import GeometryError
+from rvfem.geometry.features import (
+    Circle,
+    FanHole,
+    Feature,
+    HoleContext,
+    feature_text,
+    length_text,
+)
+from rvfem.geometry.profile import Profile
 
 __all__ = [
     "HoleShape",
@@ -137,7 +151,7 @@ def register_hole_shape(cls: type) -> type:
     ------
     TypeError, ValueError
         ``cls`` is not a hole shape, or its table name or table cannot be registered
-        (:func:`rvfem.case.register_hole_table`).
+        (:func:`rvfem.case.definition.register_hole_table`).
     """
     if not (isinstance(cls, type) and issubclass(cls, HoleShape)):
         raise TypeError(f"a hole shape must be a subclass of HoleShape, got {cls!r}")
@@ -184,7 +198,7 @@ def _angle_offset(case: Case, table: Any) -> float:
 
 @register_hole_shape
 class FanHoleShape(HoleShape):
-    """Fan-shaped holes between the bores (:class:`rvfem.case.FanHoles`): annular sectors with
+    """Fan-shaped holes between the bores (:class:`rvfem.case.definition.FanHoles`): annular sectors with
     filleted corners, their span given or following from the ligament to the bores."""
 
     name = "fan_holes"
@@ -309,7 +323,7 @@ def _hole_bore_wall(hole: Feature, bores: tuple[Circle, ...]) -> float:
 
 @register_hole_shape
 class RoundHoleShape(HoleShape):
-    """Round lightening holes on a circle (:class:`rvfem.case.RoundHoles`)."""
+    """Round lightening holes on a circle (:class:`rvfem.case.definition.RoundHoles`)."""
 
     name = "round_holes"
     table = RoundHoles

@@ -28,10 +28,10 @@ from dataclasses import dataclass
 import numpy as np
 from matplotlib.path import Path as _MplPath
 
-from .. import NOTICE
-from ..case import Case
-from .._arrays import readonly as _readonly
-from .profile import Profile, _c2xy, _u, build_profile, profile_eval
+from rvfem import NOTICE
+from rvfem._arrays import readonly as _readonly
+from rvfem.case.definition import Case
+from rvfem.geometry.profile import Profile, _c2xy, _u, build_profile, profile_eval
 
 log = logging.getLogger(__name__)
 

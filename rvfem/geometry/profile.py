@@ -49,9 +49,9 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial import cKDTree
 
-from ..case import Case
-from .._arrays import readonly as _readonly
-from ..errors import GeometryError
+from rvfem._arrays import readonly as _readonly
+from rvfem.case.definition import Case
+from rvfem.errors import GeometryError
 
 __all__ = [
     "Profile",

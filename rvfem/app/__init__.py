@@ -1,0 +1,1 @@
+"""The application: the analysis pipeline, runs, studies, comparisons and the command line."""

@@ -1,0 +1,344 @@
+"""The analyst's main job: one case from the case file to a folder of results.
+
+:func:`run_case` runs the whole chain — check → mesh (cached) → rigid handbook model → flexible
+load cycle → evaluation → outputs — and writes::
+
+    DIR/summary.json        key numbers (schema: docs/outputs.md)
+    DIR/report.html         self-contained report (images embedded)
+    DIR/case.json           the case as analysed (after overrides); case_from_dict() reads it back
+    DIR/bearing_loads.csv   θ, per bearing Fx, Fy, |F| flexible, rigid and equal share
+    DIR/roller_loads.csv    roller loads (bearing model "rollers")
+    DIR/pin_forces.csv      FE and classical pin forces
+    DIR/cycle.csv           pins in contact, carrier rotation, residual, iterations per angle
+    DIR/vtk/disc.pvd        ParaView collection over θ of DIR/vtk/disc_theta_*.vtu
+    DIR/images/*.png        von Mises on the deformed disc per kept angle, close-ups, the mesh
+    DIR/plots/*.png         bearing loads, roller loads, pin forces, pins in contact
+
+It is :func:`rvfem.app.analysis.analyse` (everything computed, nothing written) followed by the writers
+of :mod:`rvfem.outputs.summary`, one per format. With images, off-screen rendering is checked by a child
+process (:class:`rvfem.outputs.render.RenderWorker`) started with the run: the check runs while the mesh
+and the model are built, and the run waits for it before the load cycle (a failed check stops the
+run there); the same process then draws the stress images while the other files are written. Nothing is lost: the outputs are written into a temporary
+folder next to DIR (:func:`rvfem.outputs.summary.result_folder`) and moved into place only when complete. An existing non-empty DIR is replaced only with ``overwrite=True`` (and only
+after the new results are complete); a run that fails or is interrupted leaves neither DIR (nor
+the previous results changed) nor the temporary folder.
+
+Example (notebook)::
+
+    from rvfem.app.run import run_case
+    result = run_case("cases/rv40e_fanholes.toml", "results/rv40e_fanholes", overwrite=True)
+    result.summary["bearings"][0]["flexible"]["max_load_N"]
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from rvfem.app import analysis as _analysis
+from rvfem.app.analysis import (
+    CONTACT_BAND_ELEMENTS,
+    ProgressCallback,
+    Stages,
+    analyse,
+    resolve_case,
+)
+from rvfem.case.definition import Case
+from rvfem.outputs import summary as outputs
+from rvfem.outputs.render import RenderWorker
+from rvfem.outputs.summary import IMAGE_SIZE, SCHEMA_VERSION, summary_text
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "STAGES",
+    "CONTACT_BAND_ELEMENTS",
+    "IMAGE_SIZE",
+    "RunSummary",
+    "ProgressCallback",
+    "run_stages",
+    "run_case",
+    "summary_text",
+]
+
+STAGES: dict[str, str] = {
+    **_analysis.STAGES,
+    "check": "checking the case, the output folder and off-screen rendering",
+    "tables": "writing summary tables (CSV)",
+    "vtk": "writing VTK files for ParaView",
+    "plots": "plotting",
+    "images": "rendering stress images",
+    "report": "writing the report",
+}
+"""Stages of a run in the order of a run without images, with a one-line description (what the progress callback reports):
+those of :func:`rvfem.app.analysis.analyse`, then one per writer. With images, the stress images and
+the plots are drawn by a child process (:class:`rvfem.outputs.render.RenderWorker`) from the start of the
+writers on (the mesh picture from the end of the ``model`` stage on, during the load cycle), while
+this process writes the tables and the VTK files and then computes the attribution (it enters only
+the summary and the report; stage ``attribution``, reported after ``vtk``); the ``plots`` and
+``images`` stages are then the waits for the child process."""
+
+
+def run_stages(case: Case, *, images: bool = True) -> tuple[str, ...]:
+    """The stages a run of ``case`` reports, in the order it reports them (each once; a subset of
+    :data:`STAGES`).
+
+    With images the attribution is computed after the VTK files, while the render worker draws,
+    and the ``images`` stage is the wait for the images; without images it is computed beside the
+    stress stage. The ``duty_cycle`` stage is there only when the case has a duty cycle.
+
+    Parameters
+    ----------
+    case : Case
+    images : bool
+        As :func:`run_case`'s ``images``.
+
+    Returns
+    -------
+    tuple of str
+    """
+    analysis = ["mesh", "model", "rigid", "cycle", "evaluation", "stress"]
+    duty = ["duty_cycle"] if case.loads.duty_cycle else []
+    if images:
+        order = ["check", *analysis, *duty, "tables", "vtk", "attribution", "plots", "images", "report"]
+    else:
+        order = ["check", *analysis, "attribution", *duty, "tables", "vtk", "plots", "report"]
+    return tuple(order)
+
+
+@dataclass(frozen=True, eq=False)
+class RunSummary:
+    """Result of :func:`run_case`.
+
+    Attributes
+    ----------
+    out_dir : Path
+        The result folder (complete).
+    summary : dict
+        The content of ``summary.json``.
+    analysis : rvfem.app.analysis.Analysis
+        Everything computed (mesh, model, cycle, comparison, stresses, Hertz, …).
+    files : tuple of str
+        Files written, relative to ``out_dir``.
+    """
+
+    out_dir: Path
+    summary: dict
+    analysis: Any
+    files: tuple[str, ...]
+
+    @property
+    def case(self) -> Case:
+        """The case as analysed (overrides applied)."""
+        return self.analysis.case
+
+    @property
+    def system(self):
+        """The factorised disc model (:class:`rvfem.solve.cycle.DiscSystem`), for further solves."""
+        return self.analysis.system
+
+    @property
+    def cycle(self):
+        """The flexible load cycle (:class:`rvfem.solve.cycle.CycleResult`)."""
+        return self.analysis.cycle
+
+    @property
+    def comparison(self):
+        """Rigid vs flexible per bearing (:class:`rvfem.evaluate.compare.Comparison`)."""
+        return self.analysis.comparison
+
+
+def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angle_step_deg: float | None = None,
+             bearing_model: str | None = None, order: int | None = None, overwrite: bool = False,
+             progress: ProgressCallback | None = None, cache_dir: str | os.PathLike | None = None,
+             images: bool = True, field_step_deg: float | None = None,
+             overrides: tuple[str, ...] = ()) -> RunSummary:
+    """Run a case completely and write its result folder.
+
+    Parameters
+    ----------
+    case : Case or path
+        A case (e.g. built or modified in code, or read with overrides) or the path of a case file.
+    out_dir : path
+        Result folder; must not exist or be empty unless ``overwrite``.
+    angle_step_deg : float, optional
+        Crank-angle step, degrees (overrides ``analysis.angle_step_deg``).
+    bearing_model : str, optional
+        Overrides ``crank_bearing.model`` (:func:`rvfem.case.registry.bearing_model_names`).
+    order : {1, 2}, optional
+        Element order; overrides ``analysis.element_order``.
+    overwrite : bool
+        Replace an existing non-empty ``out_dir`` (only once the new results are complete).
+    progress : callable, optional
+        See :data:`ProgressCallback`; the stages are :data:`STAGES`.
+    cache_dir : path, optional
+        Mesh cache folder; default :func:`rvfem.app.analysis.default_cache_dir` (the repository's
+        ``meshes/`` in a source checkout, else the per-user cache).
+    images : bool
+        Render the PyVista images (needs off-screen OpenGL; checked while the mesh and the model
+        are built, and before the load cycle).
+    field_step_deg : float, optional
+        Also keep the displacement/stress fields every ``field_step_deg`` degrees (more VTU frames
+        for a ParaView animation); by default only the case's ``analysis.saved_angles_deg``, the
+        angle of the largest bearing load and the angles of the stress peaks.
+    overrides : tuple of str
+        ``KEY=VALUE`` case overrides when ``case`` is a path (:func:`rvfem.case.definition.load_case`).
+
+    Returns
+    -------
+    RunSummary
+
+    Raises
+    ------
+    CaseError, GeometryError, MeshError, ContactError
+        From the stages.
+    OutputError
+        The output folder exists (without ``overwrite``) or cannot be written.
+    RenderError
+        Off-screen rendering is impossible (only with ``images=True``).
+    """
+    t_run = time.perf_counter()
+    stages = Stages(progress, STAGES)
+    out_dir = Path(out_dir)
+
+    t = stages.start("check")
+    case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
+                                    bearing_model=bearing_model, order=order)
+    _analysis.cycle_angles(case)
+    _analysis.kept_field_angles(case, field_step_deg)
+    outputs.check_output_folder(out_dir, overwrite)
+    worker = None
+    if images:
+
+        worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
+        worker.check(wait=False)            # raises at once if this process knows it fails
+    stages.end("check", t)
+
+    try:
+        with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
+            try:
+                waited, mesh_call = [0.0], []
+
+                def draw_mesh(system):   # the worker draws the mesh picture during the load cycle
+                    t = time.perf_counter()
+                    try:
+                        mesh_call.append(outputs.start_mesh_picture(system, tmp, worker))
+                    finally:
+                        waited[0] += time.perf_counter() - t   # the rendering check, if not done
+
+                # with a render worker the attribution is computed here while the worker draws
+                result = analyse(case, provenance=provenance, field_step_deg=field_step_deg,
+                                 cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
+                                 attribute=worker is None, on_model=draw_mesh if worker is not None else None)
+                stages.seconds["check"] += waited[0]
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run,
+                                                        mesh_call[0] if mesh_call else None)
+            finally:
+                if worker is not None:
+                    worker.close()   # before the folder is moved or removed: nothing writes into it
+    finally:
+        if worker is not None:
+            worker.close()
+
+    return RunSummary(out_dir=out_dir, summary=summary, analysis=result, files=files)
+
+
+def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: list[float]) -> ProgressCallback:
+    """The progress callback of the analysis: waits for the rendering check of ``worker`` (if any)
+    when the load cycle starts (its RenderError aborts the analysis), adding the wait to
+    ``waited[0]``, then reports to ``progress``."""
+
+    def report(stage: str, done: int, total: int) -> None:
+        if worker is not None and stage == "cycle" and done == 0:
+            t = time.perf_counter()
+            try:
+                worker.check()
+            finally:
+                waited[0] += time.perf_counter() - t
+        if progress is not None:
+            progress(stage, done, total)
+
+    return report
+
+
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None):
+    """Write every file of the result folder ``tmp``; returns the summary, the files and the
+    analysis (with its attribution).
+
+    The images and the plots are handed to ``worker`` first (its child process draws them
+    meanwhile); this process writes the tables and the VTK files, then computes the attribution
+    (if the analysis left it: it enters only the summary and the report; after the VTK files,
+    which a thread of pure Python beside them would slow down), then waits for the plots and the
+    images, and writes the report and the summary. Without a worker the plots are drawn here.
+    """
+    written: list[Path] = []
+    computed = []
+
+    def attribute() -> None:
+        t = stages.start("attribution")
+        computed.append(_analysis._timed(_analysis.attribution_of, result.system, result.theta, result.cycle))
+        stages.end("attribution", t)
+
+    written += _write_files(result, tmp, stages, worker, mesh_call,
+                            meanwhile=attribute if result.attribution is None else None)
+    if computed:
+        (value, seconds), = computed
+        result = dataclasses.replace(result, attribution=value,
+                                     timings={**result.timings, "attribution_compute": seconds})
+
+    t = stages.start("report")
+    timings = {"check": stages.seconds["check"], **result.timings,
+               **{k: v for k, v in stages.seconds.items() if k != "check"}}
+    timings["total"] = time.perf_counter() - t_run
+    files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {"report.html", "summary.json"}))
+    summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
+    outputs.write_report(result, tmp, summary=summary)
+    stages.end("report", t)
+    summary["timings_s"]["report"] = stages.seconds["report"]
+    summary["timings_s"]["total"] = time.perf_counter() - t_run
+    outputs.write_summary(result, tmp, summary=summary)
+    return summary, files, result
+
+
+def _write_files(result, tmp: Path, stages: Stages, worker, mesh_call: int | None = None,
+                 meanwhile: Callable[[], None] | None = None) -> list[Path]:
+    """The tables, the VTK files, the plots and the images (drawn by ``worker`` if given; the mesh
+    picture is its call ``mesh_call`` if it was started already); ``meanwhile()`` is called after
+    the VTK files, before the plots are waited for."""
+    written: list[Path] = []
+    t = stages.start("tables")
+    written += outputs.write_tables(result, tmp)
+    written += outputs.write_case_json(result, tmp)
+    stages.end("tables", t)
+
+    t_submit = time.perf_counter()
+    pending = None
+    if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
+        pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
+                                        mesh_call=mesh_call)
+    submitted = time.perf_counter() - t_submit
+
+    n_fields = len(result.stress.snapshots)
+    t = stages.start("vtk", n_fields)
+    written += outputs.write_vtk(result, tmp, tick=lambda done, total: stages.tick("vtk", done, total))
+    stages.end("vtk", t, n_fields)
+    if meanwhile is not None:
+        meanwhile()
+
+    t = stages.start("plots")
+    written += pending.calls_result() if pending is not None else outputs.write_plots(result, tmp)
+    stages.end("plots", t)
+
+    if pending is not None:
+        n_images = outputs.image_count(result)
+        t = stages.start("images", n_images)
+        written += pending.result(tick=lambda done, total: stages.tick("images", done, total))
+        stages.end("images", t, n_images)
+        stages.seconds["images"] += submitted
+    return written

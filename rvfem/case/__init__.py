@@ -1,0 +1,1 @@
+"""The case: its schema, its tables and the registries of the models it names."""

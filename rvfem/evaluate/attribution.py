@@ -1,0 +1,150 @@
+"""What the flexibility effect is made of: the attribution of the flexible bearing loads to the
+modelling steps handbook → equal share of the FE pin resultant → one flexible disc with T/discs →
+two discs sharing the carrier → crankshaft compliance, on the same crank angles and the same
+compliance."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rvfem.evaluate.compare import equal_share_forces
+from rvfem.evaluate.iso281 import life_ratio
+from rvfem.evaluate.rigid import (
+    equivalent_load,
+    handbook_applicable,
+    handbook_bearing_loads,
+)
+from rvfem.fem.crankshaft import crankshaft_influence
+from rvfem.solve.cycle import build_stage, load_cycle
+
+__all__ = ["Attribution", "AttributionStep", "STEP_LABELS", "attribution", "case_step"]
+
+
+@dataclass(frozen=True)
+class AttributionStep:
+    """One modelling step of the attribution: the bearing-load curves it gives.
+
+    Attributes
+    ----------
+    key : str
+        ``handbook``, ``equal_share``, ``one_disc``, ``two_discs`` or ``crankshafts``.
+    label : str
+        What the step adds, in words.
+    loads : ndarray (N, n)
+        Load magnitude of each bearing over the crank angles, N.
+    """
+
+    key: str
+    label: str
+    loads: np.ndarray
+
+
+@dataclass(frozen=True)
+class Attribution:
+    """The chain handbook → equal share of the FE pin resultant → one flexible disc with T/discs
+    → two discs sharing the carrier → crankshaft compliance, on the same crank angles.
+
+    ``final`` names the step that is the case's own model (the full FE answer).
+    """
+
+    theta: np.ndarray
+    steps: tuple[AttributionStep, ...]
+    final: str
+
+    def step(self, key: str) -> AttributionStep:
+        return next(s for s in self.steps if s.key == key)
+
+    def table(self, exponent: float) -> list[dict]:
+        """Per step and bearing: max, min and equivalent load (N) and their deltas against the
+        first step (%), and the life ratio (F_ref,m/F_m)^(10/3). The first step is the handbook, or
+        the equal share where the handbook is not defined (Zp − Zc ≠ 1)."""
+        ref = self.steps[0].loads
+        rows = []
+        for s in self.steps:
+            for i in range(s.loads.shape[0]):
+                mx, mn = float(s.loads[i].max()), float(s.loads[i].min())
+                fm = float(equivalent_load(s.loads[i], exponent))
+                rmx, rmn = float(ref[i].max()), float(ref[i].min())
+                rfm = float(equivalent_load(ref[i], exponent))
+                rows.append({
+                    "step": s.key, "label": s.label, "bearing": i + 1,
+                    "max_N": mx, "min_N": mn, "equivalent_N": fm,
+                    "delta_max_percent": 100.0 * (mx / rmx - 1.0),
+                    "delta_min_percent": 100.0 * (mn / rmn - 1.0),
+                    "delta_equivalent_percent": 100.0 * (fm / rfm - 1.0),
+                    "life_ratio": life_ratio(rfm, fm),
+                })
+        return rows
+
+
+STEP_LABELS = {
+    "handbook": "handbook (rigid disc, classical pin forces, T/2 per disc)",
+    "equal_share": "equal share of the FE pin resultant (pin-force distribution of the flexible disc)",
+    "equal_share_reference": "equal share of this run's FE pin resultant (the reference: handbook not defined "
+                             "for Zp − Zc ≠ 1)",
+    "one_disc": "one flexible disc with T/2 on rigid eccentrics (bearing load sharing)",
+    "two_discs": "two discs sharing the carrier, rigid crank support",
+    "crankshafts": "two discs sharing the carrier, crankshafts as beams",
+}
+
+
+def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attribution:
+    """Solve the modelling steps the case does not already have and collect their load curves, at
+    the case's operating point.
+
+    Parameters
+    ----------
+    system : rvfem.solve.cycle.DiscSystem
+    thetas : ndarray
+        Crank angles, rad (a uniformly sampled turn).
+    cycles : dict, optional
+        Already solved cycles by step key (``one_disc``, ``two_discs``, ``crankshafts``), e.g. the
+        run's own cycle, so that it is not solved twice. All steps share the disc's compliance.
+
+    Notes
+    -----
+    The equal share is built from the one-disc cycle's pin resultant (the handbook's load sharing
+    applied to the flexible disc's pin forces): F_i = −P/N + T_disc/(N·r0)·t_i. Where the handbook
+    is not defined (Zp − Zc ≠ 1, :func:`rvfem.evaluate.rigid.handbook_applicable`) the chain starts at the
+    reference the run's bearing loads are compared with instead, the equal share of the case's own
+    cycle's pin resultant (:func:`rvfem.evaluate.compare.rigid_vs_flexible`), so that the last row's deltas
+    are the run's.
+    """
+    case = system.case
+    cycles = dict(cycles or {})
+    need = ["one_disc"]
+    discs = 2 if case.loads.discs == 2 else 1
+    if discs == 2:
+        need.append("two_discs")
+    f = crankshaft_influence(case)
+    if f is not None:
+        need.append("crankshafts")
+    for key in need:
+        if key in cycles:
+            continue
+        stage = build_stage(system, discs=1 if key == "one_disc" else discs,
+                            influence=f if key == "crankshafts" else None)
+        cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
+    if handbook_applicable(case)[0]:
+        steps = [AttributionStep("handbook", STEP_LABELS["handbook"], handbook_bearing_loads(case, thetas).magnitude)]
+        base, label = cycles["one_disc"], STEP_LABELS["equal_share"]
+    else:   # Zp − Zc ≠ 1: start at the run's own reference
+        steps, base, label = [], cycles[case_step(case)], STEP_LABELS["equal_share_reference"]
+    share = np.linalg.norm(equal_share_forces(case, base), axis=2).T
+    steps.append(AttributionStep("equal_share", label, share))
+    for key in need:
+        steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
+    return Attribution(np.asarray(thetas), tuple(steps), case_step(case))
+
+
+def case_step(case) -> str:
+    """The attribution step that is the case's own model: ``one_disc`` (one disc with T/discs on
+    rigid eccentrics: ``torque_split = "equal"``, or one disc without ``[crank_support]``),
+    ``two_discs`` (two discs on rigid eccentrics) or ``crankshafts``."""
+    if case.loads.discs > 1 and case.loads.torque_split == "equal":
+        return "one_disc"
+    if case.crank_support is not None:
+        return "crankshafts"
+    return "two_discs" if case.loads.discs == 2 else "one_disc"

@@ -1,0 +1,310 @@
+"""Where the models behind a result hold, and a one-line warning for every result outside.
+
+rvfem's results come from models with a range: the ISO 281 rating life, Hertz line contact, a
+linear-elastic disc, small displacements. An overloaded case (48 × the rated torque, a 1 mm pitch
+error) still gives numbers; this module says which of them are outside their model's range. It
+computes, it does not print: :func:`check_limits` is a pure function of plain numbers,
+:func:`analysis_warnings` and :func:`rigid_warnings` read them from an
+:class:`~rvfem.app.analysis.Analysis` or a :class:`~rvfem.app.analysis.RigidAnalysis` (which carry the
+result as their ``warnings``); ``summary.json``, ``rvfem rigid --json``, the report and the
+screen present them (docs/outputs.md, "Warnings").
+
+The limits, one constant each (sources in the docstrings and in docs/outputs.md):
+
+======================  =======================================================  ================
+code                    warns when                                               limit
+======================  =======================================================  ================
+``load_ratio``          P/C = F_m/C of a bearing is above                        0.5
+``life_under_1h``       a bearing life (L10h, duty-cycle service life) is under  1 h
+``hertz_pressure``      a roller–raceway Hertz peak pressure is above            4000 MPa (steel)
+``disc_stress_yield``   the disc's structural stress peak (von Mises) is above   1600 MPa
+``large_displacement``  the largest disc deformation is above, of the element    10 %
+                        size at the contacts
+======================  =======================================================  ================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Iterable
+
+import numpy as np
+
+__all__ = [
+    "LOAD_RATIO_LIMIT",
+    "MIN_LIFE_H",
+    "HERTZ_PRESSURE_LIMIT_MPA",
+    "BEARING_STEEL_MODULUS_MPA",
+    "BEARING_STEEL_POISSONS_RATIO",
+    "hertz_pressure_limit_MPa",
+    "PLACEHOLDER_YIELD_STRENGTH_MPA",
+    "DISPLACEMENT_FRACTION_LIMIT",
+    "ResultWarning",
+    "check_limits",
+    "analysis_warnings",
+    "rigid_warnings",
+]
+
+LOAD_RATIO_LIMIT = 0.5
+"""Largest P/C (equivalent load over the dynamic load rating) for which the ISO 281 rating life is
+reported without a warning. The rating-life formula L10 = (C/P)^(10/3) was fitted to endurance
+tests at moderate loads, where subsurface fatigue ends the life; rolling-bearing makers treat
+P > 0.5·C as outside its range (plastic deformation at the contacts governs there). On the
+shipped crank bearing, Stribeck's most loaded roller at F_m = 0.5·C already presses the raceway
+at about 3000 MPa, three quarters of the static limit :data:`HERTZ_PRESSURE_LIMIT_MPA`."""
+
+MIN_LIFE_H = 1.0
+"""A bearing life under one hour (one that a table in whole hours shows as 0 h) is a load far beyond
+the bearing's capacity, not a life."""
+
+HERTZ_PRESSURE_LIMIT_MPA = 4000.0
+"""Largest Hertz peak pressure of a roller–raceway line contact reported without a warning, MPa:
+ISO 76:2006, 3.1, defines the basic static load rating of radial roller bearings as the load that
+gives 4000 MPa at the centre of the most heavily loaded contact, where the total permanent
+deformation of roller and raceway is about 1/10 000 of the roller diameter. Above it the
+raceways deform plastically: Hertz's elastic theory and the rating life no longer hold."""
+
+BEARING_STEEL_MODULUS_MPA = 206000.0
+"""Young's modulus of bearing steel, MPa (with :data:`BEARING_STEEL_POISSONS_RATIO`): the material
+of the limit :data:`HERTZ_PRESSURE_LIMIT_MPA`."""
+
+BEARING_STEEL_POISSONS_RATIO = 0.3
+
+
+def hertz_pressure_limit_MPa(youngs_modulus_MPa: float = BEARING_STEEL_MODULUS_MPA,
+                             poissons_ratio: float = BEARING_STEEL_POISSONS_RATIO) -> float:
+    """The limit :data:`HERTZ_PRESSURE_LIMIT_MPA` for Hertz pressures computed with the given
+    material (both bodies of the contact, as :func:`rvfem.evaluate.hertz.crank_bearing_hertz` has them).
+
+    ISO 76's 4000 MPa is a pressure on bearing steel. A case whose material is not steel (the
+    rigid-disc limit of ``rv40e_classical`` has 6 × steel's modulus, a numerical device) gets
+    pressures scaled by sqrt(E'/E'_steel), E' = E/(1 − ν²), for the same roller load; the limit is
+    scaled the same way, so that the check asks whether the roller load would exceed the static
+    capacity of a steel bearing. For bearing steel it is 4000 MPa.
+    """
+    def reduced(e: float, nu: float) -> float:
+        return e / (1.0 - nu * nu)
+
+    return HERTZ_PRESSURE_LIMIT_MPA * math.sqrt(
+        reduced(youngs_modulus_MPa, poissons_ratio) / reduced(BEARING_STEEL_MODULUS_MPA, BEARING_STEEL_POISSONS_RATIO))
+
+
+PLACEHOLDER_YIELD_STRENGTH_MPA = 1600.0
+"""Yield strength of the disc material, MPa: a **placeholder** until the case gives strength data
+(the disc-strength issue). The lower end of published 0.2 % proof stresses of through-hardened
+bearing steel (GCr15 / 100Cr6, hardened and tempered at low temperature, about 1.6–2 GPa), the
+material of every shipped case. A structural peak above it means the linear-elastic disc model
+does not hold (and the disc would yield)."""
+
+DISPLACEMENT_FRACTION_LIMIT = 0.1
+"""Largest deformation of the disc (rigid-body motion removed), as a fraction of the element size
+at the contacts (the smaller of ``mesh.size_flank`` and ``mesh.size_bore``), reported without a
+warning. The model is linear: the contact gaps, the pin and roller footprints (spread over about
+1.5 elements) and the stresses are evaluated on the undeformed disc. A deformation of a tenth of
+an element moves a footprint by a tenth of its width; beyond that the small-displacement
+assumption is no longer met at the resolution the mesh gives."""
+
+
+@dataclass(frozen=True)
+class ResultWarning:
+    """One result outside its model's range.
+
+    Attributes
+    ----------
+    code : str
+        What is checked, a stable key: ``load_ratio``, ``life_under_1h``, ``hertz_pressure``,
+        ``disc_stress_yield``, ``large_displacement``.
+    message : str
+        One line for the user: the value, where it occurs, the limit and what it means.
+    value : float
+        The offending value (the worst of its kind), in ``unit``.
+    limit : float
+        The limit it crosses, in ``unit``.
+    unit : str
+        Unit of ``value`` and ``limit`` (``""`` for a ratio).
+    """
+
+    code: str
+    message: str
+    value: float
+    limit: float
+    unit: str
+
+    def as_dict(self) -> dict:
+        """The JSON object of ``summary.json`` and ``rvfem rigid --json`` (``warnings[]``)."""
+        return asdict(self)
+
+
+def _finite(items: Iterable[tuple[str, float | None]]) -> list[tuple[str, float]]:
+    return [(label, float(v)) for label, v in items if v is not None and math.isfinite(float(v))]
+
+
+def _sig(value: float, digits: int = 3) -> str:
+    """``value`` with ``digits`` significant figures, plainly written below 10^6."""
+    if value == 0 or not math.isfinite(value):
+        return f"{value:g}"
+    if 1e-3 <= abs(value) < 1e6:
+        decimals = max(0, digits - 1 - math.floor(math.log10(abs(value))))
+        return f"{value:.{decimals}f}"
+    return f"{value:.{digits - 1}e}"
+
+
+def check_limits(*, load_ratios: Iterable[tuple[str, float | None]] = (),
+                 lives_h: Iterable[tuple[str, float | None]] = (),
+                 hertz_MPa: Iterable[tuple[str, float | None]] = (),
+                 hertz_limit_MPa: float = HERTZ_PRESSURE_LIMIT_MPA,
+                 disc_stress_MPa: float | None = None,
+                 yield_strength_MPa: float = PLACEHOLDER_YIELD_STRENGTH_MPA,
+                 deformation_mm: float | None = None,
+                 element_size_mm: float | None = None) -> tuple[ResultWarning, ...]:
+    """The warnings of a set of results: one per limit crossed, naming the worst value.
+
+    Parameters
+    ----------
+    load_ratios : iterable of (str, float)
+        (where, P/C) of every bearing and model, e.g. ``("bearing 1, flexible", 0.12)``.
+    lives_h : iterable of (str, float)
+        (where, life in hours): L10h of every bearing and model, duty-cycle service lives.
+    hertz_MPa : iterable of (str, float)
+        (where, Hertz peak pressure in MPa) of the roller–raceway contacts evaluated.
+    hertz_limit_MPa : float
+        Their limit (default :data:`HERTZ_PRESSURE_LIMIT_MPA`, bearing steel; see
+        :func:`hertz_pressure_limit_MPa` for another material).
+    disc_stress_MPa : float, optional
+        The disc's structural stress peak (von Mises), MPa.
+    yield_strength_MPa : float
+        Yield strength of the disc material, MPa (default :data:`PLACEHOLDER_YIELD_STRENGTH_MPA`).
+    deformation_mm : float, optional
+        Largest deformation of the disc (rigid-body motion removed), mm.
+    element_size_mm : float, optional
+        Element size at the contacts, mm (needed with ``deformation_mm``).
+
+    Returns
+    -------
+    tuple of ResultWarning
+        In the order of the parameters; empty when every result is inside its range. Values
+        that are None or not finite (an infinite life at zero load) are skipped.
+    """
+    out: list[ResultWarning] = []
+    ratios = _finite(load_ratios)
+    if ratios:
+        where, value = max(ratios, key=lambda x: x[1])
+        if value > LOAD_RATIO_LIMIT:
+            out.append(ResultWarning(
+                "load_ratio",
+                f"P/C = {_sig(value)} ({where}) > {LOAD_RATIO_LIMIT:g}: outside the range of the ISO 281 rating "
+                "life; the lives are not meaningful",
+                value, LOAD_RATIO_LIMIT, ""))
+    lives = _finite(lives_h)
+    if lives:
+        where, value = min(lives, key=lambda x: x[1])
+        if value < MIN_LIFE_H:
+            out.append(ResultWarning(
+                "life_under_1h",
+                f"life {_sig(value)} h ({where}) < {MIN_LIFE_H:g} h: a load far beyond the bearing's capacity, "
+                "not a life",
+                value, MIN_LIFE_H, "h"))
+    pressures = _finite(hertz_MPa)
+    if pressures:
+        where, value = max(pressures, key=lambda x: x[1])
+        if value > hertz_limit_MPa:
+            scaled = ("" if math.isclose(hertz_limit_MPa, HERTZ_PRESSURE_LIMIT_MPA) else
+                      f" ({HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa on bearing steel, scaled to the case's modulus)")
+            out.append(ResultWarning(
+                "hertz_pressure",
+                f"Hertz pressure {value:.0f} MPa ({where}) > {hertz_limit_MPa:.0f} MPa, the static limit of roller "
+                f"bearings (ISO 76){scaled}: the raceways deform plastically, elastic Hertz contact does not hold",
+                value, float(hertz_limit_MPa), "MPa"))
+    if disc_stress_MPa is not None and math.isfinite(disc_stress_MPa) and disc_stress_MPa > yield_strength_MPa:
+        source = ("placeholder for through-hardened bearing steel"
+                  if yield_strength_MPa == PLACEHOLDER_YIELD_STRENGTH_MPA else "given")
+        out.append(ResultWarning(
+            "disc_stress_yield",
+            f"structural stress peak {disc_stress_MPa:.0f} MPa von Mises > yield strength "
+            f"{yield_strength_MPa:.0f} MPa ({source}): the disc yields, the linear-elastic model does not hold",
+            float(disc_stress_MPa), float(yield_strength_MPa), "MPa"))
+    if (deformation_mm is not None and element_size_mm is not None and math.isfinite(deformation_mm)
+            and element_size_mm > 0 and deformation_mm > DISPLACEMENT_FRACTION_LIMIT * element_size_mm):
+        limit = DISPLACEMENT_FRACTION_LIMIT * element_size_mm
+        out.append(ResultWarning(
+            "large_displacement",
+            f"largest disc deformation {_sig(deformation_mm)} mm = {100 * deformation_mm / element_size_mm:.0f} % "
+            f"of the element size at the contacts ({element_size_mm:g} mm) > "
+            f"{100 * DISPLACEMENT_FRACTION_LIMIT:.0f} %: beyond the small-displacement assumption of the linear "
+            "model",
+            float(deformation_mm), float(limit), "mm"))
+    return tuple(out)
+
+
+def _hertz_items(label: str, inner, outer) -> list[tuple[str, float]]:
+    return [(f"{label}, on the eccentric", inner.peak_pressure_MPa),
+            (f"{label}, in the disc bore", outer.peak_pressure_MPa)]
+
+
+def _duty_lives(duty) -> list[tuple[str, float | None]]:
+    """(where, service life) of a :class:`rvfem.app.analysis.DutyCycleResult`."""
+    if duty is None:
+        return []
+    out = [("duty-cycle service life, flexible", duty.flexible.service_life_h)]
+    if duty.rigid is not None:
+        out.append(("duty-cycle service life, rigid", duty.rigid.service_life_h))
+    if duty.flexible_fe is not None:
+        out.append(("duty-cycle service life, flexible FE at every torque", duty.flexible_fe.service_life_h))
+    return out
+
+
+_HERTZ_LABELS = {"fe_rollers": "largest FE roller load", "stribeck_rigid": "Stribeck, rigid F_max",
+                 "stribeck_flexible": "Stribeck, FE F_max"}
+
+
+def analysis_warnings(analysis) -> tuple[ResultWarning, ...]:
+    """The warnings of a complete analysis (:class:`rvfem.app.analysis.Analysis`; its ``warnings``
+    field holds them once :func:`rvfem.app.analysis.analyse` has computed them).
+
+    Checked: P/C and L10h of every bearing, rigid (handbook, where defined) and flexible; the
+    duty-cycle service lives; the Hertz pressures of every evaluated roller (FE and Stribeck);
+    the structural stress peak (P2 where re-solved; the contact-zone peak is mesh-dependent and
+    not checked); the largest deformation of the kept fields against ``min(mesh.size_flank,
+    mesh.size_bore)``.
+    """
+    c = analysis.comparison
+    ratios, lives = [], []
+    for bc in c.bearings:
+        for model in ("rigid", "flexible"):
+            s = getattr(bc, model)
+            if s is None:
+                continue
+            where = f"bearing {bc.bearing + 1}, {model}"
+            ratios.append((where, s.equivalent_N / c.rating_N))
+            lives.append((f"{where} L10h", s.L10h))
+    lives += _duty_lives(analysis.duty_cycle)
+    pressures = []
+    for key, rh in analysis.hertz.items():
+        pressures += _hertz_items(_HERTZ_LABELS.get(key, key), rh.inner, rh.outer)
+    structural = analysis.stress.structural
+    snapshots = analysis.stress.snapshots
+    deformation = max((float(np.max(np.hypot(*s.deformation.T), initial=0.0)) for s in snapshots), default=None)
+    ms, mat = analysis.case.mesh, analysis.case.material
+    return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
+                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio),
+                        disc_stress_MPa=None if structural is None else structural.von_mises_MPa,
+                        deformation_mm=deformation, element_size_mm=min(ms.size_flank, ms.size_bore))
+
+
+def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:
+    """The warnings of the rigid handbook evaluation (:class:`rvfem.app.analysis.RigidAnalysis`, what
+    ``rvfem rigid`` prints): P/C and L10h of every bearing, the duty-cycle service life and the
+    Hertz pressures of Stribeck's most loaded roller. Nothing where the handbook is not defined."""
+    ratios, lives, pressures = [], [], []
+    for b in rigid_analysis.bearings:
+        where = f"bearing {b.loads.bearing + 1}, rigid"
+        ratios.append((where, b.loads.equivalent_N / rigid_analysis.rating_N))
+        lives.append((f"{where} L10h", b.loads.L10h))
+        pressures += _hertz_items(f"Stribeck roller of bearing {b.loads.bearing + 1}, rigid", b.hertz_inner,
+                                  b.hertz_outer)
+    if rigid_analysis.duty_cycle is not None:
+        lives.append(("duty-cycle service life, rigid", rigid_analysis.duty_cycle.service_life_h))
+    mat = rigid_analysis.case.material
+    return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
+                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio))

@@ -1,0 +1,1 @@
+"""Outputs: summary, tables, VTK files, plots, images and the report."""

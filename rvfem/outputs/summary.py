@@ -1,0 +1,1330 @@
+"""Writers of an :class:`~rvfem.app.analysis.Analysis`: one per format, and the atomic result folder.
+
+Every writer has the form ``write_x(analysis, folder) -> list[Path]`` and writes into an existing
+folder (sub-folders it needs are created)::
+
+    write_case_json   case.json           the case as analysed; case_from_dict() reads it back
+    write_tables      bearing_loads.csv, roller_loads.csv (bearing model "rollers"), pin_forces.csv,
+                      cycle.csv
+    write_vtk         vtk/disc.pvd and vtk/disc_theta_<θ>.vtu per kept field (ParaView)
+    write_images      images/stress_theta_<θ>.png, the two stress close-ups (PyVista, off-screen),
+                      images/mesh.png (matplotlib)
+    write_plots       plots/*.png (matplotlib)
+    write_summary     summary.json
+    write_report      report.html (self-contained)
+
+The content of ``summary.json`` is built in one place, :func:`build_summary`, from the typed pieces
+of :data:`SUMMARY_PIECES`; docs/outputs.md documents every key (a test checks that the two agree).
+:func:`result_folder` is the atomic result folder: results are written into a temporary folder next
+to the target and moved into place only when complete.
+
+File formats and keys: docs/outputs.md.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import datetime
+import json
+import logging
+import math
+import os
+import platform
+import shlex
+import shutil
+import sys
+import tempfile
+import uuid
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Callable, Iterable, Iterator, Mapping
+
+import numpy as np
+
+from rvfem import __version__
+from rvfem.case.definition import case_to_dict, file_sha256
+from rvfem.errors import OutputError
+from rvfem.evaluate.hertz import STRIBECK_FACTOR
+from rvfem.evaluate.postprocess import user_feature_name
+from rvfem.evaluate.rigid import REFERENCE_NAMES, references
+from rvfem.geometry import crank_centres
+from rvfem.outputs import plots, render, tables, vtkio
+from rvfem.outputs.plots import mesh_plot
+from rvfem.outputs.report import toml_text
+from rvfem.outputs.report import write_report as _write_html
+from rvfem.outputs.vtkio import vtu_name
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "RIGID_SCHEMA_VERSION",
+    "VERSIONED_PACKAGES",
+    "CLI_MODULES",
+    "CLI_SCRIPTS",
+    "command_line",
+    "environment",
+    "IMAGE_SIZE",
+    "DEFORMATION_DISPLAY_FRACTION",
+    "SummaryContext",
+    "SUMMARY_PIECES",
+    "json_ready",
+    "check_output_folder",
+    "result_folder",
+    "image_count",
+    "build_summary",
+    "summary_text",
+    "stress_lines",
+    "reference_lines",
+    "warning_lines",
+    "rigid_summary",
+    "rigid_text",
+    "write_case_json",
+    "write_tables",
+    "write_vtk",
+    "write_images",
+    "submit_images",
+    "start_mesh_picture",
+    "mesh_picture",
+    "PendingImages",
+    "write_plots",
+    "plot_calls",
+    "write_summary",
+    "write_report",
+]
+
+SCHEMA_VERSION = 2
+"""Version of the ``summary.json`` layout (docs/outputs.md); bumped when a key changes meaning or
+disappears (new keys do not bump it)."""
+
+RIGID_SCHEMA_VERSION = 1
+"""Version of the ``rvfem rigid --json`` layout (docs/outputs.md); bumped when a key changes meaning
+or disappears."""
+
+IMAGE_SIZE = (1500, 1100)
+"""Size of the stress images, pixels (width, height)."""
+
+DEFORMATION_DISPLAY_FRACTION = 0.03
+"""The largest deformation of the kept fields is drawn as about this fraction of the pin-circle
+radius (the magnification is rounded down to 1, 2 or 5·10^k and written on the image)."""
+
+TickCallback = Callable[[int, int], None]
+"""``tick(done, total)``: progress within a writer (images, VTK files)."""
+
+
+# --------------------------------------------------------------------------------------------
+# JSON
+# --------------------------------------------------------------------------------------------
+
+
+def json_ready(obj: Any) -> Any:
+    """A copy of ``obj`` that :func:`json.dumps` writes as strict JSON.
+
+    Numpy scalars become Python numbers, tuples lists, dataclasses dicts, and non-finite floats
+    (an infinite life at zero load, a ratio that cannot be formed) become ``None`` (JSON
+    ``null``): ``Infinity`` and ``NaN`` are not JSON and most readers reject them.
+    """
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return json_ready(dataclasses.asdict(obj))
+    if isinstance(obj, dict):
+        return {str(k): json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_ready(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return json_ready(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        v = float(obj)
+        return v if math.isfinite(v) else None
+    return obj
+
+
+def _dump(obj: Any) -> str:
+    return json.dumps(json_ready(obj), indent=2, allow_nan=False) + "\n"
+
+
+# --------------------------------------------------------------------------------------------
+# The atomic result folder
+# --------------------------------------------------------------------------------------------
+
+
+def _is_nonempty_dir(path: Path) -> bool:
+    return path.is_dir() and any(path.iterdir())
+
+
+def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
+    """Raise :class:`~rvfem.errors.OutputError` if ``out_dir`` cannot take the results: it is a file,
+    or a non-empty folder and ``overwrite`` is false."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() or out_dir.is_symlink():
+        if not out_dir.is_dir():
+            raise OutputError(f"{out_dir} exists and is not a folder; choose another output folder")
+        if _is_nonempty_dir(out_dir) and not overwrite:
+            raise OutputError(f"{out_dir} exists and is not empty; choose another output folder or pass "
+                              "overwrite=True to replace it")
+
+
+def _make_parents(out_dir: Path) -> list[Path]:
+    """Create the missing parents of ``out_dir``; return the ones created (outermost first)."""
+    missing = []
+    p = out_dir.parent
+    while not p.exists():
+        missing.append(p)
+        p = p.parent
+    try:
+        for p in reversed(missing):
+            p.mkdir()
+    except OSError as exc:
+        raise OutputError(f"cannot create the folder {p}: {exc.strerror or exc}") from None
+    return list(reversed(missing))
+
+
+def _remove_created(created: list[Path]) -> None:
+    for p in reversed(created):
+        try:
+            p.rmdir()
+        except OSError:
+            pass
+
+
+def _commit(tmp: Path, out_dir: Path, overwrite: bool) -> None:
+    """Move the complete results into place (atomic rename; an old folder goes only after)."""
+    check_output_folder(out_dir, overwrite)
+    if _is_nonempty_dir(out_dir):
+        old = out_dir.with_name(f".{out_dir.name}.old-{uuid.uuid4().hex[:8]}")
+        os.replace(out_dir, old)
+        try:
+            os.replace(tmp, out_dir)
+        except BaseException:
+            os.replace(old, out_dir)
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(tmp, out_dir)  # also replaces an empty folder
+
+
+@contextlib.contextmanager
+def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False) -> Iterator[Path]:
+    """The atomic result folder: yields a temporary folder to write into, next to ``out_dir``.
+
+    On entry ``out_dir`` is checked (:func:`check_output_folder`) and its missing parents are
+    created. When the block ends normally the temporary folder is renamed to ``out_dir`` (an
+    existing non-empty ``out_dir`` is replaced only then, and only with ``overwrite``). When the
+    block raises (an error, Ctrl-C) the temporary folder and the parents created are removed and
+    an existing ``out_dir`` stays as it was.
+
+    Raises
+    ------
+    OutputError
+        ``out_dir`` is a file, is not empty (without ``overwrite``), or cannot be written.
+
+    Examples
+    --------
+    >>> with result_folder("results/x", overwrite=True) as tmp:    # doctest: +SKIP
+    ...     write_tables(analysis, tmp)
+    """
+    out_dir = Path(out_dir)
+    check_output_folder(out_dir, overwrite)
+    created = _make_parents(out_dir)
+    try:
+        tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=out_dir.parent))
+    except OSError as exc:
+        _remove_created(created)
+        raise OutputError(f"cannot write into {out_dir.parent}: {exc.strerror or exc}") from None
+    try:
+        umask = os.umask(0o022)
+        os.umask(umask)
+        os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; the results are an ordinary folder
+        try:
+            yield tmp
+        except OSError as exc:
+            raise OutputError(f"cannot write the results: {exc.strerror or exc}") from None
+        try:
+            _commit(tmp, out_dir, overwrite)
+        except OSError as exc:
+            raise OutputError(f"cannot move the results into {out_dir}: {exc.strerror or exc}") from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        _remove_created(created)
+        raise
+
+
+# --------------------------------------------------------------------------------------------
+# summary.json: built in one place from typed pieces
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SummaryContext:
+    """What the summary needs besides the analysis.
+
+    Attributes
+    ----------
+    files : tuple of str
+        Files of the result folder, relative paths (posix).
+    timings : dict
+        Wall time per stage (s), including the writers' and ``total``.
+    """
+
+    files: tuple[str, ...] = ()
+    timings: Mapping[str, float] = dataclasses.field(default_factory=dict)
+
+
+def _stats_dict(s) -> dict:
+    return {
+        "max_load_N": s.max_N,
+        "max_at_deg": _angle(s.max_at_deg),
+        "min_load_N": s.min_N,
+        "min_at_deg": _angle(s.min_at_deg),
+        "equivalent_load_N": s.equivalent_N,
+        "L10h_h": s.L10h,
+    }
+
+
+def _hertz_dict(h) -> dict:
+    return {
+        "roller_load_N": h.roller_load_N,
+        "bearing": None if h.bearing is None else h.bearing + 1,
+        "roller": None if h.roller is None else h.roller + 1,
+        "theta_deg": _angle(h.theta_deg),
+        "inner": dataclasses.asdict(h.inner),
+        "outer": dataclasses.asdict(h.outer),
+    }
+
+
+ANGLE_DECIMALS = 6
+"""Crank angles in ``summary.json`` and ``rvfem rigid --json`` are rounded to this many decimals
+(no float noise such as 255.00000000000003; every step rvfem accepts is a whole multiple of
+1e-6°)."""
+
+
+def _angle(deg):
+    """A crank angle for the user, degrees, rounded to :data:`ANGLE_DECIMALS` (None stays None)."""
+    return None if deg is None else round(float(deg), ANGLE_DECIMALS) + 0.0
+
+
+def _peak_dict(peak) -> dict:
+    return {
+        "x_mm": peak.x_mm,
+        "y_mm": peak.y_mm,
+        "radius_mm": peak.radius_mm,
+        "theta_deg": _angle(peak.theta_deg),
+        "feature": user_feature_name(peak.feature),
+        "feature_label": peak.feature_label,
+        "distance_to_feature_mm": peak.distance_to_feature_mm,
+    }
+
+
+VERSIONED_PACKAGES = ("numpy", "scipy", "scikit-fem", "gmsh", "vtk", "pyvista", "matplotlib", "meshio")
+"""Packages whose installed versions ``summary.json`` records (``environment.versions``)."""
+
+
+CLI_MODULES = ("rvfem", "rvfem.__main__", "rvfem.app.cli")
+"""Modules whose ``python -m`` run is the ``rvfem`` command (``__main__.__spec__.name``)."""
+
+CLI_SCRIPTS = ("rvfem", "rvfem.exe", "rvfem-script.py")
+"""File names of the ``rvfem`` console script (``sys.argv[0]``) on POSIX and Windows."""
+
+
+def command_line() -> str | None:
+    """The command line of this process if it is the ``rvfem`` command (None from Python, a
+    notebook or a test runner), shell-quoted.
+
+    Decided from the entry point, not from where the files lie: the process is the ``rvfem``
+    command if its ``__main__`` module is :mod:`rvfem` run with ``python -m rvfem`` (or
+    ``-m rvfem.app.cli``; the name of ``__main__.__spec__`` is one of :data:`CLI_MODULES`), or if
+    it is a plain script (no module spec) named ``rvfem``, the console script the installation
+    writes (:data:`CLI_SCRIPTS`). ``python -m pytest`` started in a folder named ``rvfem`` is
+    not the command.
+    """
+
+    argv = list(sys.argv)
+    if not argv:
+        return None
+    main = sys.modules.get("__main__")
+    spec = getattr(main, "__spec__", None)
+    name = getattr(spec, "name", None)
+    if name in CLI_MODULES:
+        return shlex.join(["rvfem", *argv[1:]])
+    if name in (None, "__main__") and Path(argv[0]).name in CLI_SCRIPTS:
+        return shlex.join(["rvfem", *argv[1:]])
+    return None
+
+
+def environment() -> dict:
+    """When, how and with what a result was computed: UTC date and time, the command line
+    (:func:`command_line`), Python, the platform and the versions of
+    :data:`VERSIONED_PACKAGES` (None if not installed)."""
+
+    versions = {}
+    for name in VERSIONED_PACKAGES:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return {
+        "date_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "command_line": command_line(),
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "versions": versions,
+    }
+
+
+def _piece_header(a, ctx: SummaryContext) -> dict:
+    p, case = a.provenance, a.case
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "rvfem_version": __version__,
+        "environment": environment(),
+        "case": {
+            "name": case.name,
+            "description": case.description,
+            "file": p.file,
+            "sha256": p.sha256,
+            "matches_file": p.matches_file,
+            "digest": case.digest(),
+            "overrides": dict(p.overrides),
+            "defaults_used": {k: v for k, v in p.defaults_used},
+        },
+    }
+
+
+def _piece_warnings(a, ctx: SummaryContext) -> dict:
+    return {"warnings": [w.as_dict() for w in a.warnings]}
+
+
+def _piece_model(a, ctx: SummaryContext) -> dict:
+    case, model, c = a.case, a.system.model, a.comparison
+    return {"model": {
+        "bearing_model": case.crank_bearing.model,
+        "element_order": model.order,
+        "pin_model": a.system.pin_model,
+        "pin_friction": case.analysis.friction,
+        "nodes": model.n_nodes,
+        "vertices": model.n_vertices,
+        "dofs": model.n_dofs,
+        "elements": model.n_elements,
+        "mesh_file": a.mesh.path.name,
+        "mesh_min_quality": a.mesh.min_quality,
+        "mesh_symmetry": a.system.symmetry,
+        "angle_step_deg": 360.0 / len(a.theta),
+        "angles": len(a.theta),
+        "angles_solved": int(a.cycle.timings.get("pair_solves", len(a.theta))),
+        "output_torque_Nm": case.loads.torque_Nm,
+        "discs": case.loads.discs,
+        "disc_torque_Nmm": case.loads.disc_torque_Nmm,
+        "torque_convention": "disc torque T_out/discs = moment of the pin forces about the disc centre "
+                             "(handbook: sum P_x = T/(2 e Zc))",
+        "radial_clearance_mm": case.crank_bearing.radial_clearance,
+        "equivalent_load_exponent": c.exponent,
+        "dynamic_load_rating_N": c.rating_N,
+        "bearing_speed_rpm": c.bearing_speed_rpm,
+        "handbook_k_y": c.handbook_k_y,
+        "fe_pin_resultant_ratio": c.pin_resultant_ratio,
+    }}
+
+
+def _references_dict(refs) -> dict:
+    """The ``references`` object of ``summary.json`` and ``rvfem rigid --json``."""
+    return {
+        "bearing_loads": refs.bearing_loads,
+        **{key: {"defined": ref.defined, "why": ref.why} for key, ref in refs.items()},
+    }
+
+
+def _piece_references(a, ctx: SummaryContext) -> dict:
+    return {"references": _references_dict(a.references)}
+
+
+def _piece_bearings(a, ctx: SummaryContext) -> dict:
+    bearings = [{
+        "bearing": bc.bearing + 1,
+        "crank_angle_deg": a.case.cranks.angles_deg[bc.bearing],
+        "rigid": None if bc.rigid is None else _stats_dict(bc.rigid),
+        "flexible": _stats_dict(bc.flexible),
+        "equal_share": _stats_dict(bc.equal_share),
+        "delta_max_percent": bc.delta_max_percent,
+        "delta_min_percent": bc.delta_min_percent,
+        "delta_equivalent_percent": bc.delta_equivalent_percent,
+        "life_ratio": bc.life_ratio,
+    } for bc in a.comparison.bearings]
+    k, i = a.max_load_index
+    return {
+        "bearings": bearings,
+        "max_bearing_load": {
+            "bearing": i + 1,
+            "theta_deg": _angle(math.degrees(float(a.theta[k]))),
+            "flexible_N": float(a.cycle.bearing_loads[k, i]),
+        },
+    }
+
+
+def _piece_cycle(a, ctx: SummaryContext) -> dict:
+    cy = a.cycle
+    arcmin = np.degrees(cy.carrier_rotation) * 60.0
+    return {
+        "pins_in_contact": {
+            "min": int(cy.pins_in_contact.min()),
+            "max": int(cy.pins_in_contact.max()),
+            "mean": float(cy.pins_in_contact.mean()),
+            "of": a.case.pins.count,
+        },
+        "torsional_stiffness_Nm_per_arcmin": a.torsional_stiffness_Nm_per_arcmin,
+        "carrier_rotation_arcmin": {"min": float(arcmin.min()), "max": float(arcmin.max()),
+                                    "mean": float(arcmin.mean())},
+        "equilibrium_residual": float(cy.equilibrium_residual.max()),
+        "active_set_iterations": {"max": int(cy.iterations.max()), "mean": float(cy.iterations.mean())},
+    }
+
+
+def _piece_stress(a, ctx: SummaryContext) -> dict:
+    s = a.stress
+    away, rec = s.away_from_contacts, s.recovered
+    structural = s.structural
+    return {
+        "peak_von_mises_MPa": None if structural is None else structural.von_mises_MPa,
+        "peak_von_mises_at": None if structural is None else _peak_dict(structural),
+        "stress": {
+            "structural_peak": None if rec is None else {
+                "von_mises_MPa": rec.peak.von_mises_MPa,
+                "at": _peak_dict(rec.peak),
+                "method": rec.method,
+                "element_order": 2,
+                "estimated_error_MPa": rec.estimated_error_MPa,
+                "estimated_error_percent": rec.estimated_error_percent,
+                "p1_MPa": rec.p1_MPa,
+                "p1_at_peak_MPa": rec.p1_at_peak_MPa,
+                "p1_error_percent": rec.p1_error_percent,
+                "angles_deg": [_angle(x) for x in rec.angles_deg],
+                "seconds": rec.seconds,
+            },
+            "away_from_contacts": None if away is None else {
+                "peak_von_mises_MPa": away.von_mises_MPa,
+                "element_order": a.system.model.order,
+                "at": _peak_dict(away),
+                "profile_band_mm": s.band_mm["profile"],
+                "bore_band_mm": s.band_mm.get("bore_0"),
+            },
+            "contact_zone": {
+                "peak_von_mises_MPa": s.peak.von_mises_MPa,
+                "at": _peak_dict(s.peak),
+                "mesh_dependent": True,
+            },
+            "field_angles_deg": [_angle(snap.theta_deg) for snap in s.snapshots],
+            "hot_spots": [] if s.history is None else [_hot_spot_dict(s.history, j)
+                                                       for j in range(len(s.history.names))],
+        },
+    }
+
+
+def _hot_spot_dict(h, j: int) -> dict:
+    vm, sd = h.von_mises[:, j], h.dominant[:, j]
+    return {
+        "name": h.names[j],
+        "at": _peak_dict(h.peaks[j]),
+        "von_mises_max_MPa": float(vm.max()),
+        "von_mises_min_MPa": float(vm.min()),
+        "dominant_principal_max_MPa": float(sd.max()),
+        "dominant_principal_min_MPa": float(sd.min()),
+        "dominant_principal_range_MPa": float(sd.max() - sd.min()),
+        "dominant_principal_mean_MPa": float(0.5 * (sd.max() + sd.min())),
+        "p2_factor": h.p2_factor[j],
+    }
+
+
+def _piece_hertz(a, ctx: SummaryContext) -> dict:
+    h = a.hertz
+    return {"hertz": {
+        "stribeck_factor": STRIBECK_FACTOR,
+        "fe_rollers": _hertz_dict(h["fe_rollers"]) if "fe_rollers" in h else None,
+        "stribeck_rigid": _hertz_dict(h["stribeck_rigid"]) if "stribeck_rigid" in h else None,
+        "stribeck_flexible": _hertz_dict(h["stribeck_flexible"]),
+    }}
+
+
+def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
+    if a.duty_cycle is None:
+        return {}
+    fe = a.duty_cycle.flexible_fe
+    return {"duty_cycle": {
+        "rigid": None if a.duty_cycle.rigid is None else dataclasses.asdict(a.duty_cycle.rigid),
+        "flexible": dataclasses.asdict(a.duty_cycle.flexible),
+        "flexible_fe": None if fe is None else {
+            "torques_Nm": list(fe.torques_Nm),
+            "equivalent_load_N": [list(row) for row in fe.equivalent_load_N],
+            "linear_scaling_error_percent": list(fe.linear_scaling_error_percent),
+            "service_life_h": fe.service_life_h,
+            "life_difference_percent": fe.life_difference_percent,
+            "seconds": fe.seconds,
+        },
+    }}
+
+
+def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
+    cy, case = a.cycle, a.case
+    share = None
+    disc_b = None
+    if cy.disc_torque_Nmm is not None and cy.disc_torque_Nmm.shape[1] == 2:
+        s = cy.disc_torque_Nmm[:, 0] / case.loads.disc_torque_Nmm
+        share = {"min": float(s.min()), "max": float(s.max())}
+        disc_b = float(np.linalg.norm(cy.disc_bearing_forces[:, 1], axis=-1).max())
+    f = cy.crankshaft_influence if a.attribution.final == "crankshafts" else None
+    w = cy.eccentric_displacement
+    return {"reducer_stage": {
+        "model": cy.stage,
+        "step": a.attribution.final,
+        "crank_support_rigid": f is None,
+        "torque_share": share,
+        "disc_b_max_load_N": disc_b,
+        "crankshaft_influence_mm_per_N": None if f is None else f.tolist(),
+        "eccentric_displacement_max_mm": None if (w is None or f is None) else float(np.linalg.norm(w, axis=-1).max()),
+    }}
+
+
+def _piece_attribution(a, ctx: SummaryContext) -> dict:
+    rows = a.attribution.table(a.case.analysis.equivalent_load_exponent)
+    for r in rows:
+        r["final"] = r["step"] == a.attribution.final
+    return {"attribution": rows}
+
+
+def _image_key(rel: str) -> str:
+    return Path(rel).stem
+
+
+def _piece_files(a, ctx: SummaryContext) -> dict:
+    files = set(ctx.files)
+    fields = []
+    for snap in a.stress.snapshots:
+        entry = {"theta_deg": _angle(snap.theta_deg), "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
+        image = f"images/{_stress_image_name(snap.theta_deg)}"
+        if image in files:
+            entry["image"] = image
+        fields.append(entry)
+    return {
+        "fields": sorted(fields, key=lambda f: f["theta_deg"]),
+        "images": {_image_key(f): f for f in sorted(files) if f.startswith("images/") and f.endswith(".png")},
+        "plots": {_image_key(f): f for f in sorted(files) if f.startswith("plots/") and f.endswith(".png")},
+        "timings_s": dict(ctx.timings),
+        "files": sorted(files),
+    }
+
+
+SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
+    _piece_header,
+    _piece_warnings,
+    _piece_model,
+    _piece_references,
+    _piece_bearings,
+    _piece_cycle,
+    _piece_stress,
+    _piece_hertz,
+    _piece_duty_cycle,
+    _piece_reducer_stage,
+    _piece_attribution,
+    _piece_files,
+)
+"""The pieces of ``summary.json`` in order: each ``piece(analysis, context) -> dict`` of top-level
+keys. A new result of :class:`~rvfem.app.analysis.Analysis` adds one piece here and its keys to
+docs/outputs.md."""
+
+
+def build_summary(analysis, context: SummaryContext | None = None) -> dict:
+    """The content of ``summary.json`` (JSON-ready: non-finite numbers are None).
+
+    Parameters
+    ----------
+    analysis : rvfem.app.analysis.Analysis
+    context : SummaryContext, optional
+        Files of the result folder and timings (default: none, e.g. for a summary in memory).
+    """
+    context = context or SummaryContext(timings=dict(analysis.timings))
+    summary: dict[str, Any] = {}
+    for piece in SUMMARY_PIECES:
+        summary.update(piece(analysis, context))
+    return json_ready(summary)
+
+
+def write_summary(analysis, folder: str | os.PathLike, *, summary: dict | None = None) -> list[Path]:
+    """Write ``summary.json`` (the given ``summary``, or :func:`build_summary` with the files
+    found in ``folder``)."""
+    folder = Path(folder)
+    if summary is None:
+        summary = build_summary(analysis, SummaryContext(files=_files_in(folder, ("summary.json",)),
+                                                         timings=dict(analysis.timings)))
+    path = folder / "summary.json"
+    path.write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    return [path]
+
+
+def _files_in(folder: Path, extra: Iterable[str] = ()) -> tuple[str, ...]:
+    found = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
+    return tuple(sorted(found | set(extra)))
+
+
+# --------------------------------------------------------------------------------------------
+# case.json and the CSV tables
+# --------------------------------------------------------------------------------------------
+
+
+def write_case_json(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Write ``case.json``: the case as analysed (:func:`rvfem.case.definition.case_from_dict` reads it back)."""
+    path = Path(folder) / "case.json"
+    path.write_text(json.dumps(case_to_dict(analysis.case), indent=2) + "\n", encoding="utf-8")
+    return [path]
+
+
+def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Write the CSV tables of the load cycle (:mod:`rvfem.outputs.tables`): ``bearing_loads.csv``,
+    ``roller_loads.csv`` (discrete rollers only), ``pin_forces.csv``, ``cycle.csv``. The handbook
+    and classical columns are NaN where those references are not defined (Zp − Zc ≠ 1)."""
+
+    folder = Path(folder)
+    a, cy, th = analysis, analysis.cycle, analysis.theta
+    hb = a.rigid.loads   # NaN where the handbook is not defined
+    out = [tables.write_bearing_loads(folder / "bearing_loads.csv", th, cy.bearing_forces,
+                                      np.stack([hb.fx.T, hb.fy.T], axis=2), a.equal_share_forces)]
+    if cy.roller_loads is not None:
+        out.append(tables.write_roller_loads(folder / "roller_loads.csv", th, cy.roller_angles, cy.roller_loads))
+    classical = (np.full(cy.pin_forces.shape, np.nan) if a.classical is None  # not defined for Zp − Zc ≠ 1
+                 else a.classical.magnitude.T)
+    out.append(tables.write_pin_forces(folder / "pin_forces.csv", th, a.pin_centres, cy.pin_forces, classical))
+    out.append(tables.write_cycle_table(folder / "cycle.csv", th, cy.pins_in_contact, cy.carrier_rotation,
+                                        cy.equilibrium_residual, cy.iterations))
+    if a.stress.history is not None:
+        out.append(tables.write_stress_history(folder / "stress_history.csv", a.stress.history))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# VTK
+# --------------------------------------------------------------------------------------------
+
+
+def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None) -> list[Path]:
+    """Write ``vtk/disc_theta_<θ>.vtu`` for every kept field and the collection ``vtk/disc.pvd``
+    (:mod:`rvfem.outputs.vtkio`)."""
+
+    vtk = Path(folder) / "vtk"
+    vtk.mkdir(exist_ok=True)
+    model = analysis.system.model
+    snapshots = analysis.stress.snapshots
+    points, triangles = model.mesh.p.T, model.mesh.t.T
+    mesh = vtkio.vtu_mesh(points, triangles)   # the same in every file: encoded once
+    out, entries = [], []
+    for done, snap in enumerate(snapshots, start=1):
+        name = vtkio.vtu_name(snap.theta_deg)
+        out.append(vtkio.write_vtu(vtk / name, points, triangles, snap, mesh=mesh))
+        entries.append((snap.theta_deg, name))
+        if tick is not None and done < len(snapshots):
+            tick(done, len(snapshots))
+    out.append(vtkio.write_pvd(vtk / "disc.pvd", entries))
+    cy = analysis.cycle
+    if cy.von_mises_envelope is not None:
+        structural, recovered = analysis.stress.structural, analysis.stress.recovered
+        out.append(vtkio.write_envelope_vtu(
+            vtk / vtkio.ENVELOPE_FILE, points, triangles, cy.von_mises_envelope, cy.von_mises_envelope_theta,
+            element_order=model.order, structural_peak_MPa=None if structural is None else structural.von_mises_MPa,
+            structural_peak_order=2 if recovered is not None else model.order, mesh=mesh))
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Images and plots
+# --------------------------------------------------------------------------------------------
+
+
+def _stress_image_name(theta_deg: float) -> str:
+    return f"stress_theta_{theta_deg % 360:06.2f}.png"
+
+
+def image_count(analysis) -> int:
+    """Number of images :func:`write_images` draws (for a progress bar)."""
+    s = analysis.stress
+    return len(s.snapshots) + sum(pk is not None for pk in (s.peak, s.away_from_contacts)) + 1
+
+
+@dataclass(frozen=True, eq=False)
+class _ImageSet:
+    """What :func:`write_images` draws: the stress images (PNG path, scene, keyword arguments of
+    :meth:`rvfem.outputs.render.StressRenderer.write`) and the mesh picture (keyword arguments of
+    :func:`rvfem.outputs.plots.mesh_plot`)."""
+
+    stress: list
+    mesh: dict
+
+
+def _image_set(analysis, images: Path) -> _ImageSet:
+    a, case, cy = analysis, analysis.case, analysis.cycle
+    model, mesh, snapshots = a.system.model, a.mesh, a.stress.snapshots
+    peak, away = a.stress.peak, a.stress.away_from_contacts
+    vertices, triangles = model.mesh.p.T, model.mesh.t.T
+    pin_xy, rigid_forces = a.pin_centres, a.rigid_forces
+    k_max, _ = a.max_load_index
+    max_def = max(float(np.max(np.hypot(*s.deformation.T))) for s in snapshots)
+    magnification = render.nice_factor(DEFORMATION_DISPLAY_FRACTION * case.pins.circle_radius / max_def)
+    f_ref = max(float(cy.bearing_loads.max()), float(a.rigid.loads.magnitude.max()))
+    # colour range up to the peak away from the contacts (the structural field stays readable);
+    # the contact spots above it are drawn in the "above" colour
+    clim = (0.0, (away or peak).von_mises_MPa)
+    bores = crank_centres(case)
+
+    def scene(snap, label):
+        k = snap.index
+        pf = cy.pin_forces[k]
+        return render.StressScene(
+            points=vertices, triangles=triangles, boundaries=mesh.boundaries,
+            von_mises=snap.stress.nodal.von_mises, deformation=snap.deformation,
+            magnification=magnification, clim=clim,
+            pin_centres=pin_xy[k], pin_radius=case.pins.radius,
+            pin_loaded=pf > 1e-9 * max(float(pf.max()), 1.0),
+            bore_centres=bores, bearing_forces=cy.bearing_forces[k], rigid_forces=rigid_forces[k],
+            force_scale=0.85 * case.crank_bearing.bore_radius / f_ref,
+            title=f"{case.name}   crank angle {snap.theta_deg:.1f}°{label}   von Mises on the disc deformed "
+                  f"×{magnification:g}   bearings '{case.crank_bearing.model}', P{model.order}",
+        )
+
+    stress = []
+    for snap in snapshots:
+        label = "  (max. bearing load)" if snap.index == k_max else ""
+        stress.append((images / _stress_image_name(snap.theta_deg), scene(snap, label), {}))
+    half = max(5.0, 12.0 * case.mesh.size_bore)
+    rec = a.stress.recovered
+    for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
+                          ("stress_away_from_contacts_closeup", away, "structural peak away from contacts")):
+        if pk is None:
+            continue
+        snap = next(s for s in snapshots if math.isclose(s.theta_deg, pk.theta_deg))
+        extra = ""
+        if rec is not None and key == "stress_away_from_contacts_closeup":
+            extra = f" (P2 re-solve: {rec.peak.von_mises_MPa:.0f} MPa)"
+        close = dataclasses.replace(
+            scene(snap, ""), magnification=0.0, clim=(0.0, pk.von_mises_MPa),
+            title=f"{case.name}, crank angle {snap.theta_deg:.1f}°, close-up (undeformed), {what}\n"
+                  f"von Mises {pk.von_mises_MPa:.0f} MPa (P{model.order}){extra} at the ring, "
+                  f"{pk.feature_label}")
+        stress.append((images / f"{key}.png", close, dict(focus=(pk.x_mm, pk.y_mm), half_height=half,
+                                                          marker=(pk.x_mm, pk.y_mm), show_edges=True)))
+    return _ImageSet(stress=stress, mesh=mesh_picture(a.system, images))
+
+
+def mesh_picture(system, images: str | os.PathLike) -> dict:
+    """The keyword arguments of :func:`rvfem.outputs.plots.mesh_plot` for ``images/mesh.png`` of a run:
+    the whole mesh and a close-up of the rim under the bore of bearing 1. It needs the model only,
+    so a run can have it drawn while the load cycle is solved (:func:`start_mesh_picture`)."""
+
+    case, mesh = system.case, system.mesh
+    bore = crank_centres(case)[0]
+    b0 = bore * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bore))
+    return dict(path=Path(images) / "mesh.png", points=system.model.mesh.p.T, triangles=system.model.mesh.t.T,
+                boundaries=mesh.boundaries, closeup_centre=(float(b0[0]), float(b0[1])),
+                title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
+                      f"(min quality {mesh.min_quality:.2f})",
+                closeup_title="close-up: the rim under the bore of bearing 1")
+
+
+def start_mesh_picture(system, folder: str | os.PathLike, worker) -> int:
+    """Have a render worker's child process draw ``images/mesh.png`` at once (its second thread),
+    while this process goes on; give the returned number to :func:`submit_images`.
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+
+    (number,) = worker.start_calls([(mesh_plot, mesh_picture(system, _images_folder(folder)))])
+    return number
+
+
+def _images_folder(folder: str | os.PathLike) -> Path:
+    """``folder/images``, created if missing."""
+    images = Path(folder) / "images"
+    images.mkdir(exist_ok=True)
+    return images
+
+
+class PendingImages:
+    """The images of :func:`submit_images`, being drawn by a :class:`rvfem.outputs.render.RenderWorker`;
+    :meth:`result` waits for them, :meth:`calls_result` for the other calls."""
+
+    def __init__(self, image_set: _ImageSet, worker, calls: list[int], mesh_call: int):
+        self._set, self._worker, self._calls, self._mesh_call = image_set, worker, calls, mesh_call
+
+    def calls_result(self) -> list:
+        """Wait for the calls given to :func:`submit_images` (the child makes them one after the
+        other, after the mesh picture if that was started first, else before it) and return what
+        they returned.
+
+        Raises
+        ------
+        RenderError, Exception
+            From the render worker, or what a call raised.
+        """
+        return self._worker.wait_calls(self._calls)
+
+    def result(self, *, tick: TickCallback | None = None) -> list[Path]:
+        """Wait for the images.
+
+        Parameters
+        ----------
+        tick : callable, optional
+            ``tick(done, total)`` after each image but the last.
+
+        Returns
+        -------
+        list of Path
+            The stress images, the close-ups and the mesh picture, all complete.
+
+        Raises
+        ------
+        RenderError, OSError
+            From the render worker.
+        """
+        total = len(self._set.stress) + 1
+
+        def one_more(done: int) -> None:
+            if tick is not None and done < total:
+                tick(done, total)
+
+        done = self._worker.wait(tick=one_more)
+        n = len(self._set.stress)
+        return [Path(p) for p in done[:n]] + [Path(done[n + self._mesh_call])]
+
+
+def submit_images(analysis, folder: str | os.PathLike, worker, *,
+                  calls: Iterable[tuple[Callable, dict]] = (), mesh_call: int | None = None) -> PendingImages:
+    """Start the images of :func:`write_images` in a render worker's child process, which draws
+    them while this process does other work (the mesh picture in a second thread of the child);
+    :meth:`PendingImages.result` waits for them.
+
+    Parameters
+    ----------
+    analysis : rvfem.app.analysis.Analysis
+    folder : path-like
+    worker : rvfem.outputs.render.RenderWorker
+        Checked (:meth:`~rvfem.outputs.render.RenderWorker.check`) or not; it draws one series.
+    calls : iterable of (function, dict)
+        Other drawings for the child's second thread (e.g. :func:`plot_calls`), made before the
+        mesh picture unless that was started already; :meth:`PendingImages.calls_result` waits
+        for them.
+    mesh_call : int, optional
+        The number :func:`start_mesh_picture` returned, if the mesh picture was started already.
+
+    Returns
+    -------
+    PendingImages
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+
+    images = _images_folder(folder)
+    image_set = _image_set(analysis, images)
+    calls = list(calls)
+    if mesh_call is not None:
+        return PendingImages(image_set, worker, worker.submit(image_set.stress, calls=calls), mesh_call)
+    numbers = worker.submit(image_set.stress, calls=calls + [(mesh_plot, image_set.mesh)])
+    return PendingImages(image_set, worker, numbers[:-1], numbers[-1])
+
+
+def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None,
+                 worker=None) -> list[Path]:
+    """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
+    stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.outputs.plots.mesh_plot`).
+
+    The stress images share one off-screen plotter (:class:`rvfem.outputs.render.StressRenderer`); the
+    mesh picture is drawn by a second thread meanwhile. With a render worker
+    (:class:`rvfem.outputs.render.RenderWorker`) both are drawn by its child process (see also
+    :func:`submit_images`). All files are complete on return.
+
+    Raises
+    ------
+    RenderError
+        If off-screen rendering is not possible here.
+    """
+    if worker is not None:
+        return submit_images(analysis, folder, worker).result(tick=tick)
+
+    images = _images_folder(folder)
+    total = image_count(analysis)
+    out: list[Path] = []
+
+    def done(path: Path) -> None:
+        out.append(path)
+        if tick is not None and len(out) < total:
+            tick(len(out), total)
+
+    image_set = _image_set(analysis, images)
+    # the mesh picture (matplotlib) is drawn by a second thread while VTK renders the stress images;
+    # the renderer is made first, so that PyVista (which imports matplotlib) is imported by this
+    # thread alone
+    with render.StressRenderer(IMAGE_SIZE) as renderer, \
+            ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-mesh-plot") as pool:
+        mesh_png = pool.submit(mesh_plot, **image_set.mesh)
+        for path, scene, options in image_set.stress:
+            done(renderer.write(path, scene, **options))
+        done(mesh_png.result())
+    return out
+
+
+def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict]]:
+    """The plots of :func:`write_plots` as calls: (function of :mod:`rvfem.outputs.plots`, keyword
+    arguments), each drawing one PNG file and returning its path (``plots/`` is created).
+
+    :func:`write_plots` makes the calls; a render worker can make them in its child process
+    (:func:`submit_images`).
+    """
+
+    a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
+    folder = Path(folder) / "plots"
+    folder.mkdir(exist_ok=True)
+    k_max, _ = a.max_load_index
+    th_max = math.degrees(float(th[k_max]))
+    classical = None if a.classical is None else a.classical.magnitude
+    handbook = a.comparison.reference == "handbook"
+    label = "rigid (handbook)" if handbook else "equal share of the FE pin resultant"
+    calls = [(plots.bearing_loads_plot, dict(
+        path=folder / "bearing_loads.png", theta=th, flexible=cy.bearing_loads, rigid=a.reference_loads,
+        reference_label=label,
+        title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs "
+              + ("rigid handbook" if handbook else "equal share (handbook not defined for Zp − Zc ≠ 1)")))]
+    if cy.roller_loads is not None:
+        calls.append((plots.roller_loads_plot, dict(
+            path=folder / "roller_loads.png", roller_angles=cy.roller_angles[k_max],
+            roller_loads=cy.roller_loads[k_max], bearing_forces=cy.bearing_forces[k_max], theta_deg=th_max)))
+    calls.append((plots.pin_forces_plot, dict(
+        path=folder / "pin_forces.png", pin_index=np.arange(1, case.pins.count + 1), fe=cy.pin_forces[k_max],
+        classical=None if classical is None else classical[:, k_max], theta_deg=th_max)))
+    calls.append((plots.pins_in_contact_plot, dict(
+        path=folder / "pins_in_contact.png", theta=th, count=cy.pins_in_contact, total=case.pins.count,
+        classical=None if classical is None else np.count_nonzero(classical > 0, axis=0))))
+    return calls
+
+
+def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
+    the equal share where it is not defined), roller loads and pin forces at the angle of the
+    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.outputs.plots`)."""
+    return [function(**kwargs) for function, kwargs in plot_calls(analysis, folder)]
+
+
+# --------------------------------------------------------------------------------------------
+# Report
+# --------------------------------------------------------------------------------------------
+
+
+def write_report(analysis, folder: str | os.PathLike, *, summary: dict | None = None) -> list[Path]:
+    """Write ``report.html`` (:mod:`rvfem.outputs.report`): the numbers of ``summary`` (default
+    :func:`build_summary` with the files found in ``folder``) with the PNG files of ``folder``
+    embedded."""
+    folder = Path(folder)
+    if summary is None:
+        summary = build_summary(analysis, SummaryContext(
+            files=_files_in(folder, ("report.html", "summary.json")), timings=dict(analysis.timings)))
+
+    return [_write_html(folder / "report.html", summary, analysis.case, folder)]
+
+
+# --------------------------------------------------------------------------------------------
+# Text and JSON for the command line
+# --------------------------------------------------------------------------------------------
+
+
+def _num(value: float | None, fmt: str) -> str:
+    """``format(value, fmt)``, or a dash as wide for a value that could not be computed (None)."""
+    if value is None:
+        width = "".join(c for c in fmt.split(".")[0] if c.isdigit())
+        return "–".rjust(int(width or 0))
+    return format(value, fmt)
+
+
+SCREEN_DIGITS = 4
+"""Fewest significant figures a number of the screen tables shows (:func:`_sig`)."""
+
+
+def _sig(value: float | None, fmt: str) -> str:
+    """A load, pressure or stress for a screen table: ``format(value, fmt)`` (a fixed-point format
+    such as ``"8.0f"``) where that shows at least :data:`SCREEN_DIGITS` significant figures and fits
+    the width, else the value with that many significant figures (``0.007113``, ``3.813e+08``);
+    a dash for None. A 1e-3 N·m torque gives loads in mN, not "0"."""
+    if value is None:
+        return _num(value, fmt)
+    v = float(value)
+    spec = fmt.rstrip("f")
+    width_text, _, decimals_text = spec.partition(".")
+    width = int("".join(c for c in width_text if c.isdigit()) or 0)
+    decimals = int(decimals_text or 0)
+    fixed = format(v, fmt)
+    fits = len(fixed) <= (width or 12)          # a free-width number up to 12 characters
+    if v == 0 or not math.isfinite(v) or (abs(v) >= 10.0 ** (SCREEN_DIGITS - 1 - decimals) and fits):
+        return fixed
+    return f"{v:.{SCREEN_DIGITS}g}".rjust(width)
+
+
+def _life(value: float | None, width: int = 0) -> str:
+    """A life in hours for the screen: whole hours from 1 h to 10⁷ h, three significant figures
+    outside (``0.0497``, ``1.23e+24``), ``inf`` at zero load, a dash for None."""
+    if value is None:
+        return _num(value, f"{width}.0f")
+    v = float(value)
+    if not math.isfinite(v) or v == 0:
+        return f"{v:{width}.0f}"
+    if 1.0 <= abs(v) < 1e7:
+        return f"{v:{width}.0f}"
+    return f"{v:{width}.3g}"
+
+
+def summary_text(summary: dict) -> str:
+    """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints)."""
+
+    c, m = summary["case"], summary["model"]
+    lines = [
+        f"Case {c['name']}" + (f" ({c['file']})" if c.get("file") else "") +
+        (f", overrides: {', '.join(f'{k} = {toml_text(v)}' for k, v in c['overrides'].items())}"
+         if c["overrides"] else ""),
+        f"  model: bearings '{m['bearing_model']}', P{m['element_order']}, {m['nodes']} nodes, {m['dofs']} dofs, "
+        f"{m['elements']} elements; {m['angles']} crank angles (step {m['angle_step_deg']:g}°)",
+        f"  torque {m['output_torque_Nm']:g} N·m on {m['discs']} discs = {m['disc_torque_Nmm'] / 1000:g} N·m per disc "
+        f"about the disc centre; C = {m['dynamic_load_rating_N']:.0f} N, n_b = {m['bearing_speed_rpm']:g} rpm",
+        "",
+        f"  {'bearing':>7} {'model':<9} {'max N':>8} {'at °':>6} {'min N':>8} {'at °':>6} {'F_m N':>8} {'L10h h':>9}",
+    ]
+
+    refs = summary["references"]
+    handbook = refs["bearing_loads"] == "handbook"
+    rows = ("rigid", "flexible") if handbook else ("rigid", "equal_share", "flexible")
+    names = {"rigid": "rigid", "flexible": "flexible", "equal_share": "eq. share"}
+    for b in summary["bearings"]:
+        for key in rows:
+            s = b[key]
+            head = f"  {b['bearing'] if key == 'rigid' else '':>7} {names[key]:<9} "
+            if s is None:
+                lines.append(head + "not defined for Zp − Zc ≠ 1")
+                continue
+            lines.append(head + f"{_sig(s['max_load_N'], '8.0f')} "
+                         f"{_num(s['max_at_deg'], '6.1f')} {_sig(s['min_load_N'], '8.0f')} {_num(s['min_at_deg'], '6.1f')} "
+                         f"{_sig(s['equivalent_load_N'], '8.0f')} {_life(s['L10h_h'], 9)}")
+        lines.append(f"  {'':>7} {'delta':<9} {_num(b['delta_max_percent'], '+7.1f')}% {'':>6} "
+                     f"{_num(b['delta_min_percent'], '+7.1f')}% {'':>6} {_num(b['delta_equivalent_percent'], '+7.1f')}%  "
+                     f"life ratio {_num(b['life_ratio'], '.2f')}" + ("" if handbook else "  (vs equal share)"))
+    lines += [""] + reference_lines(refs)
+    rs = summary["reducer_stage"]
+    lines += ["", f"  reducer stage: {rs['model']}"]
+    if rs["torque_share"]:
+        lines[-1] += (f"; torque of disc A {rs['torque_share']['min']:.3f}–{rs['torque_share']['max']:.3f} × T/2")
+    lines.append(f"  what the delta of bearing 1 is made of (against the "
+                 f"{'handbook' if handbook else 'equal share of the FE pin resultant'}):")
+    for r in summary["attribution"]:
+        if r["bearing"] == 1:
+            lines.append(f"    {r['step']:<12} max {_num(r['delta_max_percent'], '+6.1f')}%  min "
+                         f"{_num(r['delta_min_percent'], '+6.1f')}%  F_m {_num(r['delta_equivalent_percent'], '+6.1f')}%"
+                         f"  life ratio {_num(r['life_ratio'], '.2f')}" + ("   <- this run" if r["final"] else ""))
+    h = summary["hertz"]
+    fe = h.get("fe_rollers")
+    lines += [""] + stress_lines(summary["stress"]) + [
+        f"  pins in contact {summary['pins_in_contact']['min']}–{summary['pins_in_contact']['max']} of "
+        f"{summary['pins_in_contact']['of']}; torsional stiffness {summary['torsional_stiffness_Nm_per_arcmin']:.1f} "
+        f"N·m/arcmin per disc; equilibrium residual {summary['equilibrium_residual']:.1e}",
+    ]
+    sr = h["stribeck_rigid"]
+    hertz = ("  Hertz, most loaded roller: " + (
+        f"rigid Stribeck Q = {_sig(sr['roller_load_N'], '.0f')} N, p_in {_sig(sr['inner']['peak_pressure_MPa'], '.0f')}"
+        f" / p_out {_sig(sr['outer']['peak_pressure_MPa'], '.0f')} MPa" if sr else
+        "rigid Stribeck not defined for Zp − Zc ≠ 1"))
+    if fe:
+        hertz += (f"; FE Q = {_sig(fe['roller_load_N'], '.0f')} N, p_in {_sig(fe['inner']['peak_pressure_MPa'], '.0f')}"
+                  f" / p_out {_sig(fe['outer']['peak_pressure_MPa'], '.0f')} MPa")
+    else:
+        sf = h["stribeck_flexible"]
+        hertz += (f"; FE bearing load with Stribeck Q = {_sig(sf['roller_load_N'], '.0f')} N, p_in "
+                  f"{_sig(sf['inner']['peak_pressure_MPa'], '.0f')} / p_out "
+                  f"{_sig(sf['outer']['peak_pressure_MPa'], '.0f')} MPa")
+    lines.append(hertz)
+    duty = summary.get("duty_cycle")
+    if duty:
+        lines.append("  duty cycle: service life " + ", ".join(
+            f"{key} {_life(duty[key]['service_life_h'])} h" if duty[key] else f"{key} not defined"
+            for key in ("rigid", "flexible"))
+            + f" (equivalent torque {duty['flexible']['equivalent_torque_Nm']:.1f} N·m, "
+              f"speed {duty['flexible']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
+        fe = duty.get("flexible_fe")
+        if fe:
+            lines.append(
+                "    flexible FE at every duty torque (" + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): "
+                f"service life {_life(fe['service_life_h'])} h ({_num(fe['life_difference_percent'], '+.1f')} % "
+                "against the linear scaling); F_m off linear scaling by "
+                + ", ".join(f"{e:+.1f} %" for e in fe["linear_scaling_error_percent"]))
+    t = summary["timings_s"]
+    lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
+                 f"{len(summary['files'])} files")
+    lines += warning_lines(summary.get("warnings", []))
+    return "\n".join(lines)
+
+
+def warning_lines(warnings: list[dict], prefix: str = "  warning: ") -> list[str]:
+    """The ``warnings`` of ``summary.json`` or ``rvfem rigid --json`` as screen lines, one each
+    (:mod:`rvfem.evaluate.validity`), preceded by an empty line; none when there are none."""
+    if not warnings:
+        return []
+    return [""] + [prefix + w["message"] for w in warnings]
+
+
+def reference_lines(references: dict) -> list[str]:
+    """What a run or the rigid evaluation is compared with, and why (the ``references`` object of
+    ``summary.json`` or ``rvfem rigid --json``), as screen lines."""
+
+    used = [k for k, r in references.items() if isinstance(r, dict) and r["defined"]]
+    main = references["bearing_loads"]
+    head = (f"bearing loads compared with {REFERENCE_NAMES[main]}" if main in used else
+            "no bearing-load reference computed here")
+    others = [REFERENCE_NAMES[k] for k in used if k != main]
+    lines = ["  references: " + head + ("; also " + ", ".join(others) if others else "")]
+    for key, r in references.items():   # why the reference is not the handbook, why others are missing
+        if isinstance(r, dict) and (not r["defined"] or (key == references["bearing_loads"] != "handbook")):
+            lines.append(f"    {REFERENCE_NAMES[key]}: {r['why']}")
+    return lines
+
+
+def stress_lines(stress: dict) -> list[str]:
+    """The disc-stress lines of the screen summary (the ``stress`` object of ``summary.json``):
+    the structural peak away from contacts first, with its convergence check, then the
+    contact-zone peak, labelled as such."""
+    lines = []
+    sp, away, cz = stress.get("structural_peak"), stress.get("away_from_contacts"), stress["contact_zone"]
+    if sp:
+        at = sp["at"]
+        lines += [
+            f"  structural stress peak (away from contacts) {_sig(sp['von_mises_MPa'], '.0f')} MPa von Mises ± "
+            f"{sp['estimated_error_MPa']:.1f} MPa (estimated), {at['feature_label']} at ({at['x_mm']:.1f}, "
+            f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°",
+            f"    P2 re-solve at θ = {', '.join(f'{x:g}' for x in sp['angles_deg'])}° with the cycle's forces "
+            f"({sp['seconds']:.1f} s); the P{away['element_order']} cycle alone gives {_sig(sp['p1_MPa'], '.0f')} MPa "
+            f"({sp['p1_error_percent']:+.0f} %)",
+        ]
+    elif away:
+        at = away["at"]
+        lines.append(f"  structural stress peak (away from contacts) {_sig(away['peak_von_mises_MPa'], '.0f')} MPa "
+                     "von Mises "
+                     f"(P{away['element_order']}, not re-solved on P2), {at['feature_label']} at ({at['x_mm']:.1f}, "
+                     f"{at['y_mm']:.1f}) mm, θ = {at['theta_deg']:g}°")
+    at = cz["at"]
+    lines.append(f"  contact-zone peak {_sig(cz['peak_von_mises_MPa'], '.0f')} MPa (under a pin or roller footprint, "
+                 f"mesh-dependent; not a Hertz stress), {at['feature_label']}, {at['distance_to_feature_mm']:.2f} mm "
+                 f"from it, θ = {at['theta_deg']:g}°")
+    return lines
+
+
+def rigid_summary(result) -> dict:
+    """The rigid handbook evaluation (:class:`rvfem.app.analysis.RigidAnalysis`) as a JSON-ready dict
+    (what ``rvfem rigid --json`` writes). Loads in N, angles in degrees, speeds in rpm, lives in
+    hours, pressures in MPa, lengths in mm; non-finite numbers are None."""
+    case, comp = result.case, result.loads.components
+    bearings = [{
+        "bearing": b.loads.bearing + 1,
+        "crank_angle_deg": b.crank_angle_deg,
+        "max_load_N": b.loads.max_N,
+        "max_at_deg": _angle(b.loads.max_at_deg),
+        "min_load_N": b.loads.min_N,
+        "min_at_deg": _angle(b.loads.min_at_deg),
+        "equivalent_load_N": b.loads.equivalent_N,
+        "L10h_h": b.loads.L10h,
+        "max_roller_load_N": b.max_roller_load_N,
+        "hertz_inner": dataclasses.asdict(b.hertz_inner),
+        "hertz_outer": dataclasses.asdict(b.hertz_outer),
+    } for b in result.bearings]
+    if not result.defined:   # the handbook is not defined (Zp − Zc ≠ 1): the same keys, null
+        bearings = [{
+            "bearing": i + 1, "crank_angle_deg": angle, "max_load_N": None, "max_at_deg": None, "min_load_N": None,
+            "min_at_deg": None, "equivalent_load_N": None, "L10h_h": None, "max_roller_load_N": None,
+            "hertz_inner": None, "hertz_outer": None,
+        } for i, angle in enumerate(case.cranks.angles_deg)]
+
+    source = Path(case.source.removesuffix(" (with overrides)"))
+    report = {
+        "schema_version": RIGID_SCHEMA_VERSION,
+        "rvfem_version": __version__,
+        "environment": environment(),
+        "case": case.name,
+        "source": case.source,
+        "case_sha256": file_sha256(source) if source.is_file() else None,
+        "case_digest": case.digest(),
+        "overrides": list(case.overrides),
+        "model": "rigid handbook (equal load sharing, zero clearance)",
+        "output_torque_Nm": case.loads.torque_Nm,
+        "disc_torque_Nmm": comp.disc_torque_Nmm,
+        "output_speed_rpm": case.loads.speed_rpm,
+        "bearing_speed_rpm": result.bearing_speed_rpm,
+        "k": comp.k,
+        "k_y": comp.k_y,
+        "sum_px_N": comp.sum_px,
+        "sum_py_N": comp.sum_py,
+        "equivalent_load_exponent": result.exponent,
+        "angle_step_deg": result.angle_step_deg,
+        "dynamic_load_rating_N": result.rating_N,
+        "stribeck_factor": result.stribeck_factor,
+        "references": _references_dict(result.references or references(case, fe=False)),
+        "warnings": [w.as_dict() for w in result.warnings],
+        "bearings": bearings,
+    }
+    if case.loads.duty_cycle:
+        report["duty_cycle"] = None if result.duty_cycle is None else dataclasses.asdict(result.duty_cycle)
+    return json_ready(report)
+
+
+def rigid_text(report: dict) -> str:
+    """The rigid handbook evaluation (a :func:`rigid_summary` dict) as a table (``rvfem rigid``)."""
+
+    p = report["equivalent_load_exponent"]
+    p_text = "10/3" if math.isclose(p, 10.0 / 3.0) else f"{p:g}"
+    defined = report["references"]["handbook"]["defined"]
+    lines = [
+        f"Case {report['case']} ({report['source']}): {report['model']}",
+        f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {report['disc_torque_Nmm'] / 1000:g} N·m, "
+        f"output speed {report['output_speed_rpm']:g} rpm, bearing speed {report['bearing_speed_rpm']:g} rpm",
+        f"  k = {report['k']:.4f}, k_y = {_num(report['k_y'], '.4f')}, ΣPx = {_sig(report['sum_px_N'], '.1f')} N, "
+        f"ΣPy = {_sig(report['sum_py_N'], '.1f')} N, crank-angle step {report['angle_step_deg']:g}°",
+        f"  dynamic load rating C = {report['dynamic_load_rating_N']:.1f} N; equivalent load exponent p = {p_text}",
+    ]
+    if report.get("overrides"):
+        lines.append(f"  overrides: {', '.join(report['overrides'])}")
+    if not defined:
+        lines += reference_lines(report["references"])
+    header = (f"{'bearing':>7} {'max N':>9} {'at °':>6} {'min N':>9} {'at °':>6} {'F_m N':>9} "
+              f"{'L10h h':>9} {'Q_max N':>8} {'p_in MPa':>9} {'p_out MPa':>9}")
+    lines += ["", header, "-" * len(header)]
+    for b in report["bearings"]:
+        if b["max_load_N"] is None and not defined:
+            lines.append(f"{b['bearing']:>7d}  not defined for Zp − Zc ≠ 1 (rvfem run compares the FE with the "
+                         "equal share)")
+            continue
+        lines.append(
+            f"{b['bearing']:>7d} {_sig(b['max_load_N'], '9.1f')} {b['max_at_deg']:6.1f} {_sig(b['min_load_N'], '9.1f')} "
+            f"{b['min_at_deg']:6.1f} {_sig(b['equivalent_load_N'], '9.1f')} {_life(b['L10h_h'], 9)} "
+            f"{_sig(b['max_roller_load_N'], '8.1f')} {_sig(b['hertz_inner']['peak_pressure_MPa'], '9.1f')} "
+            f"{_sig(b['hertz_outer']['peak_pressure_MPa'], '9.1f')}")
+    lines += [
+        "",
+        "  at °: crank angle θ of the eccentric relative to the carrier; F_m = (mean F^p)^(1/p) over a turn",
+        f"  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Hertz at Q_max = {report['stribeck_factor']:g}·F_max/Z "
+        "(p_in: eccentric, p_out: disc bore)",
+    ]
+    duty = report.get("duty_cycle")
+    if "duty_cycle" in report and duty is None:
+        lines.append("  duty cycle: service life not defined (no handbook bearing lives for Zp − Zc ≠ 1)")
+    if duty:
+        lines.append(
+            f"  duty cycle: equivalent torque {duty['equivalent_torque_Nm']:.1f} N·m, equivalent speed "
+            f"{duty['equivalent_speed_rpm']:.2f} rpm, service life {_life(duty['service_life_h'])} h "
+            f"(from the shortest rated life {_life(duty['rated_life_h'])} h)")
+    lines += warning_lines(report.get("warnings", []))
+    return "\n".join(lines)

@@ -1,0 +1,173 @@
+"""CSV tables of a load cycle (one header row, comma-separated, numbers with 10 significant digits).
+
+``bearing_loads.csv``
+    One row per crank angle: ``theta_deg`` and, for every bearing i = 1…N,
+    ``bearing{i}_flexible_Fx_N``, ``bearing{i}_flexible_Fy_N``, ``bearing{i}_flexible_F_N`` (FE) and
+    ``bearing{i}_rigid_Fx_N``, ``bearing{i}_rigid_Fy_N``, ``bearing{i}_rigid_F_N`` (handbook; ``nan``
+    where it is not defined, Zp − Zc ≠ 1), then ``bearing{i}_equal_share_Fx_N``,
+    ``bearing{i}_equal_share_Fy_N``, ``bearing{i}_equal_share_F_N`` (the FE pin resultant shared
+    equally) for every bearing: the force of the bearing on the disc in the disc frame and its
+    magnitude.
+``roller_loads.csv``
+    One row per crank angle, bearing and roller (bearing model ``rollers`` only): ``theta_deg``,
+    ``bearing``, ``roller`` (1-based), ``roller_angle_deg`` (position about the bore centre, disc
+    frame), ``load_N``.
+``pin_forces.csv``
+    One row per crank angle and pin: ``theta_deg``, ``pin`` (1-based; pin k sits at
+    360°·(k − 1)/Zp on the housing), ``x_mm``, ``y_mm`` (pin centre in the disc frame),
+    ``flexible_N`` (FE), ``classical_N`` (classical rigid distribution with the exact moment;
+    ``nan`` where it is not defined, Zp − Zc ≠ 1).
+``cycle.csv``
+    One row per crank angle: ``theta_deg``, ``pins_in_contact``, ``carrier_rotation_arcmin``,
+    ``equilibrium_residual``, ``active_set_iterations``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
+           "write_stress_history"]
+
+
+def _fmt(v) -> str:
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    return f"{float(v):.10g}"
+
+
+def _write(path: str | os.PathLike, header: list[str], rows) -> Path:
+    path = Path(path)
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for row in rows:
+            w.writerow([_fmt(v) for v in row])
+    return path
+
+
+def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np.ndarray,
+                        rigid: np.ndarray, equal_share: np.ndarray | None = None) -> Path:
+    """Write ``bearing_loads.csv``.
+
+    Parameters
+    ----------
+    path : path-like
+    theta : ndarray (n,)
+        Crank angles, rad.
+    flexible, rigid : ndarray (n, N, 2)
+        Force of each bearing on the disc, N (FE and handbook; NaN where the handbook is not
+        defined).
+    equal_share : ndarray (n, N, 2), optional
+        The equal share of the FE pin resultant, N (its columns follow the others).
+    """
+    n_b = flexible.shape[1]
+    models = [("flexible", flexible), ("rigid", rigid)]
+    if equal_share is not None:
+        models.append(("equal_share", equal_share))
+    header = ["theta_deg"]
+    for i in range(1, n_b + 1):
+        for name, _ in models[:2]:
+            header += [f"bearing{i}_{name}_Fx_N", f"bearing{i}_{name}_Fy_N", f"bearing{i}_{name}_F_N"]
+    for i in range(1, n_b + 1):
+        for name, _ in models[2:]:
+            header += [f"bearing{i}_{name}_Fx_N", f"bearing{i}_{name}_Fy_N", f"bearing{i}_{name}_F_N"]
+    mags = {name: np.linalg.norm(f, axis=2) for name, f in models}
+
+    def rows():
+        for k, th in enumerate(theta):
+            row = [math.degrees(th)]
+            for group in (models[:2], models[2:]):
+                for i in range(n_b):
+                    for name, f in group:
+                        row += [f[k, i, 0], f[k, i, 1], mags[name][k, i]]
+            yield row
+
+    return _write(path, header, rows())
+
+
+def write_roller_loads(path: str | os.PathLike, theta: np.ndarray, roller_angles: np.ndarray,
+                       roller_loads: np.ndarray) -> Path:
+    """Write ``roller_loads.csv``.
+
+    Parameters
+    ----------
+    path : path-like
+    theta : ndarray (n,)
+        rad.
+    roller_angles : ndarray (n, N, Z)
+        rad.
+    roller_loads : ndarray (n, N, Z)
+        N.
+    """
+    n, n_b, z = roller_loads.shape
+
+    def rows():
+        for k in range(n):
+            deg = math.degrees(theta[k])
+            for i in range(n_b):
+                for j in range(z):
+                    yield [deg, i + 1, j + 1, math.degrees(roller_angles[k, i, j]) % 360.0, roller_loads[k, i, j]]
+
+    return _write(path, ["theta_deg", "bearing", "roller", "roller_angle_deg", "load_N"], rows())
+
+
+def write_pin_forces(path: str | os.PathLike, theta: np.ndarray, pin_xy: np.ndarray, flexible: np.ndarray,
+                     classical: np.ndarray) -> Path:
+    """Write ``pin_forces.csv``.
+
+    Parameters
+    ----------
+    path : path-like
+    theta : ndarray (n,)
+        rad.
+    pin_xy : ndarray (n, Zp, 2)
+        Pin centres in the disc frame, mm.
+    flexible : ndarray (n, Zp)
+        FE pin forces, N.
+    classical : ndarray (n, Zp)
+        Classical rigid pin forces, N.
+    """
+    n, zp = flexible.shape
+
+    def rows():
+        for k in range(n):
+            deg = math.degrees(theta[k])
+            for j in range(zp):
+                yield [deg, j + 1, pin_xy[k, j, 0], pin_xy[k, j, 1], flexible[k, j], classical[k, j]]
+
+    return _write(path, ["theta_deg", "pin", "x_mm", "y_mm", "flexible_N", "classical_N"], rows())
+
+
+def write_cycle_table(path: str | os.PathLike, theta: np.ndarray, pins_in_contact: np.ndarray,
+                      carrier_rotation: np.ndarray, residual: np.ndarray, iterations: np.ndarray) -> Path:
+    """Write ``cycle.csv`` (per-angle solver quantities; carrier rotation given in rad, written in
+    arcmin)."""
+    arcmin = np.degrees(carrier_rotation) * 60.0
+    rows = ([math.degrees(t), int(p), a, r, int(i)]
+            for t, p, a, r, i in zip(theta, pins_in_contact, arcmin, residual, iterations))
+    return _write(path, ["theta_deg", "pins_in_contact", "carrier_rotation_arcmin", "equilibrium_residual",
+                         "active_set_iterations"], rows)
+
+
+def write_stress_history(path: str | os.PathLike, history) -> Path:
+    """Write ``stress_history.csv``: per crank angle, the von Mises and principal stresses at each
+    hot spot of a :class:`rvfem.evaluate.postprocess.HotSpotHistory` (columns ``<name>_von_mises_MPa``,
+    ``<name>_s1_MPa``, ``<name>_s2_MPa``, ``<name>_dominant_MPa``: the principal stress of larger
+    magnitude, signed), MPa."""
+    header = ["theta_deg"]
+    for name in history.names:
+        header += [f"{name}_von_mises_MPa", f"{name}_s1_MPa", f"{name}_s2_MPa", f"{name}_dominant_MPa"]
+    rows = []
+    dominant = history.dominant
+    for k, theta in enumerate(history.theta):
+        row = [math.degrees(float(theta))]
+        for j in range(len(history.names)):
+            row += [history.von_mises[k, j], history.s1[k, j], history.s2[k, j], dominant[k, j]]
+        rows.append(row)
+    return _write(path, header, rows)
