@@ -186,55 +186,86 @@ def check_limits(*, load_ratios: Iterable[tuple[str, float | None]] = (),
         In the order of the parameters; empty when every result is inside its range. Values
         that are None or not finite (an infinite life at zero load) are skipped.
     """
-    out: list[ResultWarning] = []
-    ratios = _finite(load_ratios)
-    if ratios:
-        where, value = max(ratios, key=lambda x: x[1])
-        if value > LOAD_RATIO_LIMIT:
-            out.append(ResultWarning(
-                "load_ratio",
-                f"P/C = {_sig(value)} ({where}) > {LOAD_RATIO_LIMIT:g}: outside the range of the ISO 281 rating "
-                "life; the lives are not meaningful",
-                value, LOAD_RATIO_LIMIT, ""))
-    lives = _finite(lives_h)
-    if lives:
-        where, value = min(lives, key=lambda x: x[1])
-        if value < MIN_LIFE_H:
-            out.append(ResultWarning(
-                "life_under_1h",
-                f"life {_sig(value)} h ({where}) < {MIN_LIFE_H:g} h: a load far beyond the bearing's capacity, "
-                "not a life",
-                value, MIN_LIFE_H, "h"))
-    pressures = _finite(hertz_MPa)
-    if pressures:
-        where, value = max(pressures, key=lambda x: x[1])
-        if value > hertz_limit_MPa:
-            scaled = ("" if math.isclose(hertz_limit_MPa, HERTZ_PRESSURE_LIMIT_MPA) else
-                      f" ({HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa on bearing steel, scaled to the case's modulus)")
-            out.append(ResultWarning(
-                "hertz_pressure",
-                f"Hertz pressure {value:.0f} MPa ({where}) > {hertz_limit_MPa:.0f} MPa, the static limit of roller "
-                f"bearings (ISO 76){scaled}: the raceways deform plastically, elastic Hertz contact does not hold",
-                value, float(hertz_limit_MPa), "MPa"))
-    if disc_stress_MPa is not None and math.isfinite(disc_stress_MPa) and disc_stress_MPa > yield_strength_MPa:
-        source = ("placeholder for through-hardened bearing steel"
-                  if yield_strength_MPa == PLACEHOLDER_YIELD_STRENGTH_MPA else "given")
-        out.append(ResultWarning(
-            "disc_stress_yield",
-            f"structural stress peak {disc_stress_MPa:.0f} MPa von Mises > yield strength "
-            f"{yield_strength_MPa:.0f} MPa ({source}): the disc yields, the linear-elastic model does not hold",
-            float(disc_stress_MPa), float(yield_strength_MPa), "MPa"))
-    if (deformation_mm is not None and element_size_mm is not None and math.isfinite(deformation_mm)
+    found = (_load_ratio_warning(_finite(load_ratios)),
+             _life_warning(_finite(lives_h)),
+             _hertz_warning(_finite(hertz_MPa), hertz_limit_MPa),
+             _yield_warning(disc_stress_MPa, yield_strength_MPa),
+             _displacement_warning(deformation_mm, element_size_mm))
+    return tuple(w for w in found if w is not None)
+
+
+def _load_ratio_warning(ratios: list[tuple[str, float]]) -> ResultWarning | None:
+    """The ``load_ratio`` warning of the largest P/C, if it is above :data:`LOAD_RATIO_LIMIT`."""
+    if not ratios:
+        return None
+    where, value = max(ratios, key=lambda x: x[1])
+    if not value > LOAD_RATIO_LIMIT:
+        return None
+    return ResultWarning(
+        "load_ratio",
+        f"P/C = {_sig(value)} ({where}) > {LOAD_RATIO_LIMIT:g}: outside the range of the ISO 281 rating "
+        "life; the lives are not meaningful",
+        value, LOAD_RATIO_LIMIT, "")
+
+
+def _life_warning(lives: list[tuple[str, float]]) -> ResultWarning | None:
+    """The ``life_under_1h`` warning of the shortest life, if it is under :data:`MIN_LIFE_H`."""
+    if not lives:
+        return None
+    where, value = min(lives, key=lambda x: x[1])
+    if not value < MIN_LIFE_H:
+        return None
+    return ResultWarning(
+        "life_under_1h",
+        f"life {_sig(value)} h ({where}) < {MIN_LIFE_H:g} h: a load far beyond the bearing's capacity, "
+        "not a life",
+        value, MIN_LIFE_H, "h")
+
+
+def _hertz_warning(pressures: list[tuple[str, float]], hertz_limit_MPa: float) -> ResultWarning | None:
+    """The ``hertz_pressure`` warning of the largest Hertz pressure, if it is above ``hertz_limit_MPa``
+    (the message says when the limit is :data:`HERTZ_PRESSURE_LIMIT_MPA` scaled to another modulus)."""
+    if not pressures:
+        return None
+    where, value = max(pressures, key=lambda x: x[1])
+    if not value > hertz_limit_MPa:
+        return None
+    scaled = ("" if math.isclose(hertz_limit_MPa, HERTZ_PRESSURE_LIMIT_MPA) else
+              f" ({HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa on bearing steel, scaled to the case's modulus)")
+    return ResultWarning(
+        "hertz_pressure",
+        f"Hertz pressure {value:.0f} MPa ({where}) > {hertz_limit_MPa:.0f} MPa, the static limit of roller "
+        f"bearings (ISO 76){scaled}: the raceways deform plastically, elastic Hertz contact does not hold",
+        value, float(hertz_limit_MPa), "MPa")
+
+
+def _yield_warning(disc_stress_MPa: float | None, yield_strength_MPa: float) -> ResultWarning | None:
+    """The ``disc_stress_yield`` warning, if the structural peak is above the yield strength."""
+    if not (disc_stress_MPa is not None and math.isfinite(disc_stress_MPa) and disc_stress_MPa > yield_strength_MPa):
+        return None
+    source = ("placeholder for through-hardened bearing steel"
+              if yield_strength_MPa == PLACEHOLDER_YIELD_STRENGTH_MPA else "given")
+    return ResultWarning(
+        "disc_stress_yield",
+        f"structural stress peak {disc_stress_MPa:.0f} MPa von Mises > yield strength "
+        f"{yield_strength_MPa:.0f} MPa ({source}): the disc yields, the linear-elastic model does not hold",
+        float(disc_stress_MPa), float(yield_strength_MPa), "MPa")
+
+
+def _displacement_warning(deformation_mm: float | None, element_size_mm: float | None) -> ResultWarning | None:
+    """The ``large_displacement`` warning, if the deformation is above
+    :data:`DISPLACEMENT_FRACTION_LIMIT` of the element size at the contacts."""
+    if not (deformation_mm is not None and element_size_mm is not None and math.isfinite(deformation_mm)
             and element_size_mm > 0 and deformation_mm > DISPLACEMENT_FRACTION_LIMIT * element_size_mm):
-        limit = DISPLACEMENT_FRACTION_LIMIT * element_size_mm
-        out.append(ResultWarning(
-            "large_displacement",
-            f"largest disc deformation {_sig(deformation_mm)} mm = {100 * deformation_mm / element_size_mm:.0f} % "
-            f"of the element size at the contacts ({element_size_mm:g} mm) > "
-            f"{100 * DISPLACEMENT_FRACTION_LIMIT:.0f} %: beyond the small-displacement assumption of the linear "
-            "model",
-            float(deformation_mm), float(limit), "mm"))
-    return tuple(out)
+        return None
+    limit = DISPLACEMENT_FRACTION_LIMIT * element_size_mm
+    return ResultWarning(
+        "large_displacement",
+        f"largest disc deformation {_sig(deformation_mm)} mm = {100 * deformation_mm / element_size_mm:.0f} % "
+        f"of the element size at the contacts ({element_size_mm:g} mm) > "
+        f"{100 * DISPLACEMENT_FRACTION_LIMIT:.0f} %: beyond the small-displacement assumption of the linear "
+        "model",
+        float(deformation_mm), float(limit), "mm")
 
 
 def _hertz_items(label: str, inner, outer) -> list[tuple[str, float]]:
