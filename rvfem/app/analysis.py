@@ -252,32 +252,85 @@ def resolve_case(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] =
         A bad file, override or option (one line naming the key).
     """
 
-    if isinstance(case, Case):
-        base = case
-        source = case.source[: -len(_WITH_OVERRIDES)] if case.source.endswith(_WITH_OVERRIDES) else case.source
-        path: Path | None = Path(source)
-        if path.is_file():
-            try:
-                matches = load_case(path, case.overrides) == case
-            except CaseError:
-                matches = False
-        else:
-            path, matches = None, False
-    else:
-        path = Path(case)
-        base = load_case(path, overrides)
-        matches = True
+    source = _case_source(case, overrides)
+    given = _overrides_given(source.base)
+    defaults = _file_defaults(source)
+    effective, options = _with_options(source.base, angle_step_deg=angle_step_deg, order=order,
+                                       bearing_model=bearing_model)
+    given.update(options)
+    path = source.path
+    provenance = CaseProvenance(
+        file=str(path) if path is not None else None,
+        sha256=file_sha256(path) if path is not None else None,
+        matches_file=source.matches and not given,
+        overrides=given,
+        defaults_used=defaults,
+    )
+    return effective, provenance
 
+
+@dataclass(frozen=True, eq=False)
+class _CaseSource:
+    """A case before the options of :func:`resolve_case`, and its file.
+
+    Attributes
+    ----------
+    base : Case
+        The case as given, or as read from its file with the ``KEY=VALUE`` overrides.
+    path : Path or None
+        Its case file (None for a case whose ``source`` is no file).
+    matches : bool
+        True if ``base`` is exactly what its file and its overrides give.
+    """
+
+    base: Case
+    path: Path | None
+    matches: bool
+
+
+def _case_source(case: Case | str | os.PathLike, overrides: tuple[str, ...]) -> _CaseSource:
+    """The case to resolve: a :class:`Case` as given (its file found from ``Case.source`` and read
+    again to tell whether the case is still the file's), or the case file ``case`` read with
+    ``overrides``."""
+    if not isinstance(case, Case):
+        path = Path(case)
+        return _CaseSource(base=load_case(path, overrides), path=path, matches=True)
+    source = case.source[: -len(_WITH_OVERRIDES)] if case.source.endswith(_WITH_OVERRIDES) else case.source
+    path = Path(source)
+    if not path.is_file():
+        return _CaseSource(base=case, path=None, matches=False)
+    try:
+        matches = load_case(path, case.overrides) == case
+    except CaseError:
+        matches = False
+    return _CaseSource(base=case, path=path, matches=matches)
+
+
+def _overrides_given(base: Case) -> dict[str, Any]:
+    """Dotted case key → value of the case's ``KEY=VALUE`` overrides (:attr:`Case.overrides`)."""
     given: dict[str, Any] = {}
     for text in base.overrides:
         parts, value = parse_override(text)
         given[".".join(parts)] = value
-    defaults: tuple[tuple[str, Any], ...] = ()
-    if path is not None and matches:
-        raw = _read_raw(path)
-        if raw is not None:
-            defaults = _defaults_used(apply_overrides(raw, base.overrides), base)
+    return given
 
+
+def _file_defaults(source: _CaseSource) -> tuple[tuple[str, Any], ...]:
+    """The defaults the case uses (:func:`_defaults_used`): keys that neither its file nor its
+    overrides set; none known for a case that is not its file's (or whose file cannot be read)."""
+    if source.path is None or not source.matches:
+        return ()
+    raw = _read_raw(source.path)
+    if raw is None:
+        return ()
+    return _defaults_used(apply_overrides(raw, source.base.overrides), source.base)
+
+
+def _with_options(base: Case, *, angle_step_deg: float | None, order: int | None,
+                  bearing_model: str | None) -> tuple[Case, dict[str, Any]]:
+    """``base`` with the options of :func:`resolve_case` applied (each checked; the case is checked
+    again as a whole), and the options as dotted case key → value (empty without options: ``base``
+    is returned as it is)."""
     options: dict[str, Any] = {}
     analysis, bearing = base.analysis, base.crank_bearing
     if angle_step_deg is not None:
@@ -297,22 +350,14 @@ def resolve_case(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] =
                             f"got {bearing_model!r}")
         bearing = dataclasses.replace(bearing, model=bearing_model)
         options["crank_bearing.model"] = bearing_model
+    if not options:
+        return base, options
     try:
-        effective = base.replace(analysis=analysis, crank_bearing=bearing) if options else base
+        effective = base.replace(analysis=analysis, crank_bearing=bearing)
     except CaseError as exc:
         text = ", ".join(f"{k} = {v}" for k, v in options.items())
         raise CaseError(f"the overrides ({text}) are not valid: {exc}") from None
-    if options:
-        effective = dataclasses.replace(effective, overrides=base.overrides)
-    given.update(options)
-    provenance = CaseProvenance(
-        file=str(path) if path is not None else None,
-        sha256=file_sha256(path) if path is not None else None,
-        matches_file=matches and not given,
-        overrides=given,
-        defaults_used=defaults,
-    )
-    return effective, provenance
+    return dataclasses.replace(effective, overrides=base.overrides), options
 
 
 def cycle_angles(case: Case) -> np.ndarray:
@@ -1001,6 +1046,52 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
     """
 
     stages = Stages(progress)
+    checked = _checked_case(case, provenance, stages, overrides=overrides, angle_step_deg=angle_step_deg,
+                            bearing_model=bearing_model, order=order, field_step_deg=field_step_deg)
+    case = checked.case
+    # the P2 model of the stress stage is built in a child process beside the load cycle
+    # (:class:`_P2Model`); the process starts now, so that its imports are done meanwhile
+    child = (_start_p2_child() if recover_stress and case.analysis.element_order == 1 and _models_in_package(case)
+             else None)
+    background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
+    try:
+        geometry, mesh, system = _disc_model(case, stages, cache_dir)
+        if on_model is not None:
+            on_model(system)
+        return _analyse_from_model(case, checked.provenance, stages, checked.thetas, checked.saved, geometry, mesh,
+                                   system, background, recover_stress, duty_fe, attribute, child)
+    finally:
+        background.shutdown(wait=True, cancel_futures=True)
+        if child is not None:
+            child.close()
+
+
+@dataclass(frozen=True, eq=False)
+class _CheckedCase:
+    """The case :func:`analyse` analyses, checked.
+
+    Attributes
+    ----------
+    case : Case
+        The case with the options applied (:func:`resolve_case`).
+    provenance : CaseProvenance
+    thetas : ndarray
+        Crank angles of the load cycle, rad (:func:`cycle_angles`).
+    saved : tuple of float
+        Crank angles whose fields the cycle keeps, degrees (:func:`kept_field_angles`).
+    """
+
+    case: Case
+    provenance: CaseProvenance
+    thetas: np.ndarray
+    saved: tuple[float, ...]
+
+
+def _checked_case(case, provenance: CaseProvenance | None, stages: Stages, *, overrides: tuple[str, ...],
+                  angle_step_deg: float | None, bearing_model: str | None, order: int | None,
+                  field_step_deg: float | None) -> _CheckedCase:
+    """The ``check`` stage of :func:`analyse`: the case resolved with its options and its angles
+    checked; without the stage when ``provenance`` is given (``case`` is then resolved already)."""
     if provenance is None:
         t = stages.start("check")
         case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
@@ -1013,29 +1104,22 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
             raise TypeError("analyse(..., provenance=...) needs a resolved Case")
         saved = kept_field_angles(case, field_step_deg)
         thetas = cycle_angles(case)
+    return _CheckedCase(case=case, provenance=provenance, thetas=thetas, saved=saved)
 
-    # the P2 model of the stress stage is built in a child process beside the load cycle
-    # (:class:`_P2Model`); the process starts now, so that its imports are done meanwhile
-    child = (_start_p2_child() if recover_stress and case.analysis.element_order == 1 and _models_in_package(case)
-             else None)
-    background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
-    try:
-        t = stages.start("mesh")
-        geometry = disc_geometry(case)
-        mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
-        stages.end("mesh", t)
 
-        t = stages.start("model")
-        system = cycle_module.build_system(case, mesh, geometry=geometry)
-        stages.end("model", t)
-        if on_model is not None:
-            on_model(system)
-        return _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
-                                   recover_stress, duty_fe, attribute, child)
-    finally:
-        background.shutdown(wait=True, cancel_futures=True)
-        if child is not None:
-            child.close()
+def _disc_model(case: Case, stages: Stages, cache_dir: str | os.PathLike | None):
+    """The ``mesh`` and ``model`` stages of :func:`analyse`: the disc geometry, its mesh (cached in
+    ``cache_dir``, default :func:`default_cache_dir`) and the assembled, factorised disc model
+    (:class:`rvfem.solve.cycle.DiscSystem`)."""
+    t = stages.start("mesh")
+    geometry = disc_geometry(case)
+    mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
+    stages.end("mesh", t)
+
+    t = stages.start("model")
+    system = cycle_module.build_system(case, mesh, geometry=geometry)
+    stages.end("model", t)
+    return geometry, mesh, system
 
 
 def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,

@@ -43,6 +43,7 @@ from typing import Any, Callable
 from rvfem.app import analysis as _analysis
 from rvfem.app.analysis import (
     CONTACT_BAND_ELEMENTS,
+    CaseProvenance,
     ProgressCallback,
     Stages,
     analyse,
@@ -207,38 +208,16 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
     stages = Stages(progress, STAGES)
     out_dir = Path(out_dir)
 
-    t = stages.start("check")
-    case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
-                                    bearing_model=bearing_model, order=order)
-    _analysis.cycle_angles(case)
-    _analysis.kept_field_angles(case, field_step_deg)
-    outputs.check_output_folder(out_dir, overwrite)
-    worker = None
-    if images:
-
-        worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
-        worker.check(wait=False)            # raises at once if this process knows it fails
-    stages.end("check", t)
-
+    checked = _checked_run(case, out_dir, stages, overrides=overrides, angle_step_deg=angle_step_deg,
+                           bearing_model=bearing_model, order=order, field_step_deg=field_step_deg,
+                           overwrite=overwrite, images=images)
+    worker = checked.worker
     try:
         with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
             try:
-                waited, mesh_call = [0.0], []
-
-                def draw_mesh(system):   # the worker draws the mesh picture during the load cycle
-                    t = time.perf_counter()
-                    try:
-                        mesh_call.append(outputs.start_mesh_picture(system, tmp, worker))
-                    finally:
-                        waited[0] += time.perf_counter() - t   # the rendering check, if not done
-
-                # with a render worker the attribution is computed here while the worker draws
-                result = analyse(case, provenance=provenance, field_step_deg=field_step_deg,
-                                 cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
-                                 attribute=worker is None, on_model=draw_mesh if worker is not None else None)
-                stages.seconds["check"] += waited[0]
-                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run,
-                                                        mesh_call[0] if mesh_call else None)
+                result, mesh_call = _analyse_for_run(checked, tmp, stages, progress=progress, cache_dir=cache_dir,
+                                                     field_step_deg=field_step_deg)
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, mesh_call)
             finally:
                 if worker is not None:
                     worker.close()   # before the folder is moved or removed: nothing writes into it
@@ -247,6 +226,72 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
             worker.close()
 
     return RunSummary(out_dir=out_dir, summary=summary, analysis=result, files=files)
+
+
+@dataclass(frozen=True, eq=False)
+class _CheckedRun:
+    """What the ``check`` stage of :func:`run_case` gives.
+
+    Attributes
+    ----------
+    case : Case
+        The case with the options applied (:func:`rvfem.app.analysis.resolve_case`).
+    provenance : CaseProvenance
+    worker : rvfem.outputs.render.RenderWorker or None
+        The render worker checking off-screen rendering (None without images).
+    """
+
+    case: Case
+    provenance: CaseProvenance
+    worker: RenderWorker | None
+
+
+def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, *, overrides: tuple[str, ...],
+                 angle_step_deg: float | None, bearing_model: str | None, order: int | None,
+                 field_step_deg: float | None, overwrite: bool, images: bool) -> _CheckedRun:
+    """The ``check`` stage of :func:`run_case`: the case resolved with its options, its angles and
+    the output folder checked, and with images the render worker started (its rendering check
+    runs meanwhile; one this process knows to fail raises at once)."""
+    t = stages.start("check")
+    case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
+                                    bearing_model=bearing_model, order=order)
+    _analysis.cycle_angles(case)
+    _analysis.kept_field_angles(case, field_step_deg)
+    outputs.check_output_folder(out_dir, overwrite)
+    worker = None
+    if images:
+        worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
+        worker.check(wait=False)            # raises at once if this process knows it fails
+    stages.end("check", t)
+    return _CheckedRun(case=case, provenance=provenance, worker=worker)
+
+
+def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progress: ProgressCallback | None,
+                     cache_dir: str | os.PathLike | None, field_step_deg: float | None):
+    """The analysis of a run (:func:`rvfem.app.analysis.analyse`); returns it and the render worker's
+    call drawing the mesh picture into ``tmp`` (None without a worker).
+
+    With a render worker the mesh picture is handed to it once the model is built (it draws
+    during the load cycle), the load cycle waits for its rendering check, and the attribution is
+    left for :func:`_write_outputs` to compute while the worker draws; the waits for the
+    rendering check count in the ``check`` stage.
+    """
+    worker = checked.worker
+    waited, mesh_call = [0.0], []
+
+    def draw_mesh(system):   # the worker draws the mesh picture during the load cycle
+        t = time.perf_counter()
+        try:
+            mesh_call.append(outputs.start_mesh_picture(system, tmp, worker))
+        finally:
+            waited[0] += time.perf_counter() - t   # the rendering check, if not done
+
+    # with a render worker the attribution is computed here while the worker draws
+    result = analyse(checked.case, provenance=checked.provenance, field_step_deg=field_step_deg,
+                     cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
+                     attribute=worker is None, on_model=draw_mesh if worker is not None else None)
+    stages.seconds["check"] += waited[0]
+    return result, (mesh_call[0] if mesh_call else None)
 
 
 def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: list[float]) -> ProgressCallback:
