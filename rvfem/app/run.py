@@ -33,6 +33,7 @@ Example (notebook)::
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import logging
 import os
 import time
@@ -316,13 +317,15 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
     """Write every file of the result folder ``tmp``; returns the summary, the files and the
     analysis (with its attribution).
 
-    The images and the plots are handed to ``worker`` first (its child process draws them
-    meanwhile); this process writes the tables and the VTK files, then computes the attribution
-    (if the analysis left it: it enters only the summary and the report; after the VTK files,
-    which a thread of pure Python beside them would slow down), then waits for the plots and the
-    images, and writes the report and the summary. Without a worker the plots are drawn here.
+    The writers are the registered ones (:func:`rvfem.outputs.summary.writers`), in their order:
+    those that do not need the summary by :func:`_write_files`; then the summary is built, and the
+    writers that take it run, ``report.html`` in the ``report`` stage and ``summary.json`` (stage
+    None) last, holding the time of every stage. The images and the plots are handed to ``worker``
+    first (its child process draws them meanwhile); this process writes the tables and the VTK
+    files, then computes the attribution (if the analysis left it: it enters only the summary and
+    the report; after the VTK files, which a thread of pure Python beside them would slow down),
+    then waits for the plots and the images. Without a worker the plots are drawn here.
     """
-    written: list[Path] = []
     computed = []
 
     def attribute() -> None:
@@ -330,38 +333,40 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
         computed.append(_analysis._timed(_analysis.attribution_of, result.system, result.theta, result.cycle))
         stages.end("attribution", t)
 
-    written += _write_files(result, tmp, stages, worker, mesh_call,
-                            meanwhile=attribute if result.attribution is None else None)
+    registered = outputs.writers(images=worker is not None)
+    written = _write_files(result, tmp, stages, worker, [w for w in registered if not w.needs_summary], mesh_call,
+                           meanwhile=attribute if result.attribution is None else None)
     if computed:
         (value, seconds), = computed
         result = dataclasses.replace(result, attribution=value,
                                      timings={**result.timings, "attribution_compute": seconds})
 
+    last = [w for w in registered if w.needs_summary]
     t = stages.start("report")
     timings = {"check": stages.seconds["check"], **result.timings,
                **{k: v for k, v in stages.seconds.items() if k != "check"}}
     timings["total"] = time.perf_counter() - t_run
-    files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {"report.html", "summary.json"}))
+    files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {f for w in last for f in w.files}))
     summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
-    outputs.write_report(result, tmp, summary=summary)
+    for w in last:
+        if w.stage is not None:
+            w.write(result, tmp, summary=summary)   # report.html
     stages.end("report", t)
     summary["timings_s"]["report"] = stages.seconds["report"]
     summary["timings_s"]["total"] = time.perf_counter() - t_run
-    outputs.write_summary(result, tmp, summary=summary)
+    for w in last:
+        if w.stage is None:
+            w.write(result, tmp, summary=summary)   # summary.json, with the time of every stage
     return summary, files, result
 
 
-def _write_files(result, tmp: Path, stages: Stages, worker, mesh_call: int | None = None,
+def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[outputs.Writer], mesh_call: int | None = None,
                  meanwhile: Callable[[], None] | None = None) -> list[Path]:
-    """The tables, the VTK files, the plots and the images (drawn by ``worker`` if given; the mesh
-    picture is its call ``mesh_call`` if it was started already); ``meanwhile()`` is called after
-    the VTK files, before the plots are waited for."""
-    written: list[Path] = []
-    t = stages.start("tables")
-    written += outputs.write_tables(result, tmp)
-    written += outputs.write_case_json(result, tmp)
-    stages.end("tables", t)
-
+    """Call the ``registered`` writers (the tables, the VTK files, the plots and the images), each
+    run of writers sharing a stage reported as that stage. With ``worker`` the plots and the images
+    are handed to it first (the mesh picture is its call ``mesh_call`` if it was started already)
+    and the writers taking ``pending`` wait for them; ``meanwhile()`` is called before the first
+    of those."""
     t_submit = time.perf_counter()
     pending = None
     if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
@@ -369,21 +374,20 @@ def _write_files(result, tmp: Path, stages: Stages, worker, mesh_call: int | Non
                                         mesh_call=mesh_call)
     submitted = time.perf_counter() - t_submit
 
-    n_fields = len(result.stress.snapshots)
-    t = stages.start("vtk", n_fields)
-    written += outputs.write_vtk(result, tmp, tick=lambda done, total: stages.tick("vtk", done, total))
-    stages.end("vtk", t, n_fields)
-    if meanwhile is not None:
+    written: list[Path] = []
+    for stage, group in itertools.groupby(registered, key=lambda w: w.stage):
+        group = list(group)
+        if meanwhile is not None and any("pending" in w.options for w in group):
+            meanwhile()
+            meanwhile = None
+        total = next((w.ticks(result) for w in group if w.ticks is not None), 1)
+        t = stages.start(stage, total)
+        for w in group:
+            options = {"tick": lambda done, n, stage=stage: stages.tick(stage, done, n), "pending": pending}
+            written += w.write(result, tmp, **{k: options[k] for k in w.options})
+        stages.end(stage, t, total)
+    if meanwhile is not None:   # no writer waited for the worker
         meanwhile()
-
-    t = stages.start("plots")
-    written += pending.calls_result() if pending is not None else outputs.write_plots(result, tmp)
-    stages.end("plots", t)
-
     if pending is not None:
-        n_images = outputs.image_count(result)
-        t = stages.start("images", n_images)
-        written += pending.result(tick=lambda done, total: stages.tick("images", done, total))
-        stages.end("images", t, n_images)
-        stages.seconds["images"] += submitted
+        stages.seconds["images"] += submitted   # handing the drawings over counts as drawing
     return written

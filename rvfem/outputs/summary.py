@@ -1,17 +1,18 @@
 """Writers of an :class:`~rvfem.app.analysis.Analysis`: one per format, and the atomic result folder.
 
 Every writer has the form ``write_x(analysis, folder) -> list[Path]`` and writes into an existing
-folder (sub-folders it needs are created)::
+folder (sub-folders it needs are created). Each registers itself (:mod:`rvfem.outputs.registry`);
+:func:`writers` lists them in the order a run calls them::
 
-    write_case_json   case.json           the case as analysed; case_from_dict() reads it back
     write_tables      bearing_loads.csv, roller_loads.csv (bearing model "rollers"), pin_forces.csv,
-                      cycle.csv
+                      cycle.csv, stress_history.csv
+    write_case_json   case.json           the case as analysed; case_from_dict() reads it back
     write_vtk         vtk/disc.pvd and vtk/disc_theta_<θ>.vtu per kept field (ParaView)
+    write_plots       plots/*.png (matplotlib)
     write_images      images/stress_theta_<θ>.png, the two stress close-ups (PyVista, off-screen),
                       images/mesh.png (matplotlib)
-    write_plots       plots/*.png (matplotlib)
-    write_summary     summary.json
     write_report      report.html (self-contained)
+    write_summary     summary.json
 
 The content of ``summary.json`` is built in one place, :func:`build_summary`, from the typed pieces
 of :data:`SUMMARY_PIECES`; docs/outputs.md documents every key (a test checks that the two agree).
@@ -53,6 +54,7 @@ from rvfem.evaluate.rigid import REFERENCE_NAMES, references
 from rvfem.geometry import crank_centres
 from rvfem.outputs import plots, render, tables, vtkio
 from rvfem.outputs.plots import mesh_plot
+from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import toml_text
 from rvfem.outputs.report import write_report as _write_html
 from rvfem.outputs.vtkio import vtu_name
@@ -94,6 +96,9 @@ __all__ = [
     "plot_calls",
     "write_summary",
     "write_report",
+    "Writer",
+    "register_writer",
+    "writers",
 ]
 
 SCHEMA_VERSION = 2
@@ -652,6 +657,7 @@ def build_summary(analysis, context: SummaryContext | None = None) -> dict:
     return json_ready(summary)
 
 
+@register_writer("summary", order=70, stage=None, options=("summary",), files=("summary.json",))
 def write_summary(analysis, folder: str | os.PathLike, *, summary: dict | None = None) -> list[Path]:
     """Write ``summary.json`` (the given ``summary``, or :func:`build_summary` with the files
     found in ``folder``)."""
@@ -674,6 +680,7 @@ def _files_in(folder: Path, extra: Iterable[str] = ()) -> tuple[str, ...]:
 # --------------------------------------------------------------------------------------------
 
 
+@register_writer("case_json", order=20, stage="tables", files=("case.json",))
 def write_case_json(analysis, folder: str | os.PathLike) -> list[Path]:
     """Write ``case.json``: the case as analysed (:func:`rvfem.case.definition.case_from_dict` reads it back)."""
     path = Path(folder) / "case.json"
@@ -681,6 +688,8 @@ def write_case_json(analysis, folder: str | os.PathLike) -> list[Path]:
     return [path]
 
 
+@register_writer("tables", order=10, stage="tables", files=("bearing_loads.csv", "roller_loads.csv", "pin_forces.csv",
+                                                        "cycle.csv", "stress_history.csv"))
 def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
     """Write the CSV tables of the load cycle (:mod:`rvfem.outputs.tables`): ``bearing_loads.csv``,
     ``roller_loads.csv`` (discrete rollers only), ``pin_forces.csv``, ``cycle.csv``. The handbook
@@ -708,6 +717,8 @@ def write_tables(analysis, folder: str | os.PathLike) -> list[Path]:
 # --------------------------------------------------------------------------------------------
 
 
+@register_writer("vtk", order=30, stage="vtk", options=("tick",), files=("vtk/*.vtu", "vtk/disc.pvd"),
+                 ticks=lambda analysis: len(analysis.stress.snapshots))
 def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None) -> list[Path]:
     """Write ``vtk/disc_theta_<θ>.vtu`` for every kept field and the collection ``vtk/disc.pvd``
     (:mod:`rvfem.outputs.vtkio`)."""
@@ -937,21 +948,26 @@ def submit_images(analysis, folder: str | os.PathLike, worker, *,
     return PendingImages(image_set, worker, numbers[:-1], numbers[-1])
 
 
+@register_writer("images", order=50, stage="images", options=("tick", "pending"), files=("images/*.png",),
+                 renders=True, ticks=image_count)
 def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | None = None,
-                 worker=None) -> list[Path]:
+                 worker=None, pending: PendingImages | None = None) -> list[Path]:
     """Render ``images/``: von Mises on the deformed disc at every kept angle, close-ups of the two
     stress peaks (PyVista, off-screen) and the mesh (:func:`rvfem.outputs.plots.mesh_plot`).
 
     The stress images share one off-screen plotter (:class:`rvfem.outputs.render.StressRenderer`); the
     mesh picture is drawn by a second thread meanwhile. With a render worker
     (:class:`rvfem.outputs.render.RenderWorker`) both are drawn by its child process (see also
-    :func:`submit_images`). All files are complete on return.
+    :func:`submit_images`); with ``pending`` (what :func:`submit_images` returned) the images the
+    worker is drawing are waited for. All files are complete on return.
 
     Raises
     ------
     RenderError
         If off-screen rendering is not possible here.
     """
+    if pending is not None:
+        return pending.result(tick=tick)
     if worker is not None:
         return submit_images(analysis, folder, worker).result(tick=tick)
 
@@ -1011,10 +1027,15 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
     return calls
 
 
-def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
+@register_writer("plots", order=40, stage="plots", options=("pending",), files=("plots/*.png",))
+def write_plots(analysis, folder: str | os.PathLike, *, pending: PendingImages | None = None) -> list[Path]:
     """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
     the equal share where it is not defined), roller loads and pin forces at the angle of the
-    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.outputs.plots`)."""
+    largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.outputs.plots`). With
+    ``pending`` (:func:`submit_images` given :func:`plot_calls`) the plots a render worker is
+    drawing are waited for instead."""
+    if pending is not None:
+        return pending.calls_result()
     return [function(**kwargs) for function, kwargs in plot_calls(analysis, folder)]
 
 
@@ -1023,6 +1044,7 @@ def write_plots(analysis, folder: str | os.PathLike) -> list[Path]:
 # --------------------------------------------------------------------------------------------
 
 
+@register_writer("report", order=60, stage="report", options=("summary",), files=("report.html",))
 def write_report(analysis, folder: str | os.PathLike, *, summary: dict | None = None) -> list[Path]:
     """Write ``report.html`` (:mod:`rvfem.outputs.report`): the numbers of ``summary`` (default
     :func:`build_summary` with the files found in ``folder``) with the PNG files of ``folder``
