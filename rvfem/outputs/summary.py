@@ -1106,11 +1106,10 @@ def _life(value: float | None, width: int = 0) -> str:
     return f"{v:{width}.3g}"
 
 
-def summary_text(summary: dict) -> str:
-    """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints)."""
-
+def _header_lines(summary: dict) -> list[str]:
+    """The case, the model, the torque and the rating, and the head of the bearing table."""
     c, m = summary["case"], summary["model"]
-    lines = [
+    return [
         f"Case {c['name']}" + (f" ({c['file']})" if c.get("file") else "") +
         (f", overrides: {', '.join(f'{k} = {toml_text(v)}' for k, v in c['overrides'].items())}"
          if c["overrides"] else ""),
@@ -1122,10 +1121,12 @@ def summary_text(summary: dict) -> str:
         f"  {'bearing':>7} {'model':<9} {'max N':>8} {'at °':>6} {'min N':>8} {'at °':>6} {'F_m N':>8} {'L10h h':>9}",
     ]
 
-    refs = summary["references"]
-    handbook = refs["bearing_loads"] == "handbook"
+
+def _bearing_lines(summary: dict, handbook: bool) -> list[str]:
+    """Per bearing: the loads and life by each model, then the deltas and the life ratio."""
     rows = ("rigid", "flexible") if handbook else ("rigid", "equal_share", "flexible")
     names = {"rigid": "rigid", "flexible": "flexible", "equal_share": "eq. share"}
+    lines = []
     for b in summary["bearings"]:
         for key in rows:
             s = b[key]
@@ -1139,9 +1140,13 @@ def summary_text(summary: dict) -> str:
         lines.append(f"  {'':>7} {'delta':<9} {_num(b['delta_max_percent'], '+7.1f')}% {'':>6} "
                      f"{_num(b['delta_min_percent'], '+7.1f')}% {'':>6} {_num(b['delta_equivalent_percent'], '+7.1f')}%  "
                      f"life ratio {_num(b['life_ratio'], '.2f')}" + ("" if handbook else "  (vs equal share)"))
-    lines += [""] + reference_lines(refs)
+    return lines
+
+
+def _stage_lines(summary: dict, handbook: bool) -> list[str]:
+    """The reducer stage and what the delta of bearing 1 is made of, step by step."""
     rs = summary["reducer_stage"]
-    lines += ["", f"  reducer stage: {rs['model']}"]
+    lines = ["", f"  reducer stage: {rs['model']}"]
     if rs["torque_share"]:
         lines[-1] += (f"; torque of disc A {rs['torque_share']['min']:.3f}–{rs['torque_share']['max']:.3f} × T/2")
     lines.append(f"  what the delta of bearing 1 is made of (against the "
@@ -1151,42 +1156,61 @@ def summary_text(summary: dict) -> str:
             lines.append(f"    {r['step']:<12} max {_num(r['delta_max_percent'], '+6.1f')}%  min "
                          f"{_num(r['delta_min_percent'], '+6.1f')}%  F_m {_num(r['delta_equivalent_percent'], '+6.1f')}%"
                          f"  life ratio {_num(r['life_ratio'], '.2f')}" + ("   <- this run" if r["final"] else ""))
-    h = summary["hertz"]
-    fe = h.get("fe_rollers")
-    lines += [""] + stress_lines(summary["stress"]) + [
-        f"  pins in contact {summary['pins_in_contact']['min']}–{summary['pins_in_contact']['max']} of "
-        f"{summary['pins_in_contact']['of']}; torsional stiffness {summary['torsional_stiffness_Nm_per_arcmin']:.1f} "
-        f"N·m/arcmin per disc; equilibrium residual {summary['equilibrium_residual']:.1e}",
-    ]
-    sr = h["stribeck_rigid"]
-    hertz = ("  Hertz, most loaded roller: " + (
+    return lines
+
+
+def _hertz_line(h: dict) -> str:
+    """The Hertz pressures of the most loaded roller: rigid Stribeck, then the FE roller load (or
+    Stribeck with the FE bearing load where there are no FE roller loads)."""
+    sr, fe = h["stribeck_rigid"], h.get("fe_rollers")
+    line = ("  Hertz, most loaded roller: " + (
         f"rigid Stribeck Q = {_sig(sr['roller_load_N'], '.0f')} N, p_in {_sig(sr['inner']['peak_pressure_MPa'], '.0f')}"
         f" / p_out {_sig(sr['outer']['peak_pressure_MPa'], '.0f')} MPa" if sr else
         "rigid Stribeck not defined for Zp − Zc ≠ 1"))
     if fe:
-        hertz += (f"; FE Q = {_sig(fe['roller_load_N'], '.0f')} N, p_in {_sig(fe['inner']['peak_pressure_MPa'], '.0f')}"
-                  f" / p_out {_sig(fe['outer']['peak_pressure_MPa'], '.0f')} MPa")
-    else:
-        sf = h["stribeck_flexible"]
-        hertz += (f"; FE bearing load with Stribeck Q = {_sig(sf['roller_load_N'], '.0f')} N, p_in "
-                  f"{_sig(sf['inner']['peak_pressure_MPa'], '.0f')} / p_out "
-                  f"{_sig(sf['outer']['peak_pressure_MPa'], '.0f')} MPa")
-    lines.append(hertz)
-    duty = summary.get("duty_cycle")
-    if duty:
-        lines.append("  duty cycle: service life " + ", ".join(
-            f"{key} {_life(duty[key]['service_life_h'])} h" if duty[key] else f"{key} not defined"
-            for key in ("rigid", "flexible"))
-            + f" (equivalent torque {duty['flexible']['equivalent_torque_Nm']:.1f} N·m, "
-              f"speed {duty['flexible']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)")
-        fe = duty.get("flexible_fe")
-        if fe:
-            lines.append(
-                "    flexible FE at every duty torque (" + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): "
-                f"service life {_life(fe['service_life_h'])} h ({_num(fe['life_difference_percent'], '+.1f')} % "
-                "against the linear scaling); F_m off linear scaling by "
-                + ", ".join(f"{e:+.1f} %" for e in fe["linear_scaling_error_percent"]))
-    t = summary["timings_s"]
+        return line + (f"; FE Q = {_sig(fe['roller_load_N'], '.0f')} N, p_in "
+                       f"{_sig(fe['inner']['peak_pressure_MPa'], '.0f')} / p_out "
+                       f"{_sig(fe['outer']['peak_pressure_MPa'], '.0f')} MPa")
+    sf = h["stribeck_flexible"]
+    return line + (f"; FE bearing load with Stribeck Q = {_sig(sf['roller_load_N'], '.0f')} N, p_in "
+                   f"{_sig(sf['inner']['peak_pressure_MPa'], '.0f')} / p_out "
+                   f"{_sig(sf['outer']['peak_pressure_MPa'], '.0f')} MPa")
+
+
+def _duty_lines(duty: dict | None) -> list[str]:
+    """The duty-cycle service lives and their check by the flexible model; none without a duty cycle."""
+    if not duty:
+        return []
+    lines = ["  duty cycle: service life " + ", ".join(
+        f"{key} {_life(duty[key]['service_life_h'])} h" if duty[key] else f"{key} not defined"
+        for key in ("rigid", "flexible"))
+        + f" (equivalent torque {duty['flexible']['equivalent_torque_Nm']:.1f} N·m, "
+          f"speed {duty['flexible']['equivalent_speed_rpm']:.2f} rpm; loads scaled linearly with the torque)"]
+    fe = duty.get("flexible_fe")
+    if fe:
+        lines.append(
+            "    flexible FE at every duty torque (" + ", ".join(f"{t:g}" for t in fe["torques_Nm"]) + " N·m): "
+            f"service life {_life(fe['service_life_h'])} h ({_num(fe['life_difference_percent'], '+.1f')} % "
+            "against the linear scaling); F_m off linear scaling by "
+            + ", ".join(f"{e:+.1f} %" for e in fe["linear_scaling_error_percent"]))
+    return lines
+
+
+def summary_text(summary: dict) -> str:
+    """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints)."""
+
+    handbook = summary["references"]["bearing_loads"] == "handbook"
+    pins, t = summary["pins_in_contact"], summary["timings_s"]
+    lines = _header_lines(summary) + _bearing_lines(summary, handbook)
+    lines += [""] + reference_lines(summary["references"])
+    lines += _stage_lines(summary, handbook)
+    lines += [""] + stress_lines(summary["stress"]) + [
+        f"  pins in contact {pins['min']}–{pins['max']} of {pins['of']}; torsional stiffness "
+        f"{summary['torsional_stiffness_Nm_per_arcmin']:.1f} N·m/arcmin per disc; equilibrium residual "
+        f"{summary['equilibrium_residual']:.1e}",
+    ]
+    lines.append(_hertz_line(summary["hertz"]))
+    lines += _duty_lines(summary.get("duty_cycle"))
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")
     lines += warning_lines(summary.get("warnings", []))
