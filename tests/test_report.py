@@ -301,3 +301,11 @@ def test_the_screen_text_has_every_part(summary):
     assert ("  duty cycle: service life rigid not defined, flexible 2000 h (equivalent torque 400.0 N·m, speed "
             "12.50 rpm; loads scaled linearly with the torque)") in lines
     assert lines[-2:] == ["", "  warning: P/C above 0.5"]
+
+
+def test_the_report_says_whether_the_bearing_has_clearance_or_preload():
+    from rvfem.outputs.report import clearance_text
+
+    assert clearance_text(0.01) == "radial clearance 10 µm"
+    assert clearance_text(-0.005).startswith("preload 5 µm")
+    assert clearance_text(0.0) == "no radial clearance and no preload"

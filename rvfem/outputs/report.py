@@ -385,14 +385,24 @@ def _attribution(summary: dict) -> dict:
                              "life ratio"], rows)}
 
 
+def clearance_text(radial_clearance: float) -> str:
+    """The crank bearing's play in words: a radial clearance (every roller open by half of it at
+    zero load), a preload (a negative clearance: every roller compressed by half of it) or none."""
+    if radial_clearance > 0:
+        return f"radial clearance {radial_clearance * 1000:g} µm"
+    if radial_clearance < 0:
+        return f"preload {-radial_clearance * 1000:g} µm (negative radial clearance: every roller compressed at zero load)"
+    return "no radial clearance and no preload"
+
+
 def _depends_on(summary: dict, case: Case) -> str:
     """This run's modelling choices, for the section "What this delta depends on" (the measured
     sensitivity of the shipped fan-hole case is in notebooks/what_drives_the_flexibility_effect.ipynb)."""
     m, rs = summary["model"], summary["reducer_stage"]
     b, mod = case.crank_bearing, case.cycloid.modification
     law = b.stiffness_law if b.model == "rollers" else "isotropic spring"
-    return (f"{rs['model']}; bearing model {m['bearing_model']} ({law}), radial clearance "
-            f"{b.radial_clearance:g} mm; pin model {m['pin_model']}, friction μ = {case.analysis.friction:g}; "
+    return (f"{rs['model']}; bearing model {m['bearing_model']} ({law}), {clearance_text(b.radial_clearance)}; "
+            f"pin model {m['pin_model']}, friction μ = {case.analysis.friction:g}; "
             f"profile modification ΔRrp = {mod.equidistant:g} mm, ΔRp = {mod.shift:g} mm")
 
 
@@ -490,8 +500,8 @@ def _case_rows(case: Case) -> list[list[str]]:
         ["pins", f"Zp = {p.count}, Rp = {p.circle_radius:g} mm, r_rp = {p.radius:g} mm, model {p.model}"],
         ["cranks", f"N = {k.count} on r0 = {k.circle_radius:g} mm at {', '.join(f'{a:g}°' for a in k.angles_deg)}"],
         ["crank bearing", f"Z = {b.rollers}, D_we = {b.roller_diameter:g} mm, L_we = {b.roller_length:g} mm, "
-                          f"D_m = {b.pitch_diameter:g} mm, bore r = {b.bore_radius:g} mm, clearance "
-                          f"{b.radial_clearance:g} mm, b_m = {b.b_m:g}, λ_ν = {b.lambda_nu:g}"],
+                          f"D_m = {b.pitch_diameter:g} mm, bore r = {b.bore_radius:g} mm, "
+                          f"{clearance_text(b.radial_clearance)}, b_m = {b.b_m:g}, λ_ν = {b.lambda_nu:g}"],
         ["material", f"{mat.name}: E = {mat.youngs_modulus:g} MPa, ν = {mat.poissons_ratio:g}"],
         ["loads", f"T_out = {ld.torque_Nm:g} N·m, {ld.speed_rpm:g} rpm output, {ld.discs} discs"
                   + (f", duty cycle of {len(ld.duty_cycle)} rows" if ld.duty_cycle else "")],
