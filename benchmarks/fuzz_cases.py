@@ -51,7 +51,7 @@ if str(ROOT) not in sys.path:
 
 from rvfem.case.definition import table_class  # noqa: E402
 from rvfem.app.cli import main as rvfem_main  # noqa: E402
-from rvfem.case.schema import file_fields  # noqa: E402
+from rvfem.case.schema import file_fields, toml_literal  # noqa: E402
 
 CASES_DIR = ROOT / "cases"
 SHIPPED = {p.stem: p.read_text(encoding="utf-8") for p in sorted(CASES_DIR.glob("*.toml"))}
@@ -68,23 +68,7 @@ def _key(key: str) -> str:
 
 
 def _value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "nan"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list):
-        return "[" + ", ".join(_value(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{_key(k)} = {_value(v)}" for k, v in value.items()) + "}"
-    raise TypeError(type(value))
+    return toml_literal(value, bare_keys=True)
 
 
 def _is_table_array(value: Any) -> bool:

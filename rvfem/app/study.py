@@ -81,7 +81,7 @@ from threadpoolctl import threadpool_limits
 
 from rvfem.app.run import run_case
 from rvfem.case.definition import case_to_dict, load_case, parse_override
-from rvfem.case.schema import param, read_table
+from rvfem.case.schema import param, read_table, toml_literal
 from rvfem.errors import CaseError, OutputError, RvfemError
 from rvfem.outputs.summary import result_folder
 
@@ -208,27 +208,6 @@ class Study:
     @property
     def base(self) -> Variant:
         return self.variants[0]
-
-
-def toml_literal(value: Any) -> str:
-    """``value`` as a TOML literal (the right-hand side of an override ``KEY=VALUE``)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "nan"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(toml_literal(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{json.dumps(str(k))} = {toml_literal(v)}" for k, v in value.items()) + "}"
-    raise CaseError(f"{value!r} cannot be written as a TOML value")
 
 
 def _value_text(value: Any) -> str:

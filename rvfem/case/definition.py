@@ -272,7 +272,10 @@ class CrankBearing:
         side when centred). Negative: a preload (interference); every roller is then compressed
         by half of it at zero load. Bounded below at −0.02 mm: a 10 µm approach per roller
         already gives each roller of the shipped bearings about 1.5 kN of preload, of the order
-        of the operating roller loads (Palmgren's line contact).
+        of the operating roller loads (Palmgren's line contact). Bounded above at 0.2 mm (crank
+        bearings run at a few µm to tens of µm): with 1 mm the discs rattle in their bearings and
+        the contact set of the solid RV-40E stage no longer settles (at θ = 46°); the shipped
+        RV-40E pair and the CRV-80E solve at 0.1 and 0.2 mm.
     b_m, lambda_nu : float
         ISO 281 rating factors (material/manufacturing and edge-stress reduction).
     model : str
@@ -295,7 +298,7 @@ class CrankBearing:
     pitch_diameter: float = param(unit="mm", low=1.0, high=2000.0, doc="D_m; the rollers must fit: Z·D_we < π·D_m")
     bore_radius: float = param(unit="mm", low=0.5, high=1000.0,
                                doc="radius of the disc bore, at least (D_m + D_we)/2 (the outer raceway)")
-    radial_clearance: float = param(0.0, unit="mm", low=-0.02, high=1.0,
+    radial_clearance: float = param(0.0, unit="mm", low=-0.02, high=0.2,
                                     doc="radial clearance of the bearing; negative: a preload (interference)")
     b_m: float = param(1.1, low=B_M_RANGE[0], high=B_M_RANGE[1],
                        doc="ISO 281 rating factor for material and manufacturing quality (1.1 for radial roller "

@@ -33,7 +33,9 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
+import json
 import math
+import re
 import sys
 import types
 import typing
@@ -43,6 +45,7 @@ from typing import Any, Callable, Iterator, Mapping
 from rvfem.errors import CaseError
 
 __all__ = [
+    "toml_literal",
     "Param",
     "param",
     "FieldSpec",
@@ -529,3 +532,43 @@ def markdown_table(cls: type) -> str:
             f"{_allowed_text(spec)} | {p.doc} |"
         )
     return "\n".join(lines)
+
+
+_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
+
+
+def toml_literal(value: Any, *, bare_keys: bool = False) -> str:
+    """``value`` as a TOML literal: ``true``, ``0.5``, ``"text"``, ``[1.0, 2.0]``,
+    ``{"equidistant" = 0.0}`` (the right-hand side of an override ``KEY=VALUE``, or a case value as
+    a case file writes it). ``bare_keys`` writes the keys of inline tables unquoted where TOML
+    allows (``{equidistant = 0.0}``).
+
+    Raises
+    ------
+    CaseError
+        For a value TOML cannot hold.
+
+    Examples
+    --------
+    >>> toml_literal({"symmetric": True, "values": [0.5, 1]}, bare_keys=True)
+    '{symmetric = true, values = [0.5, 1]}'
+    """
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_literal(v, bare_keys=bare_keys) for v in value) + "]"
+    if isinstance(value, dict):
+        def key(k):
+            return str(k) if bare_keys and _BARE_KEY.match(str(k)) else json.dumps(str(k))
+        return "{" + ", ".join(f"{key(k)} = {toml_literal(v, bare_keys=bare_keys)}" for k, v in value.items()) + "}"
+    raise CaseError(f"{value!r} cannot be written as a TOML value")

@@ -17,10 +17,8 @@ from __future__ import annotations
 
 import base64
 import functools
-import json
 import math
 import os
-import re
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +27,8 @@ import jinja2
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
 from rvfem.case.definition import Case
 from rvfem.case.registry import bearing_model, pin_model
+from rvfem.case.schema import toml_literal
+from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 
 __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "report_context", "toml_text",
@@ -37,37 +37,16 @@ __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "repo
 TEMPLATE = "report.html.j2"
 """The report's template, in the folder ``templates`` of this package (shipped as package data)."""
 
-_BARE_KEY = re.compile(r"^[A-Za-z0-9_-]+$")
-
 
 def toml_text(value: Any) -> str:
     """A case value as it is written in a case file (TOML): ``true``, ``0.0``, ``"text"``,
     ``[1.0, 2.0]``, ``{equidistant = 0.0, shift = 0.0}`` (no Python ``True`` or dicts in what users
-    read).
-
-    Examples
-    --------
-    >>> toml_text({"symmetric": True, "values": [0.5, 1]})
-    '{symmetric = true, values = [0.5, 1]}'
-    """
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
+    read; :func:`rvfem.case.schema.toml_literal` with bare keys), or ``str(value)`` for anything TOML
+    cannot hold."""
+    try:
+        return toml_literal(value, bare_keys=True)
+    except CaseError:
         return str(value)
-    if isinstance(value, float):
-        if math.isnan(value):
-            return "nan"
-        if math.isinf(value):
-            return "inf" if value > 0 else "-inf"
-        return repr(value)
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(toml_text(v) for v in value) + "]"
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k if _BARE_KEY.match(str(k)) else json.dumps(str(k))} = {toml_text(v)}"
-                               for k, v in value.items()) + "}"
-    return str(value)
 
 
 def key_field_angles(summary: dict, case: Case) -> list[float]:
