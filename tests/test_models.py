@@ -6,14 +6,18 @@ import math
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR
 from scipy.integrate import quad
 
-from rvfem.solve import contact
 from rvfem.case import registry
 from rvfem.case.definition import load_case
-from rvfem.geometry import build_profile, pin_profile_contacts, profile_curvature, trochoid_curvature
-
-from conftest import CASES_DIR
+from rvfem.geometry import (
+    build_profile,
+    pin_profile_contacts,
+    profile_curvature,
+    trochoid_curvature,
+)
+from rvfem.solve import contact, models
 
 E, NU = 206000.0, 0.3
 L = 9.0
@@ -121,11 +125,11 @@ def test_every_pin_model_of_the_case_format_is_registered_and_described():
     case = load_case(CASES_DIR / "rv40e.toml")
     assert set(registry.pin_model_names()) >= {"rigid", "hertz", "palmgren", "linear"}
     for name in ("rigid", "hertz", "palmgren"):
-        assert registry.pin_model(name)(case).describe()
-    assert "Hertz line contact" in registry.pin_model("hertz")(case).describe()
-    assert "Palmgren" in registry.pin_model("palmgren")(case).describe()
-    assert "1e+04 N/mm" in registry.pin_model("linear")(case, 1e4).describe() or \
-        "10000 N/mm" in registry.pin_model("linear")(case, 1e4).describe()
+        assert models.pin_model(name)(case).describe()
+    assert "Hertz line contact" in models.pin_model("hertz")(case).describe()
+    assert "Palmgren" in models.pin_model("palmgren")(case).describe()
+    assert "1e+04 N/mm" in models.pin_model("linear")(case, 1e4).describe() or \
+        "10000 N/mm" in models.pin_model("linear")(case, 1e4).describe()
 
 
 @pytest.mark.slow
@@ -133,9 +137,9 @@ def test_classical_model_through_its_case_file_gives_the_textbook_distribution(t
     """cases/rv40e_classical.toml (linear pins, stiff disc, rigid bearings, μ = 0, T/2 on one disc)
     reproduces the classical distribution: peak 406.7 N on the RV-40E stage, 19-20 loaded pins,
     and every pin force within 0.5 % of the peak. The distribution repeats every pin pitch (9°)."""
-    from rvfem.solve import cycle
     from rvfem.evaluate import rigid
     from rvfem.mesh import mesh_case
+    from rvfem.solve import cycle
 
     case = load_case(CASES_DIR / "rv40e_classical.toml")
     system = cycle.build_system(case, mesh_case(case, tmp_path))

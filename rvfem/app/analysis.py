@@ -39,7 +39,6 @@ import platformdirs
 
 from rvfem._arrays import release_freed_memory
 from rvfem._child import ChildProcess, ChildProcessEnded
-from rvfem.case import registry
 from rvfem.case.definition import (
     Case,
     apply_overrides,
@@ -65,6 +64,7 @@ from rvfem.evaluate.rigid import equivalent_load
 from rvfem.geometry import disc_geometry, pin_centres
 from rvfem.mesh import mesh_case
 from rvfem.solve import cycle as cycle_module
+from rvfem.solve import models
 from rvfem.solve.cycle import AngleLoads, build_system
 
 if TYPE_CHECKING:  # the heavier modules are imported where used
@@ -869,7 +869,7 @@ def _models_in_package(case) -> bool:
     (a model registered at run time, by a notebook or a test module, exists in this process only:
     its P2 model is then built on a thread here)."""
     try:
-        classes = (registry.bearing_model(case.crank_bearing.model), registry.pin_model(case.pins.model))
+        classes = (models.bearing_model(case.crank_bearing.model), models.pin_model(case.pins.model))
     except KeyError:
         return False
     return all(c.__module__.split(".")[0] == "rvfem" for c in classes)

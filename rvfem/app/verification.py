@@ -33,7 +33,6 @@ import scipy.sparse.linalg as spla
 from skfem import Basis, ElementVector, FacetBasis, Functional, LinearForm, asm
 
 from rvfem import fem
-from rvfem.case import registry
 from rvfem.case.definition import load_case
 from rvfem.evaluate import compare, rigid
 from rvfem.evaluate.hertz import hertz_peak_pressure
@@ -51,7 +50,7 @@ from rvfem.evaluate.rigid import (
 from rvfem.fem import crankshaft
 from rvfem.fem.model import _scalar_element
 from rvfem.mesh import gmsh_session, mesh_case
-from rvfem.solve import contact, cycle
+from rvfem.solve import contact, cycle, models
 from rvfem.solve.cycle import build_system
 
 log = logging.getLogger(__name__)
@@ -496,7 +495,7 @@ def rigid_limit_section(discs: _Discs) -> Section:
     lin_case = _case("rv40e_solid", 'crank_bearing.stiffness_law="linear"',
                      "crank_bearing.linear_stiffness_N_per_mm=2e5", "analysis.friction=0")
     lin_system = dataclasses.replace(linear, case=lin_case,
-                                     bearings=registry.bearing_model("rollers")(lin_case, 1.0))
+                                     bearings=models.bearing_model("rollers")(lin_case, 1.0))
     lin = cycle.load_cycle(lin_system, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(lin_system))
     e_share = (np.abs(lin.bearing_forces - compare.equal_share_forces(lin_case, lin)).max()
                / lin.bearing_loads.max())

@@ -5,25 +5,24 @@ reader, the command line and the report all take the list of valid names from he
 model is one class registered with :func:`register_bearing_model` / :func:`register_pin_model`
 (from any module, a test module included) plus its case keys.
 
-The built-in names are known without importing the (heavier) model module; their classes are
-imported on first use.
+The built-in names are known without importing the (heavier) model module, which registers their
+classes when it is imported; :func:`rvfem.solve.models.bearing_model` and
+:func:`rvfem.solve.models.pin_model` look a class up by name.
 """
 
 from __future__ import annotations
-
-import importlib
 
 __all__ = [
     "register_bearing_model",
     "register_pin_model",
     "bearing_model_names",
     "pin_model_names",
-    "bearing_model",
-    "pin_model",
+    "registered_models",
+    "builtin_model_names",
 ]
 
-_BUILTIN_BEARINGS = {"rollers": "RollerBearing", "rigid_bore": "RigidBoreBearing"}
-_BUILTIN_PINS = {"rigid": "RigidPins", "hertz": "HertzPins", "palmgren": "PalmgrenPins", "linear": "LinearPins"}
+_BUILTIN_BEARINGS = ("rollers", "rigid_bore")
+_BUILTIN_PINS = ("rigid", "hertz", "palmgren", "linear")
 _BEARINGS: dict[str, type] = {}
 _PINS: dict[str, type] = {}
 
@@ -51,24 +50,14 @@ def pin_model_names(*, case_file: bool = True) -> tuple[str, ...]:
     return tuple(dict.fromkeys([*_BUILTIN_PINS, *_PINS]))
 
 
-def _resolve(name: str, registered: dict, builtin: dict, kind: str) -> type:
-    if name not in registered and name in builtin:
-        # the built-in models' module, loaded by name on first use like a plugin: the case layer
-        # names the models without importing the solver
-        models = importlib.import_module("rvfem.solve.models")
-        registered.setdefault(name, getattr(models, builtin[name]))
-    try:
-        return registered[name]
-    except KeyError:
-        known = ", ".join(dict.fromkeys([*builtin, *registered]))
-        raise KeyError(f"unknown {kind} model {name!r}; known: {known}") from None
+def registered_models(kind: str) -> dict[str, type]:
+    """The registered model classes of a kind (``"bearing"`` or ``"pin"``) by name: the built-in
+    ones once :mod:`rvfem.solve.models` has been imported (it registers them), and any registered
+    since. The solver looks a model up with :func:`rvfem.solve.models.bearing_model` /
+    :func:`rvfem.solve.models.pin_model`."""
+    return {"bearing": _BEARINGS, "pin": _PINS}[kind]
 
 
-def bearing_model(name: str) -> type:
-    """The class of bearing model ``name``."""
-    return _resolve(name, _BEARINGS, _BUILTIN_BEARINGS, "bearing")
-
-
-def pin_model(name: str) -> type:
-    """The class of pin model ``name``."""
-    return _resolve(name, _PINS, _BUILTIN_PINS, "pin")
+def builtin_model_names(kind: str) -> tuple[str, ...]:
+    """The names of the built-in models of a kind, known without importing the solver."""
+    return tuple({"bearing": _BUILTIN_BEARINGS, "pin": _BUILTIN_PINS}[kind])

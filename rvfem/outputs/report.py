@@ -26,10 +26,10 @@ import jinja2
 
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
 from rvfem.case.definition import Case
-from rvfem.case.registry import bearing_model, pin_model
 from rvfem.case.schema import toml_literal
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
+from rvfem.solve.models import bearing_model, pin_model
 
 __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "report_context", "toml_text",
            "write_report"]

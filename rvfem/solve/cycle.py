@@ -74,7 +74,6 @@ from threadpoolctl import threadpool_limits
 
 from rvfem import fem
 from rvfem._arrays import max_load_index
-from rvfem.case import registry
 from rvfem.case.definition import FOOTPRINT_ELEMENTS, Case
 from rvfem.errors import CaseError, ContactError, MeshError
 from rvfem.fem import nodal_stress_operator
@@ -89,7 +88,7 @@ from rvfem.geometry import (
     profile_curvature,
 )
 from rvfem.mesh import rotation_permutation
-from rvfem.solve import contact
+from rvfem.solve import contact, models
 from rvfem.solve.contact import AngleSolution, Compliance, ContactSet, Interface
 from rvfem.solve.models import (
     ContactGroup,
@@ -246,8 +245,8 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     bearing_model = bearing_model or case.crank_bearing.model
     pin_model = pin_model or case.pins.model
     try:
-        pins = registry.pin_model(pin_model)(case, pin_stiffness_N_per_mm)
-        bearings = registry.bearing_model(bearing_model)(case, bearing_stiffness_scale)
+        pins = models.pin_model(pin_model)(case, pin_stiffness_N_per_mm)
+        bearings = models.bearing_model(bearing_model)(case, bearing_stiffness_scale)
     except KeyError as exc:
         raise CaseError(exc.args[0]) from None
     times = {}

@@ -24,7 +24,12 @@ import scipy.sparse as sp
 
 from rvfem._arrays import readonly as _readonly
 from rvfem.case.definition import FOOTPRINT_ELEMENTS
-from rvfem.case.registry import register_bearing_model, register_pin_model
+from rvfem.case.registry import (
+    builtin_model_names,
+    register_bearing_model,
+    register_pin_model,
+    registered_models,
+)
 from rvfem.errors import CaseError
 from rvfem.solve import contact
 
@@ -426,3 +431,24 @@ class LinearPins:
 
     def law(self, contacts=None, curvature=None):
         return contact.linear_law(self.stiffness)
+
+
+def _model(kind: str, name: str) -> type:
+    registered = registered_models(kind)
+    try:
+        return registered[name]
+    except KeyError:
+        known = ", ".join(dict.fromkeys([*builtin_model_names(kind), *registered]))
+        raise KeyError(f"unknown {kind} model {name!r}; known: {known}") from None
+
+
+def bearing_model(name: str) -> type:
+    """The class of the crank-bearing model ``name`` (built in or registered,
+    :func:`rvfem.case.registry.register_bearing_model`)."""
+    return _model("bearing", name)
+
+
+def pin_model(name: str) -> type:
+    """The class of the pin model ``name`` (built in or registered,
+    :func:`rvfem.case.registry.register_pin_model`)."""
+    return _model("pin", name)
