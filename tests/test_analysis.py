@@ -16,6 +16,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR, ROOT, coarse_case
 
 from rvfem import fem
 from rvfem.app import analysis as an
@@ -34,8 +35,6 @@ from rvfem.errors import CaseError
 from rvfem.evaluate import iso281
 from rvfem.evaluate.rigid import equivalent_load, load_cycle_angles
 from rvfem.solve import cycle as cycle_module
-
-from conftest import CASES_DIR, ROOT, coarse_case
 
 CRV80E = CASES_DIR / "crv80e.toml"
 STEP_DEG = 30.0

@@ -14,13 +14,12 @@ import json
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from conftest import CASES_DIR
 
 from rvfem.app import cli
-from rvfem.solve import contact
 from rvfem.case import registry
+from rvfem.solve import contact
 from rvfem.solve.models import ContactGroup
-
-from conftest import CASES_DIR
 
 STIFFNESS = 7.0e5
 

@@ -5,11 +5,10 @@ from __future__ import annotations
 import math
 
 import pytest
+from conftest import CASES_DIR
 
 from rvfem.case.definition import Case, case_from_dict, case_to_dict, load_case
 from rvfem.errors import CaseError, RvfemError
-
-from conftest import CASES_DIR
 
 
 def expect_error(tmp_path, text, key, *fragments):
@@ -355,13 +354,13 @@ import copy  # noqa: E402
 import dataclasses  # noqa: E402
 import re  # noqa: E402
 
+from conftest import ROOT  # noqa: E402
+
 from rvfem.case import definition as case_module  # noqa: E402
 from rvfem.case import registry  # noqa: E402
 from rvfem.case.definition import CrankSupport, estimated_mesh_nodes, table_class  # noqa: E402
 from rvfem.case.format_doc import render_case_format  # noqa: E402
 from rvfem.case.schema import file_fields  # noqa: E402
-
-from conftest import ROOT  # noqa: E402
 
 
 def test_misspelled_required_key_is_unknown_not_missing(case_text, tmp_path):

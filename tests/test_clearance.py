@@ -7,13 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR, coarse_case
 
 from rvfem.evaluate import attribution
-from rvfem.solve import contact
-from rvfem.solve import cycle
 from rvfem.mesh import mesh_case
-
-from conftest import CASES_DIR, coarse_case
+from rvfem.solve import contact, cycle
 
 SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))
 CLEARANCES_UM = (0, 2, 5, 10, 20, 50)

@@ -8,12 +8,11 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import CASES_DIR, documented_keys, written_keys
 
 import rvfem
 from rvfem import __version__
 from rvfem.app import cli
-
-from conftest import CASES_DIR, documented_keys, written_keys
 
 CRV80E = str(CASES_DIR / "crv80e.toml")
 
@@ -298,8 +297,8 @@ def test_run_stages_are_numbered_in_the_order_they_start(images, duty):
     import io
     import re
 
-    from rvfem.case.definition import load_case
     from rvfem.app.run import STAGES, run_stages
+    from rvfem.case.definition import load_case
 
     case = load_case(CASES_DIR / ("crv80e_duty.toml" if duty else "rv40e_fanholes.toml"))
     stages = run_stages(case, images=images)

@@ -15,9 +15,9 @@ import pytest
 import scipy.sparse as sp
 
 from rvfem import fem
-from rvfem.solve import contact
-from rvfem.errors import ContactError
 from rvfem.app.verification import squeezed_cylinder_mesh
+from rvfem.errors import ContactError
+from rvfem.solve import contact
 
 R, L, E, NU = 10.0, 1.0, 2.0e5, 0.3
 H_CONTACT = 0.03  # element size in the contact zones, mm
@@ -168,11 +168,11 @@ def test_reverse_torque_is_the_mirror_image_of_forward_torque(tmp_path, pin_mode
     the contact solve uses the sign of the torque (cold start, likely columns, carrier equation)."""
     import dataclasses
 
-    from rvfem.solve import cycle
+    from conftest import CASES_DIR
+
     from rvfem.case.definition import case_from_dict, case_to_dict, load_case
     from rvfem.mesh import mesh_case
-
-    from conftest import CASES_DIR
+    from rvfem.solve import cycle
 
     data = case_to_dict(load_case(CASES_DIR / "rv40e_fanholes.toml"))
     data["mesh"].update(size_flank=0.6, size_bore=0.6, size_interior=4.0)

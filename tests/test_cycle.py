@@ -10,16 +10,13 @@ import math
 
 import numpy as np
 import pytest
+from conftest import coarse_case as coarse
 
-from rvfem.evaluate import compare
-from rvfem.solve import contact
-from rvfem.solve import cycle
-from rvfem.evaluate import rigid
 from rvfem.case.definition import case_from_dict, case_to_dict
 from rvfem.errors import ContactError
+from rvfem.evaluate import compare, rigid
 from rvfem.mesh import mesh_case
-
-from conftest import coarse_case as coarse
+from rvfem.solve import contact, cycle
 
 STEP = np.radians(10.0)
 THETA = np.arange(36) * STEP   # 10° steps: the 120° shifts of three cranks are whole samples
@@ -245,7 +242,12 @@ def test_contacts_of_many_angles_are_those_built_one_by_one(fanholes):
     the contacts of each angle built on its own from coordinates, entry for entry."""
     import scipy.sparse as sp
 
-    from rvfem.geometry import crank_centres, pin_centres, pin_profile_contacts, profile_curvature
+    from rvfem.geometry import (
+        crank_centres,
+        pin_centres,
+        pin_profile_contacts,
+        profile_curvature,
+    )
 
     case, mesh = fanholes
     system = cycle.build_system(case, mesh)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from conftest import CASES_DIR
 
 from rvfem.case.definition import DutyRow, load_case
 from rvfem.evaluate.hertz import (
@@ -29,8 +30,6 @@ from rvfem.evaluate.iso281 import (
     rating_life_hours,
 )
 from rvfem.evaluate.rigid import handbook_bearing_loads, summarize_bearing_loads
-
-from conftest import CASES_DIR
 
 STEEL_E, STEEL_NU = 206000.0, 0.3
 

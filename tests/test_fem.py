@@ -22,19 +22,23 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from skfem import FacetBasis, LinearForm, asm
+from skfem import ElementTriP1, ElementTriP2, ElementVector, FacetBasis, LinearForm, asm
+from skfem.assembly import Dofs
 
 from rvfem import fem
+
+# the structured meshes, the Lamé closed form and the Dirichlet-Lamé error norms are the ones the
+# verification manual reports (one implementation for both)
+from rvfem.app.verification import (
+    kirsch_stress,
+    lame_dirichlet_errors,
+    quads_to_triangles,
+)
+from rvfem.app.verification import lame_solution as lame
+from rvfem.app.verification import structured_annulus as annulus
 from rvfem.errors import MeshError
 from rvfem.fem import loads as fe_loads
 from rvfem.fem import model as fe_model
-from skfem import ElementTriP1, ElementTriP2, ElementVector
-from skfem.assembly import Dofs
-# the structured meshes, the Lamé closed form and the Dirichlet-Lamé error norms are the ones the
-# verification manual reports (one implementation for both)
-from rvfem.app.verification import lame_dirichlet_errors, quads_to_triangles
-from rvfem.app.verification import kirsch_stress, lame_solution as lame
-from rvfem.app.verification import structured_annulus as annulus
 
 E, NU, THICK = 2.1e5, 0.3, 10.0
 

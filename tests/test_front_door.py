@@ -7,9 +7,9 @@ import subprocess
 import sys
 
 import pytest
+from conftest import ROOT
 
 import rvfem
-from conftest import ROOT
 
 #: The front door and the module each name lives in.
 HOMES = {

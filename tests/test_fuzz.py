@@ -13,10 +13,9 @@ import math
 import sys
 
 import pytest
+from conftest import ROOT
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
-from conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
 

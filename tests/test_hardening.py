@@ -6,10 +6,9 @@ from __future__ import annotations
 import re
 
 import pytest
+from conftest import CASES_DIR
 
 from rvfem.app import cli
-
-from conftest import CASES_DIR
 
 COARSE = ["mesh.size_flank=0.6", "mesh.size_bore=0.6", "mesh.size_interior=4.0", "analysis.angle_step_deg=30",
           'loads.torque_split="equal"']
@@ -93,8 +92,8 @@ def test_duty_cycle_life_of_a_zero_life_is_zero_not_a_division_by_zero(monkeypat
     from types import SimpleNamespace
 
     from rvfem.app import analysis
-    from rvfem.evaluate import iso281
     from rvfem.case.definition import load_case
+    from rvfem.evaluate import iso281
 
     case = load_case(CASES_DIR / "crv80e_duty.toml")
     monkeypatch.setattr(iso281, "crank_bearing_rating", lambda bearing: 1e-300)
@@ -111,9 +110,9 @@ def test_duty_cycle_life_of_a_zero_life_is_zero_not_a_division_by_zero(monkeypat
 def test_the_coarsest_boundary_sizes_allowed_still_build_the_contact_model(tmp_path):
     """At the largest `size_bore` and `size_flank` the case accepts, the load footprints are built
     (`size_bore = 45` used to fail there with an internal error)."""
-    from rvfem.solve import cycle
     from rvfem.case.definition import load_case, max_element_sizes
     from rvfem.mesh import mesh_case
+    from rvfem.solve import cycle
 
     case = load_case(CASES_DIR / "rv40e_solid.toml", ["mesh.size_interior=6.0"])
     limits = max_element_sizes(case)

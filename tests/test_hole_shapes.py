@@ -10,16 +10,29 @@ import math
 
 import numpy as np
 import pytest
-
-from rvfem.solve import cycle
-from rvfem.case.definition import case_from_dict, case_to_dict, hole_table_names, load_case
-from rvfem.errors import CaseError, GeometryError
-from rvfem.geometry import (WALL_SPACING, Arc, HoleShape, LineSegment, default_angle_offset, disc_geometry,
-                            hole_shape, register_hole_shape, unregister_hole_shape)
-from rvfem.mesh import mesh_case, mesh_key, mesh_path
-from rvfem.case.schema import param
-
 from conftest import CASES_DIR, CaseText
+
+from rvfem.case.definition import (
+    case_from_dict,
+    case_to_dict,
+    hole_table_names,
+    load_case,
+)
+from rvfem.case.schema import param
+from rvfem.errors import CaseError, GeometryError
+from rvfem.geometry import (
+    WALL_SPACING,
+    Arc,
+    HoleShape,
+    LineSegment,
+    default_angle_offset,
+    disc_geometry,
+    hole_shape,
+    register_hole_shape,
+    unregister_hole_shape,
+)
+from rvfem.mesh import mesh_case, mesh_key, mesh_path
+from rvfem.solve import cycle
 
 # ------------------------------------------------------------------------------------------------
 # The slot holes: a table, a feature and a hole shape, nothing more

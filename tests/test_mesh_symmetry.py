@@ -12,6 +12,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import coarse_case
 
 from rvfem.errors import MeshError
 from rvfem.geometry import disc_geometry
@@ -22,8 +23,6 @@ from rvfem.mesh import (
     rotation_permutation,
     symmetry_order,
 )
-
-from conftest import coarse_case
 
 DISCS = ("rv40e_fanholes", "rv40e_solid")
 

@@ -16,7 +16,6 @@ import math
 from pathlib import Path
 
 import pytest
-
 from conftest import ROOT, assert_figures_shown
 
 nbformat = pytest.importorskip("nbformat")

@@ -6,12 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import coarse_case
 
 from rvfem import fem
-from rvfem.solve import cycle
 from rvfem.mesh import mesh_case
-
-from conftest import coarse_case
+from rvfem.solve import cycle
 
 THETA = np.radians(np.arange(0.0, 360.0, 30.0))
 

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from rvfem.outputs.summary import _life, _sig, warning_lines
+from rvfem.app.screen import _life, _sig, warning_lines
 from rvfem.outputs.report import toml_text
 
 

@@ -20,14 +20,18 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import coarse_case, structured_annulus
 
 from rvfem import fem
 from rvfem.evaluate import postprocess
-from rvfem.evaluate.postprocess import field_snapshots, max_load_index, nearest_index, peak_von_mises
+from rvfem.evaluate.postprocess import (
+    field_snapshots,
+    max_load_index,
+    nearest_index,
+    peak_von_mises,
+)
 from rvfem.mesh import mesh_case
 from rvfem.solve import cycle as cycle_module
-
-from conftest import coarse_case, structured_annulus
 
 E, NU, THICK = 2.1e5, 0.3, 10.0
 R_IN, R_OUT, N_R, N_T = 8.0, 30.0, 6, 72

@@ -8,14 +8,14 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR
+from conftest import coarse_case as coarse
 
-from rvfem.fem import crankshaft
-from rvfem.solve import cycle
-from rvfem.evaluate import rigid
 from rvfem.case.definition import case_from_dict, case_to_dict, load_case
+from rvfem.evaluate import rigid
+from rvfem.fem import crankshaft
 from rvfem.mesh import mesh_case
-
-from conftest import CASES_DIR, coarse_case as coarse
+from rvfem.solve import cycle
 
 STEP = np.radians(10.0)
 THETA = np.arange(36) * STEP   # 10° steps: 180° and the 120° crank spacing are whole samples

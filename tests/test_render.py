@@ -15,10 +15,10 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import structured_annulus
-from rvfem.outputs import render
+
 from rvfem.errors import RenderError
+from rvfem.outputs import render
 
 pytestmark = pytest.mark.slow
 

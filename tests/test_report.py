@@ -16,13 +16,12 @@ from pathlib import Path
 
 import jinja2
 import pytest
+from conftest import CASES_DIR, ROOT
 
-from rvfem.app import cli
+from rvfem.app import cli, screen
 from rvfem.case.definition import case_from_dict, case_to_dict, load_case
 from rvfem.outputs import registry, report
 from rvfem.outputs import summary as outputs
-
-from conftest import CASES_DIR, ROOT
 
 COARSE = ["--set", "mesh.size_flank=0.6", "--set", "mesh.size_bore=0.6", "--set", "mesh.size_interior=4.0",
           "--step", "30", "--no-images"]
@@ -284,7 +283,7 @@ def test_every_value_is_escaped(run_folder, summary, case):
 
 @pytest.mark.slow
 def test_the_screen_text_has_every_part(summary):
-    text = outputs.summary_text(summary)
+    text = screen.summary_text(summary)
     lines = text.splitlines()
     assert lines[0].startswith(f"Case {summary['case']['name']} (") and "overrides: mesh.size_flank = 0.6" in lines[0]
     assert sum(line.split()[:1] == ["flexible"] for line in lines) == 3
@@ -297,7 +296,7 @@ def test_the_screen_text_has_every_part(summary):
     s["duty_cycle"] = {"rigid": None, "flexible": {"service_life_h": 2000.0, "equivalent_torque_Nm": 400.0,
                                                    "equivalent_speed_rpm": 12.5}}
     s["warnings"] = [{"code": "load_ratio", "message": "P/C above 0.5"}]
-    lines = outputs.summary_text(s).splitlines()
+    lines = screen.summary_text(s).splitlines()
     assert ("  duty cycle: service life rigid not defined, flexible 2000 h (equivalent torque 400.0 N·m, speed "
             "12.50 rpm; loads scaled linearly with the torque)") in lines
     assert lines[-2:] == ["", "  warning: P/C above 0.5"]

@@ -8,13 +8,13 @@ import json
 import shutil
 
 import pytest
-
 from conftest import ROOT
+
 from rvfem.app import cli
 from rvfem.app.cli_study import COMPARE, STUDY
-from rvfem.errors import OutputError
 from rvfem.app.result_compare import compare_results, read_result
 from rvfem.app.run import run_case
+from rvfem.errors import OutputError
 
 COARSE = ["mesh.size_flank=1.2", "mesh.size_bore=1.5", "mesh.size_interior=6.0", "mesh.size_hole=2.0",
           "analysis.angle_step_deg=30"]

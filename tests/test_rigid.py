@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR
 
 from rvfem.case.definition import load_case
 from rvfem.errors import CaseError
@@ -19,8 +20,6 @@ from rvfem.evaluate.rigid import (
     load_cycle_angles,
     summarize_bearing_loads,
 )
-
-from conftest import CASES_DIR
 
 
 @pytest.fixture(scope="module")
@@ -464,11 +463,11 @@ def test_two_teeth_rigid_limit_keeps_the_equal_share_but_not_the_classical_distr
     FE departs from the touching-pin distribution by most of the peak pin force (a pin entering over
     a trimmed tip corner through a micrometre gap takes load the rigid distribution does not give
     it), while the FE bearing forces stay the equal share of the FE pin resultant."""
-    from rvfem.evaluate.compare import equal_share_forces
-    from rvfem.solve.cycle import build_system, load_cycle, single_disc_stage
-    from rvfem.mesh import mesh_case
-
     from conftest import coarse_case
+
+    from rvfem.evaluate.compare import equal_share_forces
+    from rvfem.mesh import mesh_case
+    from rvfem.solve.cycle import build_system, load_cycle, single_disc_stage
 
     case = coarse_case("rv40e_solid", cycloid={"teeth": 38})
     theta = load_cycle_angles(10.0)

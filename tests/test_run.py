@@ -19,20 +19,19 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
-
-from rvfem.app import cli
-from rvfem.outputs import summary as outputs
-from rvfem.outputs import render
-from rvfem.app.analysis import analyse
-from rvfem.case.definition import file_sha256, load_case
-from rvfem.evaluate.compare import rigid_vs_flexible
-from rvfem.solve.cycle import build_system, load_cycle
-from rvfem.errors import OutputError, RenderError
-from rvfem.mesh import mesh_case
-from rvfem.app.run import IMAGE_SIZE, run_case
-from rvfem.outputs.vtkio import CELL_FIELDS, POINT_FIELDS
-
 from conftest import CaseText, documented_keys, written_keys
+
+from rvfem.app import cli, screen
+from rvfem.app.analysis import analyse
+from rvfem.app.run import IMAGE_SIZE, run_case
+from rvfem.case.definition import file_sha256, load_case
+from rvfem.errors import OutputError, RenderError
+from rvfem.evaluate.compare import rigid_vs_flexible
+from rvfem.mesh import mesh_case
+from rvfem.outputs import render
+from rvfem.outputs import summary as outputs
+from rvfem.outputs.vtkio import CELL_FIELDS, POINT_FIELDS
+from rvfem.solve.cycle import build_system, load_cycle
 
 STEP_DEG = 20.0
 
@@ -647,7 +646,7 @@ def test_structural_peak_leads_and_is_recovered_on_p2(summary, cli_run):
     assert 0 < sp["estimated_error_MPa"] < 0.2 * sp["von_mises_MPa"]
     assert sp["at"]["theta_deg"] in sp["angles_deg"] and sp["seconds"] > 0
     assert cz["mesh_dependent"] is True and cz["peak_von_mises_MPa"] >= away["peak_von_mises_MPa"]
-    screen_lines = outputs.stress_lines(st)
+    screen_lines = screen.stress_lines(st)
     assert screen_lines[0].lstrip().startswith("structural stress peak (away from contacts)")
     assert "contact-zone" in screen_lines[-1] and "mesh-dependent" in screen_lines[-1]
     html = (cli_run / "report.html").read_text(encoding="utf-8")
@@ -831,7 +830,7 @@ def test_report_links_further_field_images_instead_of_embedding_them(cli_run, su
 def test_screen_gives_the_stribeck_pressure_without_roller_loads_and_stiffness_per_disc(summary):
     rigid_bore = json.loads(json.dumps(summary))
     rigid_bore["hertz"]["fe_rollers"] = None           # what the 'rigid_bore' bearing model gives
-    text = outputs.summary_text(rigid_bore)
+    text = screen.summary_text(rigid_bore)
     sf = summary["hertz"]["stribeck_flexible"]
     assert f"FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N" in text
     assert "N·m/arcmin per disc" in text

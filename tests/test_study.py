@@ -15,14 +15,14 @@ import time
 from pathlib import Path
 
 import pytest
-
 from conftest import ROOT, assert_figures_shown
+
 from rvfem.app import cli
-from rvfem.case.definition import load_case
 from rvfem.app.cli_study import COMPARE, STUDY
-from rvfem.errors import CaseError, OutputError
 from rvfem.app.run import run_case
 from rvfem.app.study import LOCK_NAME, load_study, read_study_csv, run_study
+from rvfem.case.definition import load_case
+from rvfem.errors import CaseError, OutputError
 
 BIN = Path(sys.executable).parent
 BASE_CASE = ROOT / "cases" / "rv40e_fanholes.toml"

@@ -9,12 +9,10 @@ import math
 
 import numpy as np
 import pytest
-
-from rvfem.solve import contact
-from rvfem.solve import cycle
-from rvfem.mesh import mesh_case
-
 from conftest import coarse_case as coarse
+
+from rvfem.mesh import mesh_case
+from rvfem.solve import contact, cycle
 
 STEP = np.radians(10.0)
 THETA = np.arange(36) * STEP   # 10° steps: 120° and 180° are whole samples

@@ -7,11 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import ROOT, assert_figures_shown
 
 from rvfem.app import verification
 from rvfem.app.verification import Check, Section, render
-
-from conftest import ROOT, assert_figures_shown
 
 MANUAL = ROOT / "docs" / "verification.md"
 NOTEBOOK = ROOT / "notebooks" / "what_drives_the_flexibility_effect.ipynb"

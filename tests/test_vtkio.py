@@ -13,10 +13,9 @@ from types import SimpleNamespace
 import meshio
 import numpy as np
 import pytest
+from conftest import structured_annulus
 
 from rvfem.outputs import vtkio
-
-from conftest import structured_annulus
 
 
 def _disc(n_r=5, n_t=40, r_in=8.0, r_out=30.0):

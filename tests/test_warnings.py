@@ -10,15 +10,21 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR, CaseText, coarse_case
 
 from rvfem.app import cli
-from rvfem.evaluate import validity
 from rvfem.app.analysis import analyse_rigid
 from rvfem.case.definition import load_case
-from rvfem.evaluate.validity import (DISPLACEMENT_FRACTION_LIMIT, HERTZ_PRESSURE_LIMIT_MPA, LOAD_RATIO_LIMIT, MIN_LIFE_H,
-                            PLACEHOLDER_YIELD_STRENGTH_MPA, ResultWarning, check_limits)
-
-from conftest import CASES_DIR, CaseText, coarse_case
+from rvfem.evaluate import validity
+from rvfem.evaluate.validity import (
+    DISPLACEMENT_FRACTION_LIMIT,
+    HERTZ_PRESSURE_LIMIT_MPA,
+    LOAD_RATIO_LIMIT,
+    MIN_LIFE_H,
+    PLACEHOLDER_YIELD_STRENGTH_MPA,
+    ResultWarning,
+    check_limits,
+)
 
 CRV80E = str(CASES_DIR / "crv80e.toml")
 SHIPPED = sorted(p.stem for p in CASES_DIR.glob("*.toml"))

@@ -35,6 +35,7 @@ from rvfem.app.commands import (
     Subcommand,
 )
 from rvfem.app.run import STAGES, run_case, run_stages, summary_text
+from rvfem.app.screen import rigid_text
 from rvfem.case.definition import Case, load_case
 from rvfem.case.registry import bearing_model_names
 from rvfem.errors import OutputError, RvfemError
@@ -43,7 +44,7 @@ from rvfem.geometry import disc_geometry
 from rvfem.geometry.features import feature_text
 from rvfem.mesh import mesh_case
 from rvfem.outputs.plots import mesh_preview
-from rvfem.outputs.summary import check_output_folder, rigid_summary, rigid_text
+from rvfem.outputs.summary import check_output_folder, rigid_summary
 
 __all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_INTERNAL_ERROR",
            "EXIT_USER_ERROR", "EXIT_INTERRUPTED"]

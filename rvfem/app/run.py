@@ -50,10 +50,11 @@ from rvfem.app.analysis import (
     analyse,
     resolve_case,
 )
+from rvfem.app.screen import summary_text
 from rvfem.case.definition import Case
 from rvfem.outputs import summary as outputs
 from rvfem.outputs.render import RenderWorker
-from rvfem.outputs.summary import IMAGE_SIZE, SCHEMA_VERSION, summary_text
+from rvfem.outputs.summary import IMAGE_SIZE, SCHEMA_VERSION
 
 log = logging.getLogger(__name__)
 
