@@ -93,3 +93,17 @@ def test_no_string_sentinel_stands_for_the_case():
             for d in defaults:
                 assert not (isinstance(d, ast.Constant) and d.value == "case"), (
                     f"{path.relative_to(ROOT)}:{fn.lineno} {fn.name} has the default 'case'")
+
+
+def test_the_atomic_text_writer_replaces_a_file_whole(tmp_path):
+    from rvfem._files import write_text_atomic
+
+    path = tmp_path / "study.csv"
+    path.write_text("old", encoding="utf-8")
+    assert write_text_atomic(path, "new\n") == path
+    assert path.read_text(encoding="utf-8") == "new\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["study.csv"]      # no temporary file left
+    with pytest.raises(TypeError):
+        write_text_atomic(path, b"bytes are not text")
+    assert path.read_text(encoding="utf-8") == "new\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["study.csv"]

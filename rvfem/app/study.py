@@ -79,6 +79,7 @@ from typing import Any, Callable, Sequence
 
 from threadpoolctl import threadpool_limits
 
+from rvfem._files import write_text_atomic
 from rvfem.app.run import run_case
 from rvfem.case.definition import case_to_dict, load_case, parse_override
 from rvfem.case.schema import param, read_table, toml_literal
@@ -683,21 +684,6 @@ def _existing_record(variant: Variant, folder: Path) -> dict | None:
             "summary": summary, "wall_time_s": float(summary.get("timings_s", {}).get("total", float("nan")))}
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    """Replace the file ``path`` by ``text`` in one step (a temporary file, then :func:`os.replace`).
-
-    For ``study.json``, ``study.csv`` and ``report.html``, single files beside the variant folders
-    that the workers write: :func:`rvfem.outputs.summary.result_folder`, the package's atomic writer,
-    replaces whole folders (the variants' and ``plots/``), not one file among others.
-    """
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
 # --------------------------------------------------------------------------------------------
 # Dask
 # --------------------------------------------------------------------------------------------
@@ -928,7 +914,7 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
     variants_dir = out_dir / "variants"
     _remove_partials(variants_dir)
     _remove_partials(out_dir)
-    _write_atomic(out_dir / "study.json", json.dumps(_study_dict(study), indent=2, allow_nan=False) + "\n")
+    write_text_atomic(out_dir / "study.json", json.dumps(_study_dict(study), indent=2, allow_nan=False) + "\n")
     records: dict[str, dict] = {}
     todo: list[Variant] = []
     first_of: dict[str, str] = {}  # case digest -> id of the variant that computes it
@@ -960,17 +946,17 @@ def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers,
                     "computed": False, "summary": None, "wall_time_s": float("nan")})
             _same_case_records(study, records, first_of)
             rows = study_rows(study, records)
-            _write_atomic(out_dir / "study.csv", _csv_text(rows))
+            write_text_atomic(out_dir / "study.csv", _csv_text(rows))
     _same_case_records(study, records, first_of)
     rows = study_rows(study, records)
     files = {"csv": out_dir / "study.csv", "json": out_dir / "study.json"}
-    _write_atomic(files["csv"], _csv_text(rows))
+    write_text_atomic(files["csv"], _csv_text(rows))
     plot_files = _plots(study, rows, out_dir / "plots") if plots else {}
     files.update(plot_files)
     files["report"] = out_dir / "report.html"
     compute = _compute_time(records)
     wall = time.perf_counter() - started
-    _write_atomic(files["report"], _report_html(study, rows, plot_files, wall, compute))
+    write_text_atomic(files["report"], _report_html(study, rows, plot_files, wall, compute))
     computed = sum(1 for r in records.values() if r["computed"])
     failed = sum(1 for r in records.values() if r["status"] != "ok")
     return StudyResult(out_dir=out_dir, study=study, rows=tuple(rows), computed=computed,
