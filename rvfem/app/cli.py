@@ -117,9 +117,6 @@ def _add_mesh_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_mesh(args: argparse.Namespace) -> int:
-
-
-
     case = _load(args)
     start = time.perf_counter()
     geom = disc_geometry(case)
@@ -134,8 +131,8 @@ def _run_mesh(args: argparse.Namespace) -> int:
           f"min element quality ({mesh.quality_measure}) {mesh.min_quality:.3f}")
     print(f"  mesh cache: {Path(cache).resolve()}" + (" (default)" if args.cache_dir is None else ""))
     print(f"  boundaries: {', '.join(f'{user_feature_name(n)} ({len(e)} edges)' for n, e in mesh.boundaries.items())}")
-    print(f"  thinnest wall {thinnest.thickness:.2f} mm between {user_feature_name(thinnest.first)} and "
-          f"{user_feature_name(thinnest.second)}")
+    print(f"  thinnest wall {thinnest.thickness:.2f} mm between {feature_text(thinnest.first)} and "
+          f"{feature_text(thinnest.second)}")
     print(f"  preview: {png}")
     return EXIT_OK
 
@@ -242,9 +239,6 @@ class _RunProgress:
 
 
 def _run_run(args: argparse.Namespace) -> int:
-
-
-
     case = _load(args)
     out_dir = Path(args.output) if args.output else Path("results") / case.name
     try:

@@ -470,8 +470,6 @@ class _Discs:
 
 
 def rigid_limit_section(discs: _Discs) -> Section:
-
-
     theta = _thetas()
     stiff = dict(stiffness_scale=1e6, bearing_model="rigid_bore", bearing_stiffness_scale=1e3,
                  pin_model="linear", pin_stiffness_N_per_mm=3e5)
