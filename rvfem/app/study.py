@@ -779,12 +779,14 @@ def _sigint_ignored_by_children():
 
 @contextlib.contextmanager
 def _dask_logging_silenced():
-    """Dask's loggers silenced but for critical messages (restored afterwards): the warnings of
-    a cluster shut down after Ctrl-C ("Worker process still alive after 4.0 seconds, killing")
-    say nothing the interrupted study does not."""
-    loggers = [logging.getLogger("distributed")] + [
+    """Dask's loggers (and those of tornado, its event loop) silenced but for critical messages
+    (restored afterwards): the warnings of a cluster shut down after Ctrl-C ("Worker process still
+    alive after 4.0 seconds, killing") and the errors of callbacks cut short by it (a cancel that
+    raced the interrupt: "NameError: cannot access free variable 'future'" in distributed's
+    ``sync``) say nothing the interrupted study does not."""
+    loggers = [logging.getLogger("distributed"), logging.getLogger("tornado")] + [
         logger for name, logger in logging.root.manager.loggerDict.items()
-        if name.startswith("distributed.") and isinstance(logger, logging.Logger)]
+        if name.startswith(("distributed.", "tornado.")) and isinstance(logger, logging.Logger)]
     levels = [logger.level for logger in loggers]
     for logger in loggers:
         logger.setLevel(logging.CRITICAL)
@@ -1032,10 +1034,11 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
     except BaseException as exc:
         interrupted = isinstance(exc, KeyboardInterrupt)
         if futures:
-            try:
-                client.cancel(futures, force=True)
-            except Exception:
-                log.debug("cancelling the futures failed", exc_info=True)
+            with _dask_logging_silenced() if interrupted else contextlib.nullcontext():
+                try:
+                    client.cancel(futures, force=True)
+                except Exception:
+                    log.debug("cancelling the futures failed", exc_info=True)
         raise
     finally:
         with _dask_logging_silenced() if interrupted else contextlib.nullcontext():
