@@ -219,8 +219,12 @@ class _StudyProgress:
 
 def _run_study(args: argparse.Namespace) -> int:
     study = load_study(args.study, extra_overrides=args.overrides)
-    # Dask configures its loggers at INFO; follow rvfem's verbosity (-v, -vv) instead
+    # Dask configures its loggers at INFO; follow rvfem's verbosity (-v, -vv) instead. The errors
+    # tornado (Dask's event loop) logs are Dask's internals, e.g. a callback cut short by Ctrl-C; a
+    # failing variant is recorded by the study itself: shown with -vv only
     logging.getLogger("distributed").setLevel(max(logging.getLogger().getEffectiveLevel(), logging.DEBUG))
+    if args.verbose < 2:
+        logging.getLogger("tornado").setLevel(logging.CRITICAL)
     if args.check:
         _print_variants(study)
         return EXIT_OK
