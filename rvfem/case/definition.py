@@ -67,6 +67,8 @@ __all__ = [
     "Pins",
     "Cranks",
     "CrankBearing",
+    "RollerProfile",
+    "Lubricant",
     "CrankSupport",
     "FanHoles",
     "RoundHoles",
@@ -251,6 +253,70 @@ below says the bearing is not one ISO 281 rates, and near 0 the life underflows 
 
 
 @dataclass(frozen=True)
+class RollerProfile:
+    """Axial profile (generatrix) of the crank-bearing rollers (table ``[crank_bearing.profile]``).
+
+    The drop z(x) of the roller surface below its straight generatrix along the effective length
+    L_we (x from the roller centre; the corners lie outside L_we). ``kind``:
+
+    * ``"straight"``: z = 0 (the default: the usual roller of RV-reducer crank bearings, as
+      Zhang et al., *Contact load and elastohydrodynamic lubrication analysis of eccentric
+      bearings in RV reducer considering the effects of roller profile modification*, describe
+      it, eq. 8; the conservative choice when a case gives no profile, and the one that keeps
+      ISO 281's edge-stress factor λν meaningful);
+    * ``"arc"``: z = R − √(R² − x²), R = ``crown_radius`` (their eq. 9);
+    * ``"logarithmic"``: Johns–Gohar's drop for the design load Q_d = ``design_load_N``,
+      z = 2Q_d/(π·L·E*)·ln[1/(1 − (1 − b²/l²)(x/l)²)], l = L/2, b the Hertz half-width at Q_d;
+    * ``"combined"``: straight centre, then a circular segment of length a =
+      ``modification_length`` dropping by b = ``modification_drop`` at the end of L_we (their
+      eq. 10, R = (a² + b²)/(2b)).
+    """
+
+    kind: str = param("straight", choices=("straight", "arc", "logarithmic", "combined"),
+                      doc="roller generatrix: straight, arc (crown radius), logarithmic (Johns–Gohar) or combined "
+                          "(straight centre and a modified end segment)")
+    crown_radius: float = param(500.0, unit="mm", low=10.0, high=1.0e6, doc="R of the `arc` profile")
+    design_load_N: float = param(2000.0, unit="N", low=1.0, high=1.0e6,
+                                 doc="roller load Q_d at which the `logarithmic` profile gives a uniform pressure")
+    modification_length: float = param(1.23, unit="mm", low=0.01, high=100.0,
+                                       doc="length a of each modified end segment of the `combined` profile")
+    modification_drop: float = param(0.006, unit="mm", low=0.0, high=0.2,
+                                     doc="drop b of the `combined` profile at the end of the effective length")
+    misalignment_mrad: float = param(0.0, unit="mrad", low=-10.0, high=10.0,
+                                     doc="extra tilt of the eccentric against the bore (mounting, machining), "
+                                         "added to the crankshaft's slope")
+    slices: int = param(30, low=8, high=400, doc="slices along the roller of the slice model")
+
+
+@dataclass(frozen=True)
+class Lubricant:
+    """The lubricant of the crank bearings (table ``[lubricant]``, all keys optional).
+
+    Viscosity from two points (``nu40``, ``nu100``; or ``iso_vg`` alone, ν100 then from the grade
+    at a viscosity index of about 100), the operating temperature, the pressure–viscosity
+    coefficient and density for the film thickness, the contamination factor e_C of ISO 281
+    (given, or from a cleanliness level, ISO 281 Table 14 for D_pw < 100 mm) and the roughness.
+    """
+
+    iso_vg: int | None = param(68, choices=(22, 32, 46, 68, 100, 150, 220, 320, 460),
+                               doc="ISO viscosity grade (ν40 = the grade; ν100 at viscosity index ≈ 100) unless "
+                                   "`nu40` and `nu100` are given")
+    nu40: float | None = param(None, unit="mm²/s", low=2.0, high=5000.0, doc="kinematic viscosity at 40 °C")
+    nu100: float | None = param(None, unit="mm²/s", low=1.0, high=500.0, doc="kinematic viscosity at 100 °C")
+    temperature_C: float = param(60.0, unit="°C", low=-30.0, high=150.0, doc="operating temperature of the bearing")
+    pressure_viscosity_per_GPa: float = param(20.0, unit="1/GPa", low=1.0, high=60.0,
+                                              doc="pressure–viscosity coefficient α (mineral oils 15–25)")
+    density: float = param(870.0, unit="kg/m³", low=500.0, high=2000.0, doc="density at the operating temperature")
+    contamination_factor: float | None = param(None, low=0.0, high=1.0,
+                                               doc="ISO 281 e_C; overrides `cleanliness`")
+    cleanliness: str = param("normal", choices=("extreme", "high", "normal", "slight", "typical", "severe",
+                                                "very_severe"),
+                             doc="ISO 281 cleanliness level giving e_C (Table 14, D_pw < 100 mm, mid-range)")
+    roughness_Ra_um: float = param(0.1, unit="µm", low=0.005, high=5.0,
+                                   doc="Ra of roller and raceways (composite σ = 1.25·√2·Ra for Λ)")
+
+
+@dataclass(frozen=True)
 class CrankBearing:
     """The crank (turning-arm) bearing: rollers between the eccentric and the disc bore.
 
@@ -288,6 +354,10 @@ class CrankBearing:
         Roller stiffness for the linear law, N/mm.
     rigid_bore_stiffness_N_per_mm : float
         Isotropic bearing stiffness of the ``rigid_bore`` model, N/mm.
+    profile : RollerProfile
+        Axial roller profile (``[crank_bearing.profile]``) for the pressure along the roller.
+    static_load_rating_N, fatigue_load_limit_N : float or None
+        C0 and C_u overrides, N (None: from the geometry, ISO 76 and ISO 281 Annex B).
     """
 
     rollers: int = param(low=2, high=200, doc="number of rollers Z")
@@ -314,6 +384,11 @@ class CrankBearing:
                                                     doc="roller stiffness; required when `stiffness_law = \"linear\"`")
     rigid_bore_stiffness_N_per_mm: float = param(7.0e5, unit="N/mm", low=1.0e2, high=1.0e10,
                                                  doc="bearing stiffness of the `rigid_bore` model")
+    profile: RollerProfile = param(RollerProfile())
+    static_load_rating_N: float | None = param(None, unit="N", low=1.0, high=1.0e8,
+                                               doc="C0; default ISO 76 from the geometry")
+    fatigue_load_limit_N: float | None = param(None, unit="N", low=1.0, high=1.0e7,
+                                               doc="C_u; default ISO 281 Annex B from C0")
 
     @property
     def inner_raceway_radius(self) -> float:
@@ -704,6 +779,7 @@ class Case:
     fan_holes: FanHoles | None = param(None)
     round_holes: RoundHoles | None = param(None)
     crank_support: CrankSupport | None = param(None)
+    lubricant: Lubricant = param(Lubricant())
     description: str = param("", max_length=10000, doc="free text")
     source: str = param("<code>", compare=False, in_file=False)
     overrides: tuple[str, ...] = param((), compare=False, in_file=False)
