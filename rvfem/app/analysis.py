@@ -56,6 +56,7 @@ from rvfem.evaluate import (
     iso281,
     postprocess,
     rigid,
+    roller_life,
     validity,
 )
 from rvfem.evaluate.compare import equal_share_forces
@@ -714,6 +715,9 @@ class Analysis:
         Results outside their model's range (:func:`rvfem.evaluate.validity.analysis_warnings`: P/C,
         lives under 1 h, Hertz pressures, disc stress against the yield strength, deformation
         against the element size); empty when all hold.
+    roller_depth : rvfem.evaluate.roller_life.CrankBearingDepth or None
+        The crank bearing in depth (slice pressures, film, κ, a_ISO, L_nm, L10r; rigid and flexible);
+        None for a bearing model without discrete rollers.
     """
 
     case: Case
@@ -734,6 +738,7 @@ class Analysis:
     attribution: Any = None
     references: rigid.References | None = None
     warnings: tuple = ()
+    roller_depth: Any = None
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -1197,7 +1202,13 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
                       comparison=comparison, stress=stress, hertz=roller_hertz,
                       torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
                       attribution=attribution, references=references)
-    return dataclasses.replace(result, warnings=validity.analysis_warnings(result))
+    # the crank bearing in depth: slices of every roller, film, a_ISO, L_nm and L10r (rigid and flexible)
+    depth = roller_life.crank_bearing_depth(case, np.asarray(thetas), cycle, result.rigid_forces, comparison,
+                                            rigid_analysis.rating_N, rigid_analysis.bearing_speed_rpm)
+    if depth is not None:
+        result.timings["roller_depth"] = depth.seconds
+    return dataclasses.replace(result, roller_depth=depth, warnings=validity.analysis_warnings(result)
+                               + validity.roller_depth_warnings(depth))
 
 
 def attribution_of(system, thetas, cycle):

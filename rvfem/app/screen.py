@@ -162,11 +162,35 @@ def summary_text(summary: dict) -> str:
         f"{summary['equilibrium_residual']:.1e}",
     ]
     lines.append(_hertz_line(summary["hertz"]))
+    lines += roller_depth_lines(summary.get("crank_bearing_depth"))
     lines += _duty_lines(summary.get("duty_cycle"))
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
                  f"{len(summary['files'])} files")
     lines += warning_lines(summary.get("warnings", []))
     return "\n".join(lines)
+
+
+def roller_depth_lines(depth: dict | None) -> list[str]:
+    """The crank bearing in depth: per bearing the pressure along the roller, film, κ and the three
+    lives (basic L10h, modified L_nm, lamina L10r) rigid and flexible with the flexible/rigid ratio."""
+    if not depth:
+        return []
+    lines = [f"  crank bearing in depth ({depth['profile']} rollers, {depth['slices']} slices; crankshaft slope up to "
+             f"{_sig(depth['max_slope_mrad'], '.3f')} mrad):"]
+    for b in depth["bearings"]:
+        for model in ("rigid", "flexible"):
+            d = b[model]
+            if d is None:
+                continue
+            lines.append(f"    bearing {b['bearing']} {model:<8} p_max {_sig(d['roller_peak_pressure_MPa'], '.0f')} MPa "
+                         f"(edge factor {_num(d['roller_edge_factor'], '.2f')}, {d['peak_raceway']}), h_min "
+                         f"{_num(d['film_thickness_min_um'], '.3f')} µm, κ {_num(d['kappa'], '.2f')}, a_ISO "
+                         f"{_num(d['a_iso'], '.2f')}; L10h {_life(d['L10h_h'])} h, L_nm {_life(d['L_nm_h'])} h, "
+                         f"L10r {_life(d['L10r_h'])} h")
+        if b["rigid"] is not None:
+            lines.append(f"    bearing {b['bearing']} flexible/rigid: L10h {_num(b['L10h_ratio'], '.2f')}, L_nm "
+                         f"{_num(b['L_nm_ratio'], '.2f')}, L10r {_num(b['L10r_ratio'], '.2f')}")
+    return lines
 
 
 def warning_lines(warnings: list[dict], prefix: str = "  warning: ") -> list[str]:

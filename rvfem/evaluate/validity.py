@@ -44,6 +44,8 @@ __all__ = [
     "check_limits",
     "analysis_warnings",
     "rigid_warnings",
+    "KAPPA_RANGE",
+    "roller_depth_warnings",
 ]
 
 LOAD_RATIO_LIMIT = 0.5
@@ -339,3 +341,40 @@ def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:
     mat = rigid_analysis.case.material
     return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
                         hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio))
+
+
+KAPPA_RANGE = (0.1, 4.0)
+"""Range of the viscosity ratio κ = ν/ν1 of ISO 281's a_ISO (9.3.2): below 0.1 the formulas are not
+defined (the standard leaves such lubrication outside its scope); above 4 a_ISO is evaluated at κ = 4."""
+
+
+def roller_depth_warnings(depth) -> tuple[ResultWarning, ...]:
+    """The warnings of the crank bearing in depth (:class:`rvfem.evaluate.roller_life.CrankBearingDepth`,
+    None: none): the largest slice pressure along a roller above :data:`HERTZ_PRESSURE_LIMIT_MPA`
+    (code ``roller_pressure``), κ outside :data:`KAPPA_RANGE` (code ``kappa_range``) and P/C of the
+    modified lives above :data:`LOAD_RATIO_LIMIT` (already the ``load_ratio`` warning of the basic
+    lives; not repeated)."""
+    if depth is None:
+        return ()
+    out = []
+    items = list(depth.rigid) + list(depth.flexible)
+    if items:
+        worst = max(items, key=lambda d: d.roller_peak_pressure_MPa)
+        if worst.roller_peak_pressure_MPa > HERTZ_PRESSURE_LIMIT_MPA:
+            out.append(ResultWarning(
+                "roller_pressure",
+                f"pressure along the roller {worst.roller_peak_pressure_MPa:.0f} MPa (bearing {worst.bearing + 1}, "
+                f"{worst.model}, {worst.raceway}) > {HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa, the static limit of roller "
+                "bearings (ISO 76): the raceway deforms plastically, the slice model and L10r do not hold",
+                worst.roller_peak_pressure_MPa, HERTZ_PRESSURE_LIMIT_MPA, "MPa"))
+        kappa = items[0].kappa
+        low, high = KAPPA_RANGE
+        if kappa < low:
+            out.append(ResultWarning(
+                "kappa_range", f"viscosity ratio κ = {_sig(kappa)} < {low:g}: outside ISO 281's a_ISO; L_nm is "
+                f"evaluated at κ = {low:g} and is not meaningful", kappa, low, ""))
+        elif kappa > high:
+            out.append(ResultWarning(
+                "kappa_range", f"viscosity ratio κ = {_sig(kappa)} > {high:g}: ISO 281 evaluates a_ISO at κ = {high:g} "
+                "(more viscosity gives no more life)", kappa, high, ""))
+    return tuple(out)

@@ -57,6 +57,7 @@ from rvfem.outputs.plots import mesh_plot
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
 from rvfem.outputs.vtkio import vtu_name
+from rvfem.outputs import roller_outputs  # noqa: F401  (registers roller_pressure.csv and its plot)
 
 log = logging.getLogger(__name__)
 
@@ -616,6 +617,48 @@ def _piece_files(a, ctx: SummaryContext) -> dict:
     }
 
 
+def _depth_dict(d) -> dict:
+    return {
+        "roller_peak_pressure_MPa": d.roller_peak_pressure_MPa,
+        "roller_edge_factor": d.roller_edge_factor,
+        "peak_raceway": d.raceway,
+        "peak_theta_deg": _angle(d.theta_deg),
+        "peak_roller": d.roller + 1,
+        "peak_roller_load_N": d.roller_load_N,
+        "peak_tilt_mrad": d.tilt_mrad,
+        "max_shear_MPa": d.max_shear_MPa,
+        "max_shear_depth_mm": d.max_shear_depth_mm,
+        "film_thickness_min_um": d.film_thickness_min_um,
+        "film_thickness_central_um": d.film_thickness_central_um,
+        "film_parameter": d.film_parameter,
+        "kappa": d.kappa,
+        "a_iso": d.a_iso,
+        "L10h_h": d.L10h,
+        "L_nm_h": d.L_nm_h,
+        "L10r_h": d.L10r_h,
+    }
+
+
+def _piece_roller_depth(a, ctx: SummaryContext) -> dict:
+    depth = getattr(a, "roller_depth", None)
+    if depth is None:
+        return {"crank_bearing_depth": None}
+    rigid = {d.bearing: d for d in depth.rigid}
+    bearings = []
+    for f in depth.flexible:
+        r = rigid.get(f.bearing)
+        ratio = (lambda key: None if r is None or not getattr(r, key) else getattr(f, key) / getattr(r, key))
+        bearings.append({"bearing": f.bearing + 1, "rigid": None if r is None else _depth_dict(r),
+                         "flexible": _depth_dict(f), "L10h_ratio": ratio("L10h"), "L_nm_ratio": ratio("L_nm_h"),
+                         "L10r_ratio": ratio("L10r_h")})
+    return {"crank_bearing_depth": {
+        "profile": a.case.crank_bearing.profile.kind,
+        "slices": a.case.crank_bearing.profile.slices,
+        "max_slope_mrad": depth.max_slope_mrad,
+        "bearings": bearings,
+    }}
+
+
 SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_header,
     _piece_warnings,
@@ -628,6 +671,7 @@ SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_duty_cycle,
     _piece_reducer_stage,
     _piece_attribution,
+    _piece_roller_depth,
     _piece_files,
 )
 """The pieces of ``summary.json`` in order: each ``piece(analysis, context) -> dict`` of top-level

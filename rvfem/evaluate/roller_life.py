@@ -1,0 +1,445 @@
+"""The crank bearing in depth over a load cycle: tilt of the eccentrics from the crankshaft beams,
+the slice model of every roller at every crank angle on both raceways, film thickness, κ, the
+ISO 281 modified life L_nm and the ISO 16281 reference life L10r (lamina method).
+
+Inputs are the roller loads of a load cycle (the FE rollers, or the rigid rings'
+:func:`rvfem.evaluate.roller_slices.rigid_ring_roller_loads` under the handbook forces); the
+formulas are in docs/theory.md ("The crank bearing in depth").
+
+Sources
+-------
+* ISO/TS 16281:2008 (now ISO 16281:2025), *Rolling bearings - Methods for calculating the modified
+  reference rating life for universally loaded bearings* (lamina ratings q_c, equivalent lamina
+  loads q_e, L10r of line contact).
+* ISO 281:2007 (L10, a_ISO, L_nm = a1·a_ISO·L10).
+* Roark's *Formulas for Stress and Strain*, simply supported beam with an intermediate point load
+  (the slope of the crankshaft at its eccentrics).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from rvfem.evaluate import lubrication, roller_slices
+from rvfem.evaluate.hertz import composite_modulus, reduced_radius
+from rvfem.evaluate.iso281 import ROLLER_LIFE_EXPONENT
+
+__all__ = [
+    "beam_slope_influence",
+    "crankshaft_slope_influence",
+    "eccentric_slopes",
+    "roller_tilts",
+    "RacewayGeometry",
+    "raceways",
+    "cycle_slices",
+    "lamina_ratings",
+    "lamina_life_mrev",
+    "BearingDepth",
+    "bearing_depth",
+    "CrankBearingDepth",
+    "crank_bearing_depth",
+]
+
+log = logging.getLogger(__name__)
+
+
+def beam_slope_influence(span: float, positions, bending_stiffness: float,
+                         support_compliance: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
+    """Cross-section rotation at z_i per unit load at z_j of a beam on two elastic supports, rad/N.
+
+    Bending (Roark, simply supported beam, load at b, point x): y'(x) = (L − b)(L² − (L − b)² −
+    3x²)/(6·L·EI) for x ≤ b and −b(L² − b² − 3(L − x)²)/(6·L·EI) for x ≥ b; the supports'
+    deflections c₁R₁, c₂R₂ turn the beam by (c₂·b/L − c₁·(L − b)/L)/L. Shear deflection does not
+    turn the cross-sections (Timoshenko) and is left out.
+
+    Parameters
+    ----------
+    span : float
+        L, mm.
+    positions : sequence of float
+        z, mm from support 1.
+    bending_stiffness : float
+        EI, N·mm² (inf: rigid beam).
+    support_compliance : (float, float)
+        c₁, c₂, mm/N.
+
+    Returns
+    -------
+    ndarray (n, n)
+    """
+    L = float(span)
+    z = np.asarray(positions, dtype=float)
+    x = z[:, None]
+    b = z[None, :]
+    g = np.zeros((len(z), len(z)))
+    if np.isfinite(bending_stiffness):
+        left = (L - b) * (L * L - (L - b) ** 2 - 3.0 * x * x) / (6.0 * L * bending_stiffness)
+        right = -b * (L * L - b * b - 3.0 * (L - x) ** 2) / (6.0 * L * bending_stiffness)
+        g += np.where(x <= b, left, right)
+    c1, c2 = (float(c) for c in support_compliance)
+    g += (c2 * b / L - c1 * (L - b) / L) / L + 0.0 * x
+    return g
+
+
+def crankshaft_slope_influence(case) -> np.ndarray | None:
+    """The slope influence matrix of a case's crankshaft beam (rad/N, one row per disc); None for
+    rigid support or a crankshaft given only by its deflection matrix (no slopes)."""
+    cs = case.crank_support
+    if cs is None or cs.influence_mm_per_N is not None:
+        return None
+    if cs.bending_stiffness_Nmm2 is not None:
+        ei = float(cs.bending_stiffness_Nmm2)
+    else:
+        ei = cs.youngs_modulus * math.pi * cs.journal_diameter**4 / 64.0
+    ks, kc = cs.support_stiffness_pair, cs.carrier_stiffness_pair
+    compliance = tuple((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    return beam_slope_influence(cs.span, cs.eccentric_positions, ei, compliance)
+
+
+def eccentric_slopes(case, cycle) -> np.ndarray:
+    """Slope vector of disc A's eccentrics (rad, components along the disc's x and y) at every crank
+    angle, (n, N, 2): s = −Σ_k g_Ak·F_k (−F the bearing force on the eccentric of disc k). Zero
+    with rigid crank support; the discs do not tilt (plane model), so this is the relative tilt
+    of eccentric and bore. One-way: the roller loads are those of the untilted solve."""
+    n, nb = cycle.bearing_forces.shape[:2]
+    g = crankshaft_slope_influence(case)
+    if g is None:
+        return np.zeros((n, nb, 2))
+    forces = cycle.disc_bearing_forces
+    if forces is None:                                  # one disc with T/discs
+        return -g[0, 0] * np.asarray(cycle.bearing_forces)
+    return -np.einsum("k,nkbc->nbc", g[0], np.asarray(forces))
+
+
+def roller_tilts(slopes: np.ndarray, roller_angles: np.ndarray, bearing_forces: np.ndarray,
+                 misalignment_rad: float = 0.0) -> np.ndarray:
+    """Tilt of every roller's contact line, rad, (..., Z): the slope vector's component along the
+    roller's radial line, plus an extra misalignment in the plane of the bearing force (the worst
+    orientation for the loaded rollers)."""
+    er = np.stack([np.cos(roller_angles), np.sin(roller_angles)], axis=-1)
+    tilt = np.einsum("...c,...zc->...z", slopes, er)
+    if misalignment_rad:
+        direction = np.arctan2(bearing_forces[..., 1], bearing_forces[..., 0])
+        tilt = tilt + misalignment_rad * np.cos(roller_angles - direction[..., None])
+    return tilt
+
+
+@dataclass(frozen=True)
+class RacewayGeometry:
+    """One raceway of the crank bearing: name, R' (mm), E* (MPa)."""
+
+    name: str
+    reduced_radius_mm: float
+    composite_modulus_MPa: float
+
+
+def raceways(case) -> tuple[RacewayGeometry, RacewayGeometry]:
+    """The eccentric (inner, convex) and bore (outer, concave) raceways of a case's crank bearing."""
+    b = case.crank_bearing
+    e_star = composite_modulus(case.material.youngs_modulus, case.material.poissons_ratio)
+    r = 0.5 * b.roller_diameter
+    return (RacewayGeometry("eccentric", reduced_radius(r, b.inner_raceway_radius, concave=False), e_star),
+            RacewayGeometry("bore", reduced_radius(r, b.bore_radius, concave=True), e_star))
+
+
+def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, raceway: RacewayGeometry,
+                 profile, *, bin_ratio: float = 1.1, light_fraction: float = 0.02,
+                 cache: dict | None = None) -> np.ndarray:
+    """Slice loads per length of every roller contact of a cycle on one raceway, N/mm, (..., Z, n).
+
+    The contacts are grouped by the Hertz half-width b of their nominal line load (groups a factor
+    ``bin_ratio`` wide, each solved with the influence matrix of its geometric-mean width) and
+    every group is solved at once (:func:`rvfem.evaluate.roller_slices.solve_slices`). Contacts
+    lighter than ``light_fraction`` of the heaviest share the group of that load (their
+    rectangles are then a little too wide; they carry under 10⁻⁵ of the damage). ``cache`` keeps
+    the influence matrices between calls (key: group, E*, L, slices).
+    """
+    q = np.asarray(roller_loads, dtype=float)
+    shape = q.shape
+    flat_q = q.reshape(-1)
+    flat_t = np.broadcast_to(tilts, shape).reshape(-1)
+    x, dx = roller_slices.slice_centres(length_mm, profile.slices)
+    r_red, e_star = raceway.reduced_radius_mm, raceway.composite_modulus_MPa
+    drop = roller_slices.profile_drop(profile, length_mm, x, composite_modulus_MPa=e_star, reduced_radius_mm=r_red)
+    out = np.zeros((flat_q.size, x.size))
+    q_max = flat_q.max(initial=0.0)
+    loaded = np.flatnonzero(flat_q > 1e-9 * max(q_max, 1.0))
+    if loaded.size == 0:
+        return out.reshape(shape + (x.size,))
+    q_bin = np.maximum(flat_q[loaded], light_fraction * q_max)
+    b = np.sqrt(4.0 * q_bin * r_red / (math.pi * length_mm * e_star))
+    group = np.floor(np.log(b) / math.log(bin_ratio)).astype(int)
+    cache = {} if cache is None else cache
+    for key in np.unique(group):
+        idx = loaded[group == key]
+        b_g = bin_ratio ** (key + 0.5)
+        ckey = (int(key), bin_ratio, e_star, length_mm, x.size)
+        if ckey not in cache:
+            cache[ckey] = roller_slices.rectangle_influence(x, dx, b_g, e_star)
+        p, _ = roller_slices.solve_slices(cache[ckey], 2.0 * b_g * dx,
+                                          flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx])
+        out[idx] = p * 2.0 * b_g
+    return out.reshape(shape + (x.size,))
+
+
+def lamina_ratings(case, slices: int) -> tuple[float, float]:
+    """Basic dynamic load ratings of one lamina on the inner and outer raceway, N (ISO/TS 16281,
+    line contact): q_c = 552·b_m·λν·γ^(2/9)·(1 ∓ γ)^(29/27)/(1 ± γ)^(1/4)·D_we^(29/27)·
+    (L_we/n_s)^(7/9)·Z^(−1/4), upper signs for the inner raceway. b_m and λν as in the case's basic
+    rating C (ISO 281), so that the two lives rest on the same material and edge factors."""
+    b = case.crank_bearing
+    g = b.roller_diameter / b.pitch_diameter
+    common = (552.0 * b.b_m * b.lambda_nu * g ** (2.0 / 9.0) * b.roller_diameter ** (29.0 / 27.0)
+              * (b.roller_length / slices) ** (7.0 / 9.0) * b.rollers ** -0.25)
+    inner = common * (1.0 - g) ** (29.0 / 27.0) / (1.0 + g) ** 0.25
+    outer = common * (1.0 + g) ** (29.0 / 27.0) / (1.0 - g) ** 0.25
+    return inner, outer
+
+
+def lamina_life_mrev(lamina_loads_inner: np.ndarray, lamina_loads_outer: np.ndarray, q_ci: float, q_ce: float,
+                     *, inner_rotates: bool = False) -> np.ndarray:
+    """L10r of each load state (million revolutions) from the lamina loads (ISO/TS 16281, line contact).
+
+    q_e,k = (Σ_j q_jk^w / Z)^(1/w) per lamina k over the Z rollers, w = 4 on the ring that turns
+    relative to the load and 4.5 on the one that stands; L10r = [Σ_k (q_ci/q_ei,k)^(−9/2) +
+    (q_ce/q_ee,k)^(−9/2)]^(−8/9).
+
+    Parameters
+    ----------
+    lamina_loads_inner, lamina_loads_outer : ndarray (..., Z, n_s)
+        Load of every lamina (slice) of every roller, N.
+    q_ci, q_ce : float
+        Lamina ratings (:func:`lamina_ratings`), N.
+    inner_rotates : bool
+        True if the inner raceway turns relative to the load direction.
+
+    Returns
+    -------
+    ndarray (...)
+        L10r, 10⁶ revolutions (inf without load).
+    """
+    wi, we = (4.0, 4.5) if inner_rotates else (4.5, 4.0)
+    z = lamina_loads_inner.shape[-2]
+    qei = (np.sum(lamina_loads_inner**wi, axis=-2) / z) ** (1.0 / wi)
+    qee = (np.sum(lamina_loads_outer**we, axis=-2) / z) ** (1.0 / we)
+    damage = np.sum((qei / q_ci) ** 4.5 + (qee / q_ce) ** 4.5, axis=-1)
+    with np.errstate(divide="ignore"):
+        return np.where(damage > 0, damage ** (-8.0 / 9.0), np.inf)
+
+
+@dataclass(frozen=True)
+class BearingDepth:
+    """The crank bearing in depth for one bearing and one load model (rigid or flexible).
+
+    Attributes
+    ----------
+    bearing : int
+        0-based bearing.
+    model : str
+        ``"rigid"`` or ``"flexible"``.
+    roller_peak_pressure_MPa : float
+        Largest slice pressure over the cycle, both raceways, MPa.
+    roller_edge_factor : float
+        That peak / the Hertz p_h of the same roller's nominal line load Q/L.
+    raceway : str
+        Raceway of the peak (``"eccentric"`` or ``"bore"``).
+    theta_deg : float
+        Crank angle of the peak, degrees.
+    roller : int
+        0-based roller of the peak.
+    roller_load_N : float
+        Its load Q, N.
+    tilt_mrad : float
+        Its tilt, mrad.
+    x_mm, pressure_MPa : ndarray (n_s,)
+        p(x) of that roller on that raceway, MPa.
+    max_shear_MPa, max_shear_depth_mm : float
+        Subsurface principal shear 0.300·p and its depth 0.786·b at the peak, MPa and mm.
+    film_thickness_min_um, film_thickness_central_um : float
+        EHL film (Pan & Hamrock) of the most loaded roller at the eccentric, µm.
+    film_parameter : float
+        Λ = h_min/σ.
+    kappa : float
+        ν/ν1.
+    a_iso : float
+        ISO 281 a_ISO at κ and e_C·C_u/P (P = equivalent bearing load).
+    L10h : float
+        Basic rating life (ISO 281), h.
+    L_nm_h : float
+        a1·a_ISO·L10h (a1 = 1, 10 % failure probability), h.
+    L10r_h : float
+        ISO/TS 16281 reference rating life from the lamina loads (Palmgren–Miner over the cycle), h.
+    """
+
+    bearing: int
+    model: str
+    roller_peak_pressure_MPa: float
+    roller_edge_factor: float
+    raceway: str
+    theta_deg: float
+    roller: int
+    roller_load_N: float
+    tilt_mrad: float
+    x_mm: np.ndarray
+    pressure_MPa: np.ndarray
+    max_shear_MPa: float
+    max_shear_depth_mm: float
+    film_thickness_min_um: float
+    film_thickness_central_um: float
+    film_parameter: float
+    kappa: float
+    a_iso: float
+    L10h: float
+    L_nm_h: float
+    L10r_h: float
+
+
+def _peak(case, theta, loads, tilts, slice_loads, geoms):
+    """(raceway index, angle, roller, p(x) array) of the largest slice pressure of one bearing."""
+    best = None
+    for r, (geom, q) in enumerate(zip(geoms, slice_loads)):
+        ph, _ = roller_slices.hertz_peak_from_line_load(q, geom.reduced_radius_mm, geom.composite_modulus_MPa)
+        k, j, s = np.unravel_index(int(np.argmax(ph)), ph.shape)
+        if best is None or ph[k, j, s] > best[0]:
+            best = (float(ph[k, j, s]), r, int(k), int(j), ph[k, j])
+    return best
+
+
+def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.ndarray, equivalent_load_N: float,
+                  bearing_speed_rpm: float, rating_N: float, bearing: int, model: str,
+                  cache: dict | None = None) -> BearingDepth:
+    """Slice model, lubrication and lives of one bearing over a load cycle.
+
+    Parameters
+    ----------
+    case : Case
+    theta : ndarray (n,)
+        Crank angles, rad (equally spaced over one revolution).
+    roller_loads, tilts : ndarray (n, Z)
+        Roller loads (N) and tilts (rad) of this bearing.
+    equivalent_load_N : float
+        P = F_m of the bearing (ISO 281), N.
+    bearing_speed_rpm, rating_N : float
+        n_b (rpm) and C (N).
+    bearing : int
+    model : str
+    cache : dict, optional
+        Influence matrices kept between calls (:func:`cycle_slices`).
+
+    Returns
+    -------
+    BearingDepth
+    """
+    b = case.crank_bearing
+    prof = b.profile
+    geoms = raceways(case)
+    slice_loads = [cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache) for g in geoms]
+    x, dx = roller_slices.slice_centres(b.roller_length, prof.slices)
+    peak, r, k, j, p_x = _peak(case, theta, roller_loads, tilts, slice_loads, geoms)
+    g = geoms[r]
+    q_roller = float(roller_loads[k, j])
+    nominal, _ = roller_slices.hertz_peak_from_line_load(q_roller / b.roller_length, g.reduced_radius_mm,
+                                                         g.composite_modulus_MPa)
+    _, b_peak = roller_slices.hertz_peak_from_line_load(peak**2 * math.pi * g.reduced_radius_mm
+                                                        / g.composite_modulus_MPa, g.reduced_radius_mm,
+                                                        g.composite_modulus_MPa)
+    # lubrication at the most loaded roller, on the eccentric (the smaller R', the thinner film)
+    lub = case.lubricant
+    _, _, nu = lubrication.lubricant_viscosity(lub)
+    u = lubrication.entrainment_speed(bearing_speed_rpm, b.pitch_diameter, b.roller_diameter)
+    q_max = float(np.max(roller_loads))
+    film = lubrication.pan_hamrock_film(q_max / b.roller_length, geoms[0].reduced_radius_mm,
+                                        geoms[0].composite_modulus_MPa, nu * lub.density * 1e-6, u,
+                                        lub.pressure_viscosity_per_GPa)
+    kappa = nu / lubrication.reference_viscosity(bearing_speed_rpm, b.pitch_diameter)
+    c0 = b.static_load_rating_N or lubrication.static_load_rating(b.rollers, b.roller_diameter, b.roller_length,
+                                                                  b.pitch_diameter)
+    cu = b.fatigue_load_limit_N or lubrication.fatigue_load_limit(c0, b.pitch_diameter)
+    a_iso = lubrication.a_iso_roller(kappa, lubrication.contamination_factor(lub) * cu / equivalent_load_N)
+    to_hours = 1.0e6 / (60.0 * bearing_speed_rpm)
+    l10h = to_hours * (rating_N / equivalent_load_N) ** ROLLER_LIFE_EXPONENT
+    q_ci, q_ce = lamina_ratings(case, prof.slices)
+    # the eccentric turns relative to the load (whose direction swings by tens of degrees in the disc
+    # frame but does not follow the crank); the bore stands relative to it
+    per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
+    damage = float(np.mean(1.0 / per_angle))
+    return BearingDepth(
+        bearing=bearing, model=model, roller_peak_pressure_MPa=peak, roller_edge_factor=peak / float(nominal),
+        raceway=g.name, theta_deg=math.degrees(float(theta[k])), roller=j, roller_load_N=q_roller,
+        tilt_mrad=1e3 * float(np.broadcast_to(tilts, roller_loads.shape)[k, j]), x_mm=x, pressure_MPa=p_x,
+        max_shear_MPa=roller_slices.SHEAR_FACTOR * peak,
+        max_shear_depth_mm=roller_slices.SHEAR_DEPTH_FACTOR * float(b_peak),
+        film_thickness_min_um=film.minimum_um, film_thickness_central_um=film.central_um,
+        film_parameter=film.minimum_um / lubrication.composite_roughness_um(lub.roughness_Ra_um),
+        kappa=kappa, a_iso=a_iso, L10h=l10h, L_nm_h=a_iso * l10h,
+        L10r_h=math.inf if damage == 0 else to_hours / damage)
+
+
+@dataclass(frozen=True)
+class CrankBearingDepth:
+    """The crank bearing in depth for every bearing of a case (:func:`crank_bearing_depth`).
+
+    Attributes
+    ----------
+    flexible : tuple of BearingDepth
+        From the FE roller loads, the crankshaft's tilt and the extra misalignment.
+    rigid : tuple of BearingDepth
+        From the handbook bearing forces on rigid rings without clearance and untilted rollers
+        (empty where the handbook is not defined).
+    max_slope_mrad : float
+        Largest crankshaft slope at an eccentric over the cycle, mrad (0 with rigid support).
+    seconds : float
+        Wall time of the evaluation, s.
+    """
+
+    flexible: tuple[BearingDepth, ...]
+    rigid: tuple[BearingDepth, ...]
+    max_slope_mrad: float
+    seconds: float = 0.0
+
+
+def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison, rating_N: float,
+                        speed_rpm: float) -> CrankBearingDepth | None:
+    """The crank bearing in depth over a load cycle, rigid and flexible (None without FE rollers).
+
+    Parameters
+    ----------
+    case : Case
+    theta : ndarray (n,)
+        Crank angles, rad.
+    cycle : rvfem.solve.cycle.CycleResult
+        With ``roller_loads`` and ``roller_angles`` (bearing model ``rollers``).
+    rigid_forces : ndarray (n, N, 2) or None
+        Handbook bearing forces (None or not an array where the handbook is not defined).
+    comparison : rvfem.evaluate.compare.Comparison
+        Equivalent loads P = F_m per bearing (rigid and flexible).
+    rating_N, speed_rpm : float
+        C and n_b.
+    """
+    if cycle.roller_loads is None or cycle.roller_angles is None:
+        return None
+    t0 = time.perf_counter()
+    slopes = eccentric_slopes(case, cycle)
+    misalignment = 1e-3 * case.crank_bearing.profile.misalignment_mrad
+    tilts = roller_tilts(slopes, cycle.roller_angles, cycle.bearing_forces, misalignment)
+    flexible, rigid, cache = [], [], {}
+    have_rigid = isinstance(rigid_forces, np.ndarray) and np.all(np.isfinite(rigid_forces))
+    rig_loads = roller_slices.rigid_ring_roller_loads(rigid_forces, cycle.roller_angles) if have_rigid else None
+    rig_tilts = roller_tilts(np.zeros_like(slopes), cycle.roller_angles, rigid_forces, misalignment) \
+        if have_rigid else None
+    for bc in comparison.bearings:
+        i = bc.bearing
+        flexible.append(bearing_depth(case, theta, cycle.roller_loads[:, i], tilts[:, i], bc.flexible.equivalent_N,
+                                      speed_rpm, rating_N, i, "flexible", cache))
+        if have_rigid and bc.rigid is not None:
+            rigid.append(bearing_depth(case, theta, rig_loads[:, i], rig_tilts[:, i], bc.rigid.equivalent_N,
+                                       speed_rpm, rating_N, i, "rigid", cache))
+    return CrankBearingDepth(flexible=tuple(flexible), rigid=tuple(rigid),
+                             max_slope_mrad=1e3 * float(np.max(np.hypot(slopes[..., 0], slopes[..., 1]),
+                                                                initial=0.0)),
+                             seconds=time.perf_counter() - t0)

@@ -1,0 +1,407 @@
+"""Pressure along the crank-bearing rollers: roller profile, slice model on an elastic half-space,
+subsurface shear, and the rigid-ring roller loads of the handbook model.
+
+A roller of effective length L carrying the load Q on one raceway is cut into n slices of width
+Δx along its axis. Slice j sits at x_j (from the roller centre) and its two surfaces approach by
+
+    s_j = δ + ψ·x_j − z(x_j),
+
+δ the approach of the roller and raceway at mid-length, ψ their relative tilt (rad) and z the
+profile drop of the roller (:func:`profile_drop`). Each slice carries a uniform pressure p_j over a
+rectangle Δx × 2b of the contact strip (b the Hertz half-width of the nominal line load Q/L); the
+elastic displacement of both bodies at the centre of slice i is w_i = Σ_j C_ij·p_j, with C_ij the
+displacement at the centre of rectangle i under a unit pressure on rectangle j of a half-space
+(Love's solution for a uniformly loaded rectangle, Johnson, *Contact Mechanics*, eq. 3.25; both
+bodies through the composite modulus E*). Unlike independent slice springs this couples the slices,
+so a straight roller shows its edge peaks. Contact: p_j ≥ 0, w_j = s_j where p_j > 0 and w_j ≥ s_j
+where p_j = 0, with Σ p_j·2b·Δx_j = Q (solved with an active set, :func:`solve_slices`). This is the
+half-space slice method of the roller-bearing literature (e.g. de Mul, Kalker and Fredriksson, *The
+contact between arbitrarily curved bodies of finite dimensions*, J. Tribology 1986; Reusner's
+rectangle-coupled slices) with one rectangle across the strip.
+
+The local peak pressure of slice j is the Hertz peak of its load per length q_j = p_j·2b:
+p_h,j = √(q_j·E*/(π·R')), half-width b_j = √(4·q_j·R'/(π·E*)) (Johnson §4.3); the maximum shear
+stress under it is 0.300·p_h,j at depth 0.786·b_j (principal shear, Tresca; the orthogonal shear
+τ_yz peaks at 0.25·p_h at 0.5·b, Johnson §4.2, Fig. 4.6). Near the roller ends this plane-strain
+value underestimates the true three-dimensional stress.
+
+Sources
+-------
+* K. L. Johnson, *Contact Mechanics*, Cambridge University Press 1985, §3.9 (uniform pressure on a
+  rectangle), §4.2-4.3 (line contact, subsurface stresses).
+* Zhang, Wang, Wu, Guan, Chen, *Contact load and elastohydrodynamic lubrication analysis of
+  eccentric bearings in RV reducer considering the effects of roller profile modification*,
+  eqs. 8-10 (straight, arc and combined generatrix).
+* H. Reusner, *Druckflächenbelastung und Oberflächenverschiebung im Wälzkontakt von Rotationskörpern*,
+  Dissertation, Karlsruhe 1977 (the logarithmic profile); P. M. Johns, R. Gohar, *Roller bearings
+  under radial and eccentric loads*, Tribology International 14 (1981) 131-136 (its finite form).
+* T. A. Harris, M. N. Kotzalas, *Rolling Bearing Analysis* (the zero-clearance roller load
+  distribution Q_j ∝ cos(ψ_j)^(10/9) of a radially loaded roller bearing).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "PROFILE_KINDS",
+    "SHEAR_FACTOR",
+    "SHEAR_DEPTH_FACTOR",
+    "SliceContact",
+    "profile_drop",
+    "slice_centres",
+    "rectangle_influence",
+    "solve_slices",
+    "hertz_peak_from_line_load",
+    "roller_contact",
+    "rigid_ring_roller_loads",
+]
+
+PROFILE_KINDS = ("straight", "arc", "logarithmic", "combined")
+#: Maximum principal shear stress / p_h of a Hertz line contact (Johnson, Contact Mechanics, §4.2).
+SHEAR_FACTOR = 0.300
+#: Its depth / b.
+SHEAR_DEPTH_FACTOR = 0.786
+
+
+@dataclass(frozen=True)
+class SliceContact:
+    """One roller–raceway contact solved by the slice model.
+
+    Attributes
+    ----------
+    x_mm : ndarray (n,)
+        Slice centres along the roller, from its centre, mm.
+    line_load_N_per_mm : ndarray (n,)
+        Load per length q_j of every slice, N/mm.
+    pressure_MPa : ndarray (n,)
+        Local Hertz peak pressure p_h,j = √(q_j·E*/(π·R')), MPa.
+    half_width_mm : ndarray (n,)
+        Local Hertz half-width b_j, mm.
+    approach_mm : float
+        δ, the approach at mid-length (including the half-space's far-field part), mm.
+    peak_pressure_MPa : float
+        max p_h,j, MPa.
+    edge_factor : float
+        Peak pressure / Hertz p_h of the nominal line load Q/L.
+    max_shear_MPa, max_shear_depth_mm : float
+        Largest subsurface principal shear stress 0.300·p_h,j and its depth 0.786·b_j (slice of the
+        peak), MPa and mm.
+    """
+
+    x_mm: np.ndarray
+    line_load_N_per_mm: np.ndarray
+    pressure_MPa: np.ndarray
+    half_width_mm: np.ndarray
+    approach_mm: float
+    peak_pressure_MPa: float
+    edge_factor: float
+    max_shear_MPa: float
+    max_shear_depth_mm: float
+
+
+def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: float,
+                 reduced_radius_mm: float) -> np.ndarray:
+    """Drop z(x) of the roller surface below its straight generatrix, mm.
+
+    Parameters
+    ----------
+    profile : rvfem.case.definition.RollerProfile
+        ``kind`` and its parameters (crown radius R, design load Q_d, modification length a and
+        drop b).
+    length_mm : float
+        Effective roller length L, mm.
+    x_mm : array_like
+        Positions from the roller centre, |x| ≤ L/2, mm.
+    composite_modulus_MPa, reduced_radius_mm : float
+        E* and R' of the contact (the logarithmic profile's design load sets its drop through them).
+
+    Returns
+    -------
+    ndarray
+        z(x) ≥ 0, mm.
+
+    Notes
+    -----
+    * straight: z = 0 (Zhang et al., eq. 8);
+    * arc: z = R − √(R² − x²) (eq. 9);
+    * combined: z = 0 for |x| ≤ l − a, else R − √(R² − (|x| − l + a)²) with l = L/2 and
+      R = (a² + b²)/(2b), so that z(l) = b (eq. 10, its b = R − √(R² − a²));
+    * logarithmic (Johns–Gohar): z = 2Q_d/(π·L·E*)·ln[1/(1 − (1 − b_d²/l²)·(x/l)²)], b_d the Hertz
+      half-width at Q_d; Lundberg's profile (b_d → 0) with a finite drop at the ends.
+    """
+    x = np.abs(np.asarray(x_mm, dtype=float))
+    half = 0.5 * length_mm
+    kind = profile.kind
+    if kind == "straight":
+        return np.zeros_like(x)
+    if kind == "arc":
+        r = profile.crown_radius
+        return r - np.sqrt(r * r - np.minimum(x, r) ** 2)
+    if kind == "combined":
+        a, b = profile.modification_length, profile.modification_drop
+        if b <= 0.0:
+            return np.zeros_like(x)
+        r = (a * a + b * b) / (2.0 * b)
+        u = np.clip(x - (half - a), 0.0, None)
+        return r - np.sqrt(r * r - np.minimum(u, r) ** 2)
+    if kind == "logarithmic":
+        q = profile.design_load_N
+        b_d = math.sqrt(4.0 * q * reduced_radius_mm / (math.pi * length_mm * composite_modulus_MPa))
+        frac = min(b_d / half, 1.0)
+        arg = 1.0 - (1.0 - frac * frac) * np.minimum(x / half, 1.0) ** 2
+        return 2.0 * q / (math.pi * length_mm * composite_modulus_MPa) * np.log(1.0 / arg)
+    raise ValueError(f"unknown roller profile kind {kind!r}; expected one of {PROFILE_KINDS}")
+
+
+def slice_centres(length_mm: float, slices: int) -> tuple[np.ndarray, np.ndarray]:
+    """Slice centres x_j (mm, from the roller centre) and widths Δx (mm) of ``slices`` equal slices."""
+    if slices < 1 or length_mm <= 0:
+        raise ValueError("slice_centres needs a positive length and at least one slice")
+    edges = np.linspace(-0.5 * length_mm, 0.5 * length_mm, slices + 1)
+    return 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
+
+
+def _love(u, v):
+    """Signed ∫₀^u ∫₀^v dx dy / √(x² + y²), the corner function of Love's rectangle solution:
+    sgn(u)·sgn(v)·(|u|·asinh(|v|/|u|) + |v|·asinh(|u|/|v|)) (0 where u or v is 0)."""
+    u = np.asarray(u, dtype=float)
+    v = np.asarray(v, dtype=float)
+    au, av = np.abs(u), np.abs(v)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f1 = np.where(au > 0.0, au * np.arcsinh(av / np.where(au > 0.0, au, 1.0)), 0.0)
+        f2 = np.where(av > 0.0, av * np.arcsinh(au / np.where(av > 0.0, av, 1.0)), 0.0)
+    return np.sign(u) * np.sign(v) * (f1 + f2)
+
+
+def rectangle_influence(x_mm, widths_mm, half_width_mm: float, composite_modulus_MPa: float,
+                        y_mm=None, half_heights_mm=None) -> np.ndarray:
+    """Displacement (both bodies) at the centres of rectangles per unit uniform pressure on each
+    rectangle of a half-space, mm/MPa.
+
+    C_ij = 1/(π·E*)·∫∫_rect j dA/r from the centre of rectangle i (Love's solution, Johnson,
+    *Contact Mechanics*, eq. 3.25), evaluated with the corner function u·asinh(v/u) + v·asinh(u/v).
+
+    Parameters
+    ----------
+    x_mm, widths_mm : array_like (n,)
+        Centres and widths of the rectangles along x, mm.
+    half_width_mm : float
+        Half-height of every rectangle across (y), mm (the strip half-width b of the slice model).
+    composite_modulus_MPa : float
+        E*, MPa.
+    y_mm, half_heights_mm : array_like (n,), optional
+        Centres and half-heights across for a two-dimensional grid of rectangles (default: all at
+        y = 0 with ``half_width_mm``).
+
+    Returns
+    -------
+    ndarray (n, n)
+    """
+    x = np.asarray(x_mm, dtype=float)
+    hw = 0.5 * np.asarray(widths_mm, dtype=float)
+    y = np.zeros_like(x) if y_mm is None else np.asarray(y_mm, dtype=float)
+    hh = np.full_like(x, half_width_mm) if half_heights_mm is None else np.asarray(half_heights_mm, dtype=float)
+    dx = x[:, None] - x[None, :]
+    dy = y[:, None] - y[None, :]
+    total = np.zeros(dx.shape)
+    for sx in (-1.0, 1.0):
+        for sy in (-1.0, 1.0):
+            total += sx * sy * _love(dx + sx * hw[None, :], dy + sy * hh[None, :])
+    return total / (math.pi * composite_modulus_MPa)
+
+
+def solve_slices(influence: np.ndarray, area_mm2: np.ndarray, interference_mm: np.ndarray,
+                 load_N: np.ndarray, max_iterations: int = 60) -> tuple[np.ndarray, np.ndarray]:
+    """Pressures of many slice contacts sharing one influence matrix (active-set method).
+
+    For every contact k: p ≥ 0 and C·p = δ_k + g_k on the slices in contact, C·p ≥ δ_k + g_k on
+    the others, Σ p·A = Q_k.
+
+    Parameters
+    ----------
+    influence : ndarray (n, n)
+        C, mm/MPa (:func:`rectangle_influence`).
+    area_mm2 : ndarray (n,)
+        Area A_j of each slice's rectangle, mm².
+    interference_mm : ndarray (m, n)
+        g_k,j = ψ_k·x_j − z(x_j), mm (the approach of slice j relative to mid-length).
+    load_N : ndarray (m,)
+        Q_k > 0, N.
+    max_iterations : int
+        Active-set iterations.
+
+    Returns
+    -------
+    pressure : ndarray (m, n)
+        p, MPa.
+    approach : ndarray (m,)
+        δ, mm.
+    """
+    c = np.asarray(influence, dtype=float)
+    g = np.atleast_2d(np.asarray(interference_mm, dtype=float))
+    q = np.asarray(load_N, dtype=float).reshape(-1)
+    m, n = g.shape
+    a = np.asarray(area_mm2, dtype=float)
+    # all slices in contact: p = C⁻¹(δ·1 + g), δ from the load balance
+    c_inv_1 = np.linalg.solve(c, np.ones(n))
+    c_inv_g = np.linalg.solve(c, g.T).T
+    delta = (q - c_inv_g @ a) / (c_inv_1 @ a)
+    p = delta[:, None] * c_inv_1[None, :] + c_inv_g
+    approach = delta
+    todo = np.flatnonzero((p < 0.0).any(axis=1))
+    if todo.size:
+        p_t, d_t = _active_set(c, a, g[todo], q[todo], p[todo] > 0.0, max_iterations)
+        p[todo] = p_t
+        approach[todo] = d_t
+    return p, approach
+
+
+def _solve_masked(c, a, g, q, act):
+    """Pressures and approaches of contacts with the given active sets: for every distinct set S one
+    solve of [C_SS, −1; A_S, 0]·[p_S; δ] = [g_S; Q] with all its contacts as right-hand sides."""
+    m, n = g.shape
+    masks, which = np.unique(np.packbits(act, axis=1), axis=0, return_inverse=True)
+    if 4 * masks.shape[0] > m:                  # mostly distinct sets: one batched solve
+        return _solve_batched(c, a, g, q, act)
+    masks = np.unpackbits(masks, axis=1, count=n).astype(bool)
+    p = np.zeros((m, n))
+    delta = np.zeros(m)
+    for k, mask in enumerate(masks):
+        rows = np.flatnonzero(which.reshape(-1) == k)
+        s = np.flatnonzero(mask)
+        mat = np.zeros((s.size + 1, s.size + 1))
+        mat[:-1, :-1] = c[np.ix_(s, s)]
+        mat[:-1, -1] = -1.0
+        mat[-1, :-1] = a[s]
+        rhs = np.concatenate([g[np.ix_(rows, s)].T, q[None, rows]], axis=0)
+        sol = np.linalg.solve(mat, rhs)
+        p[np.ix_(rows, s)] = sol[:-1].T
+        delta[rows] = sol[-1]
+    return p, delta
+
+
+def _solve_batched(c, a, g, q, act):
+    """:func:`_solve_masked` with one system per contact (inactive rows and columns replaced by the
+    identity, p = 0 there), solved as a batch."""
+    m, n = g.shape
+    eye = np.eye(n)
+    mat = np.empty((m, n + 1, n + 1))
+    both = act[:, :, None] & act[:, None, :]
+    mat[:, :n, :n] = np.where(both, c[None], eye[None])
+    mat[:, :n, n] = np.where(act, -1.0, 0.0)
+    mat[:, n, :n] = np.where(act, a[None, :], 0.0)
+    mat[:, n, n] = 0.0
+    rhs = np.concatenate([np.where(act, g, 0.0), q[:, None]], axis=1)
+    sol = np.linalg.solve(mat, rhs[..., None])[..., 0]
+    return sol[:, :n], sol[:, n]
+
+
+def _active_set(c, a, g, q, active, max_iterations):
+    """Active-set iterations of :func:`solve_slices` for the contacts not fully in contact: drop
+    the slices in tension, add the penetrating ones, until neither is left. Contacts with the same
+    active set are solved together (:func:`_solve_masked`)."""
+    m, n = g.shape
+    p = np.zeros((m, n))
+    delta = np.zeros(m)
+    pending = np.arange(m)
+    for _ in range(max_iterations):
+        act = active[pending]
+        pk, dk = _solve_masked(c, a, g[pending], q[pending], act)
+        gap = pk @ c.T - (dk[:, None] + g[pending])       # w − s: negative = penetration
+        negative = act & (pk < 0.0)
+        penetrating = ~act & (gap < -1e-12 * np.maximum(np.abs(dk[:, None]), 1e-9))
+        done = ~(negative.any(axis=1) | penetrating.any(axis=1))
+        p[pending[done]] = pk[done]
+        delta[pending[done]] = dk[done]
+        new = act & ~negative | penetrating
+        # never leave a contact without a slice: keep the most interfering one
+        empty = ~new.any(axis=1)
+        if empty.any():
+            new[empty, np.argmax(g[pending[empty]], axis=1)] = True
+        active[pending] = new
+        pending = pending[~done]
+        if pending.size == 0:
+            break
+    if pending.size:
+        raise RuntimeError(f"slice contact did not settle in {max_iterations} active-set iterations")
+    return np.clip(p, 0.0, None), delta
+
+
+def hertz_peak_from_line_load(line_load_N_per_mm, reduced_radius_mm: float, composite_modulus_MPa: float):
+    """Hertz peak pressure (MPa) and half-width (mm) of a line load q (N/mm):
+    p_h = √(q·E*/(π·R')), b = √(4·q·R'/(π·E*)) (Johnson, Contact Mechanics, §4.3)."""
+    q = np.clip(np.asarray(line_load_N_per_mm, dtype=float), 0.0, None)
+    return (np.sqrt(q * composite_modulus_MPa / (math.pi * reduced_radius_mm)),
+            np.sqrt(4.0 * q * reduced_radius_mm / (math.pi * composite_modulus_MPa)))
+
+
+def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, composite_modulus_MPa: float,
+                   profile, *, tilt_rad: float = 0.0, slices: int | None = None) -> SliceContact:
+    """Slice model of one roller–raceway contact (see the module docstring).
+
+    Parameters
+    ----------
+    load_N : float
+        Roller load Q on this raceway, N (> 0).
+    length_mm : float
+        Effective roller length L, mm.
+    reduced_radius_mm, composite_modulus_MPa : float
+        R' of roller and raceway (mm) and E* (MPa).
+    profile : rvfem.case.definition.RollerProfile
+        Roller profile (its ``slices`` unless ``slices`` is given).
+    tilt_rad : float
+        Relative tilt ψ of roller and raceway, rad.
+    slices : int, optional
+        Number of slices.
+
+    Returns
+    -------
+    SliceContact
+    """
+    n = profile.slices if slices is None else slices
+    x, dx = slice_centres(length_mm, n)
+    b_nom = math.sqrt(4.0 * load_N * reduced_radius_mm / (math.pi * length_mm * composite_modulus_MPa))
+    c = rectangle_influence(x, dx, b_nom, composite_modulus_MPa)
+    drop = profile_drop(profile, length_mm, x, composite_modulus_MPa=composite_modulus_MPa,
+                        reduced_radius_mm=reduced_radius_mm)
+    p, delta = solve_slices(c, 2.0 * b_nom * dx, (tilt_rad * x - drop)[None, :], np.array([load_N]))
+    q = p[0] * 2.0 * b_nom
+    ph, b = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
+    nominal, _ = hertz_peak_from_line_load(load_N / length_mm, reduced_radius_mm, composite_modulus_MPa)
+    k = int(np.argmax(ph))
+    return SliceContact(x_mm=x, line_load_N_per_mm=q, pressure_MPa=ph, half_width_mm=b,
+                        approach_mm=float(delta[0]), peak_pressure_MPa=float(ph[k]),
+                        edge_factor=float(ph[k] / nominal), max_shear_MPa=SHEAR_FACTOR * float(ph[k]),
+                        max_shear_depth_mm=SHEAR_DEPTH_FACTOR * float(b[k]))
+
+
+def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarray) -> np.ndarray:
+    """Roller loads of rigid rings without clearance under a radial force, N.
+
+    The rings approach by δ along the force; roller j at ψ_j from the force direction is
+    compressed by δ·cos ψ_j and carries Q_j = K·(δ·cos ψ_j)^(10/9) (line contact, Harris &
+    Kotzalas), so Q_j = F·c_j^(10/9) / Σ_k c_k^(19/9) with c = max(cos ψ, 0).
+
+    Parameters
+    ----------
+    bearing_forces : ndarray (..., 2)
+        Force of the bearing on the disc, N (the rollers are pressed on the side it points to).
+    roller_angles : ndarray (..., Z)
+        Angular positions of the rollers, rad, same frame.
+
+    Returns
+    -------
+    ndarray (..., Z)
+    """
+    f = np.asarray(bearing_forces, dtype=float)
+    mag = np.linalg.norm(f, axis=-1)
+    direction = np.arctan2(f[..., 1], f[..., 0])
+    c = np.clip(np.cos(np.asarray(roller_angles) - direction[..., None]), 0.0, None)
+    denom = np.sum(c ** (19.0 / 9.0), axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(denom[..., None] > 0, mag[..., None] * c ** (10.0 / 9.0) / np.where(denom > 0, denom, 1.0)[..., None], 0.0)
+    return out
