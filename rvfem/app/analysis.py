@@ -1202,9 +1202,14 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
                       comparison=comparison, stress=stress, hertz=roller_hertz,
                       torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
                       attribution=attribution, references=references)
-    # the crank bearing in depth: slices of every roller, film, a_ISO, L_nm and L10r (rigid and flexible)
-    depth = roller_life.crank_bearing_depth(case, np.asarray(thetas), cycle, result.rigid_forces, comparison,
-                                            rigid_analysis.rating_N, rigid_analysis.bearing_speed_rpm)
+    return _with_roller_depth(result)
+
+
+def _with_roller_depth(result: Analysis) -> Analysis:
+    """The analysis with the crank bearing in depth (slices of every roller, film, a_ISO, L_nm and
+    L10r, rigid and flexible; :func:`rvfem.evaluate.roller_life.crank_bearing_depth`) and all warnings."""
+    depth = roller_life.crank_bearing_depth(result.case, result.theta, result.cycle, result.rigid_forces,
+                                            result.comparison, result.rigid.rating_N, result.rigid.bearing_speed_rpm)
     if depth is not None:
         result.timings["roller_depth"] = depth.seconds
     return dataclasses.replace(result, roller_depth=depth, warnings=validity.analysis_warnings(result)

@@ -340,8 +340,14 @@ def hertz_peak_from_line_load(line_load_N_per_mm, reduced_radius_mm: float, comp
 
 
 def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, composite_modulus_MPa: float,
-                   profile, *, tilt_rad: float = 0.0, slices: int | None = None) -> SliceContact:
+                   profile, *, tilt_rad: float = 0.0, slices: int | None = None,
+                   local_width_iterations: int = 8) -> SliceContact:
     """Slice model of one roller–raceway contact (see the module docstring).
+
+    The rectangles start at the nominal Hertz half-width of Q/L; then, up to
+    ``local_width_iterations`` times, each slice's rectangle takes the Hertz half-width of its own
+    load per length (a crowned roller's contact narrows towards its ends) and the contact is solved
+    again, until the slice loads change by less than 0.1 % of the largest.
 
     Parameters
     ----------
@@ -357,6 +363,9 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
         Relative tilt ψ of roller and raceway, rad.
     slices : int, optional
         Number of slices.
+    local_width_iterations : int
+        0: every rectangle keeps the nominal half-width (as in the cycle, :func:`solve_slices` with
+        one influence matrix).
 
     Returns
     -------
@@ -365,11 +374,21 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
     n = profile.slices if slices is None else slices
     x, dx = slice_centres(length_mm, n)
     b_nom = math.sqrt(4.0 * load_N * reduced_radius_mm / (math.pi * length_mm * composite_modulus_MPa))
-    c = rectangle_influence(x, dx, b_nom, composite_modulus_MPa)
     drop = profile_drop(profile, length_mm, x, composite_modulus_MPa=composite_modulus_MPa,
                         reduced_radius_mm=reduced_radius_mm)
-    p, delta = solve_slices(c, 2.0 * b_nom * dx, (tilt_rad * x - drop)[None, :], np.array([load_N]))
-    q = p[0] * 2.0 * b_nom
+    g = (tilt_rad * x - drop)[None, :]
+    widths = np.full(n, b_nom)
+    q = None
+    for _ in range(local_width_iterations + 1):
+        c = rectangle_influence(x, dx, b_nom, composite_modulus_MPa, half_heights_mm=widths)
+        p, delta = solve_slices(c, 2.0 * widths * dx, g, np.array([load_N]))
+        q_new = p[0] * 2.0 * widths
+        converged = q is not None and np.max(np.abs(q_new - q)) < 1e-3 * np.max(q_new)
+        q = q_new
+        if converged:
+            break
+        _, b_local = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
+        widths = np.maximum(b_local, 0.2 * b_nom)
     ph, b = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
     nominal, _ = hertz_peak_from_line_load(load_N / length_mm, reduced_radius_mm, composite_modulus_MPa)
     k = int(np.argmax(ph))
@@ -379,12 +398,13 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
                         max_shear_depth_mm=SHEAR_DEPTH_FACTOR * float(b[k]))
 
 
-def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarray) -> np.ndarray:
+def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarray, iterations: int = 30) -> np.ndarray:
     """Roller loads of rigid rings without clearance under a radial force, N.
 
-    The rings approach by δ along the force; roller j at ψ_j from the force direction is
-    compressed by δ·cos ψ_j and carries Q_j = K·(δ·cos ψ_j)^(10/9) (line contact, Harris &
-    Kotzalas), so Q_j = F·c_j^(10/9) / Σ_k c_k^(19/9) with c = max(cos ψ, 0).
+    The rings move by d relative to each other; roller j along e_j = (cos ψ_j, sin ψ_j) is
+    compressed by (d·e_j)₊ and carries Q_j = K·(d·e_j)₊^(10/9) (line contact, Harris &
+    Kotzalas); d solves Σ_j Q_j·e_j = F (Newton, from the symmetric solution
+    Q_j = F·c_j^(10/9)/Σ c_k^(19/9), c = cos(ψ − φ_F)₊). K drops out.
 
     Parameters
     ----------
@@ -392,16 +412,28 @@ def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarra
         Force of the bearing on the disc, N (the rollers are pressed on the side it points to).
     roller_angles : ndarray (..., Z)
         Angular positions of the rollers, rad, same frame.
+    iterations : int
+        Newton iterations (converged to round-off in about ten).
 
     Returns
     -------
     ndarray (..., Z)
     """
     f = np.asarray(bearing_forces, dtype=float)
+    psi = np.asarray(roller_angles, dtype=float)
+    e = np.stack([np.cos(psi), np.sin(psi)], axis=-1)                       # (..., Z, 2)
     mag = np.linalg.norm(f, axis=-1)
-    direction = np.arctan2(f[..., 1], f[..., 0])
-    c = np.clip(np.cos(np.asarray(roller_angles) - direction[..., None]), 0.0, None)
+    unit = f / np.where(mag > 0, mag, 1.0)[..., None]
+    c = np.clip(np.einsum("...zc,...c->...z", e, unit), 0.0, None)
     denom = np.sum(c ** (19.0 / 9.0), axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out = np.where(denom[..., None] > 0, mag[..., None] * c ** (10.0 / 9.0) / np.where(denom > 0, denom, 1.0)[..., None], 0.0)
-    return out
+    scale = np.where(denom > 0, mag / np.where(denom > 0, denom, 1.0), 0.0)
+    d = unit * (scale ** 0.9)[..., None]                                       # Q = (d·e)^(10/9)
+    for _ in range(iterations):
+        s = np.clip(np.einsum("...zc,...c->...z", e, d), 0.0, None)
+        q = s ** (10.0 / 9.0)
+        res = np.einsum("...z,...zc->...c", q, e) - f
+        jac = np.einsum("...z,...zc,...zd->...cd", (10.0 / 9.0) * s ** (1.0 / 9.0), e, e)
+        jac = jac + 1e-12 * np.max(np.abs(jac), initial=1.0) * np.eye(2)
+        d = d - np.linalg.solve(jac, res[..., None])[..., 0]
+    s = np.clip(np.einsum("...zc,...c->...z", e, d), 0.0, None)
+    return np.where(mag[..., None] > 0, s ** (10.0 / 9.0), 0.0)
