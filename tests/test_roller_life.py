@@ -1,0 +1,188 @@
+"""Lubrication, a_ISO, the lamina life and the crankshaft tilt of the crank bearing against hand
+calculations with the standards' formulas, the rating's own definition and the beam closed form."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from rvfem.case.definition import load_case
+from rvfem.evaluate import iso281, lubrication as lb, roller_life as rl, roller_slices as rs
+from rvfem.evaluate.hertz import composite_modulus, reduced_radius
+from rvfem.fem.crankshaft import beam_influence
+
+from conftest import CASES_DIR
+
+E_STAR = composite_modulus(206000.0, 0.3)
+
+
+@pytest.fixture(scope="module")
+def case():
+    return load_case(CASES_DIR / "rv40e_fanholes.toml")
+
+
+# --------------------------------------------------------------------------------------------
+# Viscosity, speed, film
+# --------------------------------------------------------------------------------------------
+
+
+def test_walther_goes_through_its_two_points_and_between():
+    assert lb.walther_viscosity(68.0, 8.7, 40.0) == pytest.approx(68.0, rel=1e-12)
+    assert lb.walther_viscosity(68.0, 8.7, 100.0) == pytest.approx(8.7, rel=1e-12)
+    # hand calculation, ASTM D341: log log(ν + 0.7) linear in log T (K)
+    a1, a2 = math.log10(math.log10(68.7)), math.log10(math.log10(9.4))
+    t = (math.log10(333.15) - math.log10(313.15)) / (math.log10(373.15) - math.log10(313.15))
+    assert lb.walther_viscosity(68.0, 8.7, 60.0) == pytest.approx(10 ** 10 ** (a1 + t * (a2 - a1)) - 0.7, rel=1e-12)
+
+
+def test_entrainment_speed_by_hand():
+    # n_b = 600 rpm, D_m = 31 mm, D_we = 5 mm: u = ω·D_m·(1 − γ²)/4
+    u = 2 * math.pi * 10.0 * 0.031 * (1 - (5 / 31) ** 2) / 4
+    assert lb.entrainment_speed(600.0, 31.0, 5.0) == pytest.approx(u, rel=1e-12)
+    assert u == pytest.approx(0.4743, abs=1e-4)
+
+
+def test_pan_hamrock_film_against_dowson_higginson():
+    # two independently fitted line-contact formulas agree within 10 % over the crank bearing's range
+    r = reduced_radius(2.5, 13.0, concave=False)
+    for w, eta, u in [(50.0, 0.02, 0.2), (140.0, 0.03, 0.47), (400.0, 0.1, 2.0)]:
+        pan = lb.pan_hamrock_film(w, r, E_STAR, eta, u, 20.0)
+        dh = lb.dowson_higginson_min_film(w, r, E_STAR, eta, u, 20.0)
+        assert pan.minimum_um == pytest.approx(dh, rel=0.10)
+        assert pan.central_um > pan.minimum_um
+    # the dimensional form of Pan & Hamrock's h_min: 1.714·w'^−0.128·(η0·u)^0.694·α^0.568·E'^0.002·R'^0.434
+    w, eta, u, alpha = 140.0e3, 0.03, 0.47, 20e-9
+    e1, rr = 2 * E_STAR * 1e6, r * 1e-3
+    h = 1.714 * w**-0.128 * (eta * u) ** 0.694 * alpha**0.568 * e1 ** (0.128 - 0.694 + 0.568) * rr ** (1 + 0.128 - 0.694)
+    assert lb.pan_hamrock_film(140.0, r, E_STAR, eta, u, 20.0).minimum_um == pytest.approx(h * 1e6, rel=1e-9)
+
+
+# --------------------------------------------------------------------------------------------
+# ISO 281 ν1, κ, a_ISO; ISO 76 C0, ISO 281 Annex B C_u
+# --------------------------------------------------------------------------------------------
+
+
+def test_reference_viscosity_by_hand():
+    assert lb.reference_viscosity(600.0, 31.0) == pytest.approx(45000 * 600**-0.83 / math.sqrt(31), rel=1e-12)
+    assert lb.reference_viscosity(600.0, 31.0) == pytest.approx(39.96, abs=0.01)
+    assert lb.reference_viscosity(3000.0, 31.0) == pytest.approx(4500 / math.sqrt(3000 * 31), rel=1e-12)
+
+
+@pytest.mark.parametrize("kappa, c1, e", [(0.3, 2.2649, 0.054381), (0.7, 1.9987, 0.19087), (2.0, 1.9987, 0.071739)])
+def test_a_iso_by_hand_in_each_kappa_branch(kappa, c1, e):
+    for x in (0.1, 0.55 * 2835.25 / 2763.46):  # and e_C·C_u/P of the shipped bearing (normal cleanliness)
+        hand = min(0.1 * (1 - (2.5671 - c1 / kappa**e) ** 1.1 * x**0.4) ** -9.185, 50.0)
+        assert lb.a_iso_roller(kappa, x) == pytest.approx(hand, rel=1e-12)
+
+
+def test_a_iso_limits():
+    assert lb.a_iso_roller(1.0, 0.0) == pytest.approx(0.1)          # no fatigue limit margin: 0.1
+    assert lb.a_iso_roller(4.0, 5.0) == lb.A_ISO_MAX                 # capped at 50
+    assert lb.a_iso_roller(10.0, 0.3) == lb.a_iso_roller(4.0, 0.3)   # κ > 4 counts as 4
+
+
+def test_static_rating_and_fatigue_limit_by_hand():
+    c0 = 44 * (1 - 5 / 31) * 14 * 9 * 5
+    assert lb.static_load_rating(14, 5.0, 9.0, 31.0) == pytest.approx(c0, rel=1e-12)
+    assert lb.fatigue_load_limit(c0, 31.0) == pytest.approx(c0 / 8.2, rel=1e-12)
+    assert lb.fatigue_load_limit(c0, 200.0) == pytest.approx(c0 / 8.2 * 0.5**0.3, rel=1e-12)
+
+
+# --------------------------------------------------------------------------------------------
+# The lamina life (ISO/TS 16281) against the rating's definition
+# --------------------------------------------------------------------------------------------
+
+
+def _uniform_life(case, force, slices=30, phases=8):
+    qci, qce = rl.lamina_ratings(case, slices)
+    z = case.crank_bearing.rollers
+    damage = []
+    for phase in np.linspace(0, 2 * math.pi / z, phases, endpoint=False):
+        q = rs.rigid_ring_roller_loads(np.array([force, 0.0]), phase + 2 * np.pi * np.arange(z) / z)
+        lam = np.repeat(q[:, None] / slices, slices, axis=1)
+        damage.append(1.0 / rl.lamina_life_mrev(lam, lam, qci, qce, inner_rotates=True))
+    return 1.0 / np.mean(damage)
+
+
+def test_lamina_life_is_one_million_revolutions_at_the_rating(case):
+    # C is the load for 10⁶ revolutions: the lamina ratings (552·…, ISO/TS 16281) and ISO 281's
+    # C (207.9·…) rest on the same Lundberg–Palmgren integrals, with the rigid-ring load zone of
+    # ±90° that C assumes
+    c = iso281.crank_bearing_rating(case.crank_bearing)
+    assert _uniform_life(case, c) == pytest.approx(1.0, rel=0.01)
+    # line contact: L ∝ P^−4 (ISO 281's 10/3 is a compromise for all roller bearings)
+    assert _uniform_life(case, c / 8) == pytest.approx(8.0**4 * _uniform_life(case, c), rel=1e-9)
+    # independent of the number of laminae
+    assert _uniform_life(case, c / 3, slices=7) == pytest.approx(_uniform_life(case, c / 3, slices=40), rel=1e-9)
+
+
+def _din_26281_slice_springs(angles, f_rad, slices, length):
+    """Roller loads of a cylindrical roller bearing of straight rollers without clearance after the
+    independent slice springs of DIN 26281 / ISO/TS 16281 (the algorithm of ``tribology``'s
+    ``fcylrolbear``, written out here): slice stiffness 35948·L^(8/9)/n_s, slice load
+    c·δ_jk^(10/9), δ_jk = δ_r·cos ψ_j, the ring approach δ_r found by the secant method."""
+    c = 35948.0 * length ** (8 / 9) / slices
+    cos = np.cos(angles)
+
+    def force(dr):
+        d = np.clip(dr * cos, 0, None)
+        return c * slices * d ** (10 / 9), np.sum(c * slices * d ** (10 / 9) * cos)
+
+    d0, d1 = 1e-4, 2e-3
+    f0, f1 = force(d0)[1] - f_rad, force(d1)[1] - f_rad
+    for _ in range(100):
+        d0, d1, f0 = d1, d1 - f1 * (d1 - d0) / (f1 - f0), f1
+        f1 = force(d1)[1] - f_rad
+        if abs(f1) < 1e-10 * f_rad:
+            break
+    return force(d1)[0]
+
+
+def test_rigid_ring_roller_loads_against_din_26281_slice_springs():
+    angles = 2 * np.pi * np.arange(14) / 14
+    din = _din_26281_slice_springs(angles, 2763.0, 30, 9.0)
+    ours = rs.rigid_ring_roller_loads(np.array([2763.0, 0.0]), angles)
+    np.testing.assert_allclose(ours, din, rtol=1e-8, atol=1e-9)
+
+
+# --------------------------------------------------------------------------------------------
+# Tilt from the crankshaft beam
+# --------------------------------------------------------------------------------------------
+
+
+def test_beam_slope_against_the_closed_form_and_the_deflection():
+    span, ei = 33.0, 206000.0 * math.pi * 20.0**4 / 64
+    # a central load turns the beam's ends by P·L²/(16·EI) (Roark) and not its centre
+    g = rl.beam_slope_influence(span, [1e-9, span / 2], ei)
+    assert g[0, 1] == pytest.approx(span**2 / (16 * ei), rel=1e-6)
+    assert g[1, 1] == pytest.approx(0.0, abs=1e-18)
+    # the slope at each eccentric is the derivative of the (independently coded) deflection line
+    pos, h = [11.5, 21.5], 1e-4
+    comp = (2e-6, 3e-6)
+    g = rl.beam_slope_influence(span, pos, ei, comp)
+    for i, x in enumerate(pos):
+        for j, b in enumerate(pos):
+            # central difference (the deflection line is smooth through the load point too)
+            fd = (beam_influence(span, [x + h, b], ei, None, comp)[0, 1]
+                  - beam_influence(span, [x - h, b], ei, None, comp)[0, 1]) / (2 * h)
+            assert g[i, j] == pytest.approx(fd, rel=1e-5, abs=1e-15)
+
+
+def _cycle(case, n=8):
+    rng = np.random.default_rng(0)
+    f = rng.normal(size=(n, case.loads.discs, case.cranks.count, 2)) * 1000.0
+    return SimpleNamespace(bearing_forces=f[:, 0], disc_bearing_forces=f)
+
+
+def test_tilt_is_zero_on_rigid_support_and_vanishes_with_a_stiff_crankshaft(case):
+    cyc = _cycle(case)
+    assert not np.any(rl.eccentric_slopes(case.replace(crank_support=None), cyc))
+    base = np.abs(rl.eccentric_slopes(case, cyc)).max()
+    assert base > 0
+    cs = case.crank_support
+    stiff = case.replace(crank_support=cs.__class__(**{**cs.__dict__, "journal_diameter": 10 * cs.journal_diameter,
+                                                       "support_stiffness_N_per_mm": 1e10}))
+    assert np.abs(rl.eccentric_slopes(stiff, cyc)).max() < 1e-3 * base
