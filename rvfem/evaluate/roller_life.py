@@ -243,7 +243,8 @@ class BearingDepth:
     model : str
         ``"rigid"`` or ``"flexible"``.
     roller_peak_pressure_MPa : float
-        Largest slice pressure over the cycle, both raceways, MPa.
+        Largest slice pressure over the cycle, both raceways, MPa (the roller of the largest
+        pressure of the cycle's slices, solved again with each slice's own strip width).
     roller_edge_factor : float
         That peak / the Hertz p_h of the same roller's nominal line load Q/L.
     raceway : str
@@ -340,14 +341,13 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     geoms = raceways(case)
     slice_loads = [cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache) for g in geoms]
     x, dx = roller_slices.slice_centres(b.roller_length, prof.slices)
-    peak, r, k, j, p_x = _peak(case, theta, roller_loads, tilts, slice_loads, geoms)
+    _, r, k, j, _ = _peak(case, theta, roller_loads, tilts, slice_loads, geoms)
     g = geoms[r]
     q_roller = float(roller_loads[k, j])
-    nominal, _ = roller_slices.hertz_peak_from_line_load(q_roller / b.roller_length, g.reduced_radius_mm,
-                                                         g.composite_modulus_MPa)
-    _, b_peak = roller_slices.hertz_peak_from_line_load(peak**2 * math.pi * g.reduced_radius_mm
-                                                        / g.composite_modulus_MPa, g.reduced_radius_mm,
-                                                        g.composite_modulus_MPa)
+    tilt = float(np.broadcast_to(tilts, roller_loads.shape)[k, j])
+    # the worst roller again with each slice's own strip width (roller_slices.roller_contact)
+    worst = roller_slices.roller_contact(q_roller, b.roller_length, g.reduced_radius_mm, g.composite_modulus_MPa,
+                                         prof, tilt_rad=tilt)
     # lubrication at the most loaded roller, on the eccentric (the smaller R', the thinner film)
     lub = case.lubricant
     _, _, nu = lubrication.lubricant_viscosity(lub)
@@ -369,11 +369,10 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
     damage = float(np.mean(1.0 / per_angle))
     return BearingDepth(
-        bearing=bearing, model=model, roller_peak_pressure_MPa=peak, roller_edge_factor=peak / float(nominal),
-        raceway=g.name, theta_deg=math.degrees(float(theta[k])), roller=j, roller_load_N=q_roller,
-        tilt_mrad=1e3 * float(np.broadcast_to(tilts, roller_loads.shape)[k, j]), x_mm=x, pressure_MPa=p_x,
-        max_shear_MPa=roller_slices.SHEAR_FACTOR * peak,
-        max_shear_depth_mm=roller_slices.SHEAR_DEPTH_FACTOR * float(b_peak),
+        bearing=bearing, model=model, roller_peak_pressure_MPa=worst.peak_pressure_MPa,
+        roller_edge_factor=worst.edge_factor, raceway=g.name, theta_deg=math.degrees(float(theta[k])), roller=j,
+        roller_load_N=q_roller, tilt_mrad=1e3 * tilt, x_mm=x, pressure_MPa=worst.pressure_MPa,
+        max_shear_MPa=worst.max_shear_MPa, max_shear_depth_mm=worst.max_shear_depth_mm,
         film_thickness_min_um=film.minimum_um, film_thickness_central_um=film.central_um,
         film_parameter=film.minimum_um / lubrication.composite_roughness_um(lub.roughness_Ra_um),
         kappa=kappa, a_iso=a_iso, L10h=l10h, L_nm_h=a_iso * l10h,

@@ -405,6 +405,32 @@ def _hertz(summary: dict) -> dict:
     return _table(["source", "where", "Q N", "p_inner MPa", "b_inner µm", "p_outer MPa", "b_outer µm"], rows, left=2)
 
 
+def _roller_depth(summary: dict) -> dict | None:
+    """The crank bearing in depth: per bearing and load model the pressure along the roller, film,
+    κ, a_ISO and the three lives, and the flexible/rigid life ratios; None without FE rollers."""
+    d = summary.get("crank_bearing_depth")
+    if not d:
+        return None
+    rows = []
+    for b in d["bearings"]:
+        for model in ("rigid", "flexible"):
+            e = b[model]
+            if e is None:
+                continue
+            rows.append([f"bearing {b['bearing']}", model, _num(e["roller_peak_pressure_MPa"], ".0f"),
+                         _num(e["roller_edge_factor"], ".2f"), f"{e['peak_raceway']}, θ = {e['peak_theta_deg']:.0f}°",
+                         _num(e["max_shear_MPa"], ".0f"), _num(1000 * e["max_shear_depth_mm"], ".0f"),
+                         _num(e["film_thickness_min_um"], ".3f"), _num(e["kappa"], ".2f"), _num(e["a_iso"], ".2f"),
+                         _num(e["L10h_h"], ".0f"), _num(e["L_nm_h"], ".0f"), _num(e["L10r_h"], ".0f")])
+        if b["rigid"] is not None:
+            rows.append([f"bearing {b['bearing']}", "flexible/rigid", "", "", "", "", "", "", "", "",
+                         _num(b["L10h_ratio"], ".2f"), _num(b["L_nm_ratio"], ".2f"), _num(b["L10r_ratio"], ".2f")])
+    table = _table(["bearing", "loads", "p_max MPa", "edge factor", "where", "τ_max MPa", "depth µm", "h_min µm",
+                    "κ", "a_ISO", "L10h h", "L_nm h", "L10r h"], rows, left=2)
+    return {"table": table, "profile": d["profile"], "slices": d["slices"],
+            "slope": _num(d["max_slope_mrad"], ".3f")}
+
+
 def _duty_cycle(summary: dict) -> dict | None:
     """The duty-cycle lives (Palmgren–Miner) and their check by the flexible model at every torque;
     None without a duty cycle."""
@@ -526,6 +552,7 @@ def report_context(summary: dict, case: Case, root: str | os.PathLike) -> dict:
         "attribution": _attribution(summary),
         "depends_on": _depends_on(summary, case),
         "hertz": _hertz(summary),
+        "roller_depth": _roller_depth(summary),
         "duty_cycle": _duty_cycle(summary),
         "plots": _plots(summary, root),
         "images": _images(summary, case, root),

@@ -1,0 +1,70 @@
+"""Speed of the crank bearing in depth: the slice model of every roller at every crank angle.
+
+Runs the load cycle of a case once (default ``cases/rv40e_fanholes.toml``, 360 angles, no stress
+re-solve, no attribution), then times :func:`rvfem.evaluate.roller_life.crank_bearing_depth` (both
+raceways of every bearing, rigid and flexible, plus the worst roller's re-solve, film and lives)
+and the flexible slices alone (:func:`rvfem.evaluate.roller_life.cycle_slices` on both raceways of
+every bearing), best of ``--repeat``, for each roller profile. Prints the number of roller contacts
+solved and the time per contact.
+
+Run: ``python benchmarks/bench_roller_slices.py [CASE] [--repeat 5]`` (about half a minute).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from rvfem.app.analysis import analyse
+from rvfem.evaluate import roller_life
+
+
+def _best(function, repeat: int) -> float:
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        function()
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("case", nargs="?", default="cases/rv40e_fanholes.toml")
+    parser.add_argument("--repeat", type=int, default=5)
+    args = parser.parse_args()
+    a = analyse(args.case, recover_stress=False, attribute=False)
+    cyc = a.cycle
+    contacts = int(np.count_nonzero(cyc.roller_loads > 0)) * 2
+    print(f"{a.case.name}: {len(a.theta)} crank angles, {cyc.roller_loads.shape[1]} bearings × "
+          f"{cyc.roller_loads.shape[2]} rollers; {contacts} loaded roller–raceway contacts (flexible)")
+    for kind in ("straight", "arc", "logarithmic", "combined"):
+        case = a.case.replace(crank_bearing=a.case.crank_bearing.__class__(
+            **{**a.case.crank_bearing.__dict__,
+               "profile": a.case.crank_bearing.profile.__class__(**{**a.case.crank_bearing.profile.__dict__,
+                                                                     "kind": kind})}))
+        geoms = roller_life.raceways(case)
+        slopes = roller_life.eccentric_slopes(case, cyc)
+        tilts = roller_life.roller_tilts(slopes, cyc.roller_angles, cyc.bearing_forces)
+
+        def flexible_slices():
+            cache = {}
+            for i in range(cyc.roller_loads.shape[1]):
+                for g in geoms:
+                    roller_life.cycle_slices(cyc.roller_loads[:, i], tilts[:, i], case.crank_bearing.roller_length,
+                                             g, case.crank_bearing.profile, cache=cache)
+
+        def everything():
+            roller_life.crank_bearing_depth(case, a.theta, cyc, a.rigid_forces, a.comparison, a.rigid.rating_N,
+                                            a.rigid.bearing_speed_rpm)
+
+        t_flex = _best(flexible_slices, args.repeat)
+        t_all = _best(everything, args.repeat)
+        print(f"  {kind:<12} flexible slices {t_flex:.3f} s ({1e6 * t_flex / contacts:.1f} µs per contact); "
+              f"rigid + flexible with film and lives {t_all:.3f} s")
+
+
+if __name__ == "__main__":
+    main()
