@@ -30,7 +30,7 @@ curves are then exact shifts of each other on the sampled angles)."""
 REPORT_CELL = """
 import json as _json, math as _math
 _out = {}
-for _name in ("case", "one", "result", "comparison", "analysis"):
+for _name in ("case", "one", "result", "comparison", "analysis", "profile_results"):
     _v = globals().get(_name)
     if _v is None:
         continue
@@ -52,6 +52,8 @@ for _name in ("case", "one", "result", "comparison", "analysis"):
                             "p1": None if _r is None else _r.p1_MPa,
                             "feature": None if _r is None else _r.peak.feature,
                             "contact_zone": _v.stress.peak.von_mises_MPa}
+    elif _name == "profile_results":
+        _out["profile_results"] = _v
     elif _name == "case":
         _out["case"] = {"pins": _v.pins.count, "cranks": _v.cranks.count, "torque": _v.loads.disc_torque_Nmm,
                         "exponent": _v.analysis.equivalent_load_exponent}
@@ -91,6 +93,24 @@ def test_notebook_runs_from_its_own_folder(path, tmp_path):
     assert "bearing 0" not in printed            # numbered from 1, like every output
     if path.stem == "flexible_vs_rigid":
         _check_flexible_vs_rigid(checks, printed)
+    if path.stem == "roller_profiles":
+        _check_roller_profiles(checks["profile_results"], printed)
+
+
+def _check_roller_profiles(r: dict, printed: str) -> None:
+    straight, arc = r["straight"], r["arc R = 500 mm"]
+    log, comb = r["logarithmic"], r["combined a = 1.23 mm, b = 6 µm"]
+    # the straight roller peaks at its ends, the arc at its centre (Zhang et al.); the
+    # logarithmic profile designed for the largest roller load is nearly flat there
+    assert straight["x_peak"] > 4.0 and arc["x_peak"] < 0.5
+    assert log["edge"] < 1.1 < straight["edge"]
+    # the profile changes neither the basic life nor the film (same loads, same nominal line load)
+    for v in r.values():
+        assert v["L10h"] == pytest.approx(straight["L10h"], rel=1e-12)
+        assert v["h_min"] == pytest.approx(straight["h_min"], rel=1e-12)
+    # the pressure peak orders the lamina lives: the highest peak (arc) has the shortest L10r
+    assert arc["L10r"] == min(v["L10r"] for v in r.values())
+    assert "lowest peak with" in printed
 
 
 def _check_flexible_vs_rigid(c: dict, printed: str) -> None:
