@@ -33,9 +33,9 @@ import scipy.sparse.linalg as spla
 from skfem import Basis, ElementVector, FacetBasis, Functional, LinearForm, asm
 
 from rvfem import fem
-from rvfem.case.definition import load_case
-from rvfem.evaluate import compare, rigid
-from rvfem.evaluate.hertz import hertz_peak_pressure
+from rvfem.case.definition import RollerProfile, load_case
+from rvfem.evaluate import compare, lubrication, rigid, roller_life, roller_slices
+from rvfem.evaluate.hertz import composite_modulus, hertz_peak_pressure, reduced_radius
 from rvfem.evaluate.iso281 import (
     bearing_speed_rpm,
     crank_bearing_rating,
@@ -752,6 +752,47 @@ def clearance_section(discs: _Discs) -> Section:
                    "by half of it; the solve carries the disc through a clearance onto its rollers.", checks)
 
 
+def roller_depth_section() -> Section:
+    """10. The crank bearing in depth: Hertz check of Zhang et al., the logarithmic profile's design
+    property, the lamina life at the rating, the film against a second formula, the crankshaft slope."""
+    zhang = ("Zhang et al., *Contact load and elastohydrodynamic lubrication analysis of eccentric bearings in RV "
+             "reducer considering the effects of roller profile modification*")
+    p_zhang = hertz_peak_pressure(1978.0, 8.5, 0.095)
+    e_star, r_in = composite_modulus(206000.0, 0.3), reduced_radius(2.5, 13.0, concave=False)
+    log = roller_slices.roller_contact(1978.0, 9.0, r_in, e_star, RollerProfile(kind="logarithmic", design_load_N=1978.0),
+                                       slices=60)
+    case = _case("rv40e_fanholes")
+    c = crank_bearing_rating(case.crank_bearing)
+    qci, qce = roller_life.lamina_ratings(case, 30)
+    z = case.crank_bearing.rollers
+    damage = []
+    for phase in np.linspace(0.0, 2.0 * math.pi / z, 8, endpoint=False):
+        q = roller_slices.rigid_ring_roller_loads(np.array([c, 0.0]), phase + 2.0 * np.pi * np.arange(z) / z)
+        lam = np.repeat(q[:, None] / 30.0, 30, axis=1)
+        damage.append(1.0 / float(roller_life.lamina_life_mrev(lam, lam, qci, qce, inner_rotates=True)))
+    life = 1.0 / float(np.mean(damage))
+    film = lubrication.pan_hamrock_film(143.0, r_in, e_star, 0.025, 0.474, 20.0).minimum_um
+    film_dh = lubrication.dowson_higginson_min_film(143.0, r_in, e_star, 0.025, 0.474, 20.0)
+    span, ei = 33.0, 206000.0 * math.pi * 20.0**4 / 64.0
+    slope = float(roller_life.beam_slope_influence(span, [1e-9, span / 2.0], ei)[0, 1])
+    checks = (
+        Check("Hertz peak of Zhang et al.'s roller, Q = 1978 N, L = 8.5 mm, b = 95 µm, MPa", zhang + ", p_h = 1.56 GPa",
+              1560.0, p_zhang, p_zhang / 1560.0 - 1.0, 0.005),
+        Check("logarithmic (Johns–Gohar) roller at its design load 1978 N: peak / Hertz at Q/L",
+              "Lundberg's profile: uniform pressure along the roller", 1.0, log.edge_factor, log.edge_factor - 1.0, 0.05),
+        Check("lamina life (ISO/TS 16281) at P = C, rigid rings, straight rollers, 10⁶ rev",
+              "definition of the basic dynamic load rating C (ISO 281)", 1.0, life, life - 1.0, 0.01),
+        Check("minimum film, 143 N/mm, 25 mPa·s, 0.47 m/s, α = 20/GPa (Pan & Hamrock), µm",
+              "Dowson & Higginson's line-contact h_min", film_dh, film, film / film_dh - 1.0, 0.10),
+        Check("crankshaft slope at a support under a central load, rad/N",
+              "Roark: P·L²/(16·EI)", span**2 / (16.0 * ei), slope, slope / (span**2 / (16.0 * ei)) - 1.0, 1e-6),
+    )
+    return Section("10. The crank bearing in depth",
+                   "The slice model of a roller on an elastic half-space, the ISO/TS 16281 lamina life, the EHL film "
+                   "and the crankshaft's slope at the eccentrics (docs/theory.md § 12). The slice model against a "
+                   "two-dimensional half-space solve is in tests/test_roller_slices.py.", checks)
+
+
 def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
     """Compute every section (meshes cached in ``cache_dir``, a temporary folder by default)."""
 
@@ -762,6 +803,7 @@ def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
         sections.append(convergence_section(discs))
         sections.append(reducer_section(discs))
         sections.append(clearance_section(discs))
+        sections.append(roller_depth_section())
     return sections
 
 
