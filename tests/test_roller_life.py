@@ -12,6 +12,7 @@ import pytest
 from rvfem.case.definition import load_case
 from rvfem.evaluate import iso281, lubrication as lb, roller_life as rl, roller_slices as rs
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
+from rvfem.errors import CaseError
 from rvfem.fem.crankshaft import beam_influence
 
 from conftest import CASES_DIR
@@ -186,3 +187,14 @@ def test_tilt_is_zero_on_rigid_support_and_vanishes_with_a_stiff_crankshaft(case
     stiff = case.replace(crank_support=cs.__class__(**{**cs.__dict__, "journal_diameter": 10 * cs.journal_diameter,
                                                        "support_stiffness_N_per_mm": 1e10}))
     assert np.abs(rl.eccentric_slopes(stiff, cyc)).max() < 1e-3 * base
+
+
+def test_profile_kind_is_settable_and_checked():
+    c = load_case(CASES_DIR / "rv40e_fanholes.toml", overrides=("crank_bearing.profile.kind=combined",
+                                                                 "lubricant.iso_vg=100"))
+    assert c.crank_bearing.profile.kind == "combined" and c.lubricant.iso_vg == 100
+    with pytest.raises(CaseError, match="crank_bearing.profile.kind"):
+        load_case(CASES_DIR / "rv40e_fanholes.toml", overrides=("crank_bearing.profile.kind=barrel",))
+    # the shipped cases keep their numbers: the new tables have defaults
+    base = load_case(CASES_DIR / "rv40e_fanholes.toml")
+    assert base.crank_bearing.profile.kind == "straight" and base.lubricant.iso_vg == 68
