@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rvfem.case.definition import load_case
-from rvfem.evaluate import iso281, lubrication as lb, roller_life as rl, roller_slices as rs
+from rvfem.evaluate import iso281, lubrication as lb, roller_life as rl, roller_slices as rs, validity
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
 from rvfem.errors import CaseError
 from rvfem.fem.crankshaft import beam_influence
@@ -198,3 +198,17 @@ def test_profile_kind_is_settable_and_checked():
     # the shipped cases keep their numbers: the new tables have defaults
     base = load_case(CASES_DIR / "rv40e_fanholes.toml")
     assert base.crank_bearing.profile.kind == "straight" and base.lubricant.iso_vg == 68
+
+
+def test_roller_depth_warnings_one_line_each():
+    def depth(peak, kappa):
+        d = SimpleNamespace(roller_peak_pressure_MPa=peak, bearing=0, model="flexible", raceway="eccentric",
+                            kappa=kappa)
+        return SimpleNamespace(rigid=(), flexible=(d,))
+
+    assert validity.roller_depth_warnings(None) == ()
+    assert validity.roller_depth_warnings(depth(1900.0, 0.72)) == ()
+    codes = [w.code for w in validity.roller_depth_warnings(depth(4500.0, 0.05))]
+    assert codes == ["roller_pressure", "kappa_range"]
+    high = validity.roller_depth_warnings(depth(1000.0, 6.0))
+    assert [w.code for w in high] == ["kappa_range"] and "\n" not in high[0].message
