@@ -264,15 +264,18 @@ def _solve_masked(c, a, g, q, act):
     """Pressures and approaches of contacts with the given active sets: for every distinct set S one
     solve of [C_SS, −1; A_S, 0]·[p_S; δ] = [g_S; Q] with all its contacts as right-hand sides."""
     m, n = g.shape
-    masks, which = np.unique(np.packbits(act, axis=1), axis=0, return_inverse=True)
-    if 4 * masks.shape[0] > m:                  # mostly distinct sets: one batched solve
+    packed = np.ascontiguousarray(np.packbits(act, axis=1))
+    keys = packed.view(np.dtype((np.void, packed.shape[1]))).reshape(-1)
+    _, first, which = np.unique(keys, return_index=True, return_inverse=True)
+    if 4 * first.size > m:                      # mostly distinct sets: one batched solve
         return _solve_batched(c, a, g, q, act)
-    masks = np.unpackbits(masks, axis=1, count=n).astype(bool)
+    order = np.argsort(which, kind="stable")
+    bounds = np.searchsorted(which[order], np.arange(first.size + 1))
     p = np.zeros((m, n))
     delta = np.zeros(m)
-    for k, mask in enumerate(masks):
-        rows = np.flatnonzero(which.reshape(-1) == k)
-        s = np.flatnonzero(mask)
+    for k in range(first.size):
+        rows = order[bounds[k]:bounds[k + 1]]
+        s = np.flatnonzero(act[first[k]])
         mat = np.zeros((s.size + 1, s.size + 1))
         mat[:-1, :-1] = c[np.ix_(s, s)]
         mat[:-1, -1] = -1.0
