@@ -364,7 +364,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     to_hours = 1.0e6 / (60.0 * bearing_speed_rpm)
     l10h = to_hours * (rating_N / equivalent_load_N) ** ROLLER_LIFE_EXPONENT
     q_ci, q_ce = lamina_ratings(case, prof.slices)
-    # the eccentric turns relative to the load (whose direction swings by tens of degrees in the disc
+    # the eccentric turns relative to the load (whose direction swings by about 100° in the disc
     # frame but does not follow the crank); the bore stands relative to it
     per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
     damage = float(np.mean(1.0 / per_angle))
