@@ -1,0 +1,159 @@
+"""The hysteresis loop of a reducer stage: the input locked, the output loaded 0 → +T → 0 → −T → 0.
+
+With the input locked the crankshafts do not turn relative to the carrier (the spur stage would
+let them turn by z_sun/z_planet of the output angle, a small part of the cycloid stage's effect,
+left out): the stage is held at one crank angle θ and only the torque on the carrier changes. Each
+load step is one contact solve of the stage (:func:`rvfem.solve.cycle.solve_pair`) on the same
+factorised discs and lazily filled column compliance, started from the step before it. The
+output rotation is the carrier rotation φ of that solve, in the torque convention of
+:mod:`rvfem.solve.cycle` (each disc's torque about its own centre, the eccentrics turning about the
+disc centre: the handbook's and Liu et al.'s convention).
+
+**Friction.** A pin's friction opposes its sliding in the load step. At a held crank angle the
+disc turns with the carrier, so a pin slides along the flank by the rotation increment: loading
+towards +T and unloading from −T slide one way (``slip = +1`` of
+:class:`rvfem.solve.cycle.OperatingPoint`), unloading from +T and loading towards −T the other way
+(``slip = −1``). Full sliding is assumed at every step (Coulomb, no sticking phase): at a reversal
+the loop crosses at once to the other friction branch, which is what a stick phase does over a
+torque interval of 2μ times the load (drawn as the vertical segment at the loop's tips).
+
+**Zero torque.** With a clearance (a profile modification, a bearing clearance) the stage is a
+mechanism at zero torque: its rotation is anywhere in the backlash. The loop's zeros are therefore
+solved at ±``ZERO_FRACTION``·T on the side the branch comes from (unloading from +T ends at +0,
+loading towards −T starts at −0), so each zero crossing shows the backlash as the jump between
+the two.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, solve_pair
+
+log = logging.getLogger(__name__)
+
+__all__ = ["ZERO_FRACTION", "HysteresisLoop", "loop_torques", "hysteresis_loop", "loop_at_torques"]
+
+ZERO_FRACTION = 1e-4
+"""The loop's zero torque, as a fraction of the loop's torque, solved on the side the branch comes
+from (module docstring)."""
+
+BRANCHES = ("loading +", "unloading +", "loading -", "unloading -")
+"""The four branches of the loop, in order."""
+
+BRANCH_SLIP = np.array([1, -1, -1, 1])
+"""Which way the carrier turns on each branch (the pins' sliding, :class:`OperatingPoint` ``slip``)."""
+
+
+@dataclass(frozen=True)
+class HysteresisLoop:
+    """The hysteresis loop of the stage at one crank angle.
+
+    Attributes
+    ----------
+    theta : float
+        Crank angle held, rad.
+    torque_Nm : ndarray (n,)
+        Output torque of each load step, N·m (the zeros at ±ZERO_FRACTION·T).
+    rotation_rad : ndarray (n,)
+        Output (carrier) rotation of each step, rad.
+    branch : ndarray (n,) of int
+        Index into :data:`BRANCHES` of each step.
+    rated_torque_Nm : float
+        The loop's torque T, N·m.
+    friction : float
+        Coulomb coefficient at the pins.
+    iterations : ndarray (n,) of int
+        Newton iterations of each step.
+    """
+
+    theta: float
+    torque_Nm: np.ndarray
+    rotation_rad: np.ndarray
+    branch: np.ndarray
+    rated_torque_Nm: float
+    friction: float
+    iterations: np.ndarray
+
+    def branch_curve(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """(torque, rotation) of branch ``k`` (:data:`BRANCHES`), in load-step order."""
+        sel = self.branch == k
+        return self.torque_Nm[sel], self.rotation_rad[sel]
+
+
+def loop_torques(torque_Nm: float, steps: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    """The torques of a loop of ``steps`` load steps (a multiple of 4, at least 8) and the branch
+    of each: 0 → +T, +T → 0, 0 → −T, −T → 0, each branch steps/4 equal steps, its zero end at
+    ±ZERO_FRACTION·T on the side it comes from.
+
+    Returns
+    -------
+    torques : ndarray (steps + 4,)
+        N·m; every branch starts at its own first point (a branch's start is the previous branch's
+        end except at the zeros, which are solved on both sides).
+    branch : ndarray (steps + 4,) of int
+    """
+    if steps < 8 or steps % 4:
+        raise ValueError(f"a hysteresis loop needs a multiple of 4 load steps, at least 8; got {steps}")
+    m = steps // 4
+    T = float(torque_Nm)
+    eps = ZERO_FRACTION * T
+    up = np.linspace(0.0, T, m + 1)
+    up[0] = eps
+    torques = [up, up[::-1], -up, -up[::-1]]
+    branch = [np.full(m + 1, k) for k in range(4)]
+    return np.concatenate(torques), np.concatenate(branch)
+
+
+def _slip(torque_from: float, torque_to: float) -> int:
+    """+1 when the step turns the carrier in the positive sense (the torque increases), −1 else."""
+    return 1 if torque_to >= torque_from else -1
+
+
+def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, friction: float,
+                    slips: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
+    """Solve the stage at crank angle θ (rad) at each torque in turn (N·m), each step started from
+    the step before it, with the pins' friction ``friction`` sliding as ``slips`` says (+1/−1 per
+    step; default: the way the torque moves from the step before, the first step as a loading one).
+
+    Returns the carrier rotation of each step (rad), the Newton iterations and the pair results.
+    """
+    torques = np.asarray(torques, dtype=float)
+    if slips is None:
+        slips = [_slip(a, b) for a, b in zip(np.concatenate([[0.0], torques[:-1]]), torques)]
+        slips[0] = 1 if torques[0] >= 0 else -1
+    pairs: list[PairResult] = []
+    for T, slip in zip(torques, slips):
+        op = OperatingPoint(float(T), float(friction), int(slip) if friction > 0 else 0)
+        pairs.append(solve_pair(stage, theta, pairs[-1] if pairs else None, op=op))
+    rotation = np.array([p.results[0].carrier_rotation for p in pairs])
+    iterations = np.array([p.results[0].solution.iterations for p in pairs])
+    return rotation, iterations, pairs
+
+
+def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, friction: float = 0.0,
+                    steps: int = 40) -> HysteresisLoop:
+    """The quasi-static hysteresis loop of the stage at crank angle θ (rad), the input locked.
+
+    Parameters
+    ----------
+    stage : ReducerStage
+        :func:`rvfem.solve.cycle.case_stage` of the case (both discs, crankshafts, support bearings).
+    theta : float
+        Crank angle held, rad.
+    torque_Nm : float
+        The loop's torque T (the rated torque), N·m.
+    friction : float
+        Coulomb coefficient at the pins; each step's friction opposes that step's sliding.
+    steps : int
+        Load steps (multiple of 4, ≥ 8): steps/4 per branch.
+    """
+    torques, branch = loop_torques(torque_Nm, steps)
+    rotation, iterations, _ = loop_at_torques(stage, theta, torques, friction, BRANCH_SLIP[branch])
+    log.info("hysteresis loop at %.2f°: %d steps, %d Newton iterations", math.degrees(theta),
+             len(torques), int(iterations.sum()))
+    return HysteresisLoop(float(theta), torques, rotation, branch, float(torque_Nm), float(friction), iterations)
