@@ -26,12 +26,14 @@ the two.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem.errors import ContactError
 from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, solve_pair
 
 log = logging.getLogger(__name__)
@@ -115,10 +117,12 @@ def _slip(torque_from: float, torque_to: float) -> int:
 
 
 def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, friction: float,
-                    slips: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
+                    slips: np.ndarray | None = None, start: PairResult | None = None
+                    ) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
     """Solve the stage at crank angle θ (rad) at each torque in turn (N·m), each step started from
-    the step before it, with the pins' friction ``friction`` sliding as ``slips`` says (+1/−1 per
-    step; default: the way the torque moves from the step before, the first step as a loading one).
+    the step before it (the first from ``start``, if given), with the pins' friction ``friction``
+    sliding as ``slips`` says (+1/−1 per step; default: the way the torque moves from the step
+    before, the first step as a loading one).
 
     Returns the carrier rotation of each step (rad), the Newton iterations and the pair results.
     """
@@ -127,12 +131,43 @@ def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, fric
         slips = [_slip(a, b) for a, b in zip(np.concatenate([[0.0], torques[:-1]]), torques)]
         slips[0] = 1 if torques[0] >= 0 else -1
     pairs: list[PairResult] = []
+    before = None if start is None else _pair_torque_Nm(stage, start)
     for T, slip in zip(torques, slips):
         op = OperatingPoint(float(T), float(friction), int(slip) if friction > 0 else 0)
-        pairs.append(solve_pair(stage, theta, pairs[-1] if pairs else None, op=op))
+        pairs.append(_step(stage, theta, op, pairs[-1] if pairs else start, before))
+        before = float(T)
     rotation = np.array([p.results[0].carrier_rotation for p in pairs])
     iterations = np.array([p.results[0].solution.iterations for p in pairs])
     return rotation, iterations, pairs
+
+
+MAX_SUBSTEPS = 6
+"""How many times a load step whose active set does not settle is halved (:func:`_step`)."""
+
+
+def _pair_torque_Nm(stage: ReducerStage, pair: PairResult) -> float:
+    """The output torque a solved pair carries, N·m."""
+    return float(np.sum(pair.torque_Nmm)) / 1000.0 * stage.first.case.loads.discs / stage.discs
+
+
+def _step(stage: ReducerStage, theta: float, op: OperatingPoint, start: PairResult | None,
+          before: float | None, depth: int = 0) -> PairResult:
+    """One load step from ``start`` (solved at the torque ``before``, N·m). A step whose active
+    set does not settle (a clearance that closes within the step can make the iteration cycle)
+    is reached through the torque halfway (the geometric mean towards
+    zero torque), up to :data:`MAX_SUBSTEPS` times."""
+    try:
+        return solve_pair(stage, theta, start, op=op)
+    except ContactError:
+        if start is None or before is None or depth >= MAX_SUBSTEPS:
+            raise
+    a, b = before, op.torque_Nm
+    # towards the zero end the stage softens (a clearance opens): halve geometrically there
+    mid = math.copysign(math.sqrt(a * b), b) if a * b > 0 and max(a / b, b / a) > 4.0 else 0.5 * (a + b)
+    half = dataclasses.replace(op, torque_Nm=mid)
+    log.debug("load step to %.4g N·m halved at %.2f°", op.torque_Nm, math.degrees(theta))
+    mid = _step(stage, theta, half, start, before, depth + 1)
+    return _step(stage, theta, op, mid, half.torque_Nm, depth + 1)
 
 
 def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, friction: float = 0.0,
@@ -153,7 +188,19 @@ def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, fric
         Load steps (multiple of 4, ≥ 8): steps/4 per branch.
     """
     torques, branch = loop_torques(torque_Nm, steps)
-    rotation, iterations, _ = loop_at_torques(stage, theta, torques, friction, BRANCH_SLIP[branch])
+    rotation = np.zeros(len(torques))
+    iterations = np.zeros(len(torques), dtype=int)
+    start = None
+    for k in range(len(BRANCHES)):
+        # each branch from its loaded end to its zero (the state of a step depends only on its
+        # torque and its sliding direction, so the order is free): every step near zero torque,
+        # where a clearance leaves the stage nearly a mechanism, starts from a loaded neighbour
+        sel = np.flatnonzero(branch == k)
+        sel = sel[np.argsort(-np.abs(torques[sel]), kind="stable")]
+        r, it, pairs = loop_at_torques(stage, theta, torques[sel], friction,
+                                       np.full(len(sel), BRANCH_SLIP[k]), start=start)
+        rotation[sel], iterations[sel] = r, it
+        start = pairs[0] if k % 2 == 0 else None
     log.info("hysteresis loop at %.2f°: %d steps, %d Newton iterations", math.degrees(theta),
              len(torques), int(iterations.sum()))
     return HysteresisLoop(float(theta), torques, rotation, branch, float(torque_Nm), float(friction), iterations)

@@ -1,0 +1,104 @@
+"""Transmission accuracy: the hysteresis loop with the input locked against independent references.
+
+* the linear limit (no clearance, linear pins and rollers): the loop is the existing solve scaled,
+  T/φ at every step equal to T_R/φ(T_R) of one :func:`rvfem.solve.cycle.solve_pair`;
+* an equidistant modification ΔR_rp as the only backlash, stiff limit: lost motion against the
+  closed form 2·ΔR_rp/(e·Zc) (Liu et al., ΔB_c = (180·60/π)·ΔE/(e·Zc) with ΔE = 2·ΔR_rp, the normal
+  clearance of both flanks; e·Zc because the carrier rotation turns the eccentrics about the
+  disc centre, docs/theory.md);
+* a crank-bearing clearance as the only backlash, stiff limit: lost motion against 2·g/r0 (Liu et
+  al.'s ΔB_tb = (180·60/π)·Δu/a_sp with Δu = 2g the diametral play, a_sp = r0 the crank circle);
+* friction: the unloading branch lies outside the loading branch by the friction's work, and
+  without a clearance the loop closes at zero torque (Coulomb friction vanishes with the load).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import coarse_case
+
+from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures
+from rvfem.mesh import mesh_case
+from rvfem.solve import cycle
+from rvfem.solve.accuracy import ZERO_FRACTION, hysteresis_loop
+
+T_R = 412.0
+
+
+@pytest.fixture(scope="module")
+def mesh_dir(tmp_path_factory):
+    return tmp_path_factory.mktemp("meshes")
+
+
+def _stiff_stage(mesh_dir, **tables):
+    """Disc ×1e3, linear pins 2e8 N/mm and rollers 3e7 N/mm (about 1e3 and 1e2 times the Hertz and
+    Palmgren secants at the rated load), rigid eccentrics: the stiff limit."""
+    tables.setdefault("pins", {}).update(model="linear", linear_stiffness_N_per_mm=2e8)
+    tables.setdefault("crank_bearing", {}).update(stiffness_law="linear", linear_stiffness_N_per_mm=3e7)
+    case = coarse_case("rv40e", **tables)
+    system = cycle.build_system(case, mesh_case(case, mesh_dir), stiffness_scale=1e3)
+    return cycle.build_stage(system, discs=2, influence=None)
+
+
+def test_linear_limit_is_the_existing_solve_scaled(mesh_dir):
+    case = coarse_case("rv40e", pins={"model": "linear", "linear_stiffness_N_per_mm": 2e5},
+                       crank_bearing={"stiffness_law": "linear", "linear_stiffness_N_per_mm": 3e5})
+    stage = cycle.case_stage(cycle.build_system(case, mesh_case(case, mesh_dir)))
+    theta = 0.3
+    loop = hysteresis_loop(stage, theta, T_R, steps=8)
+    for sign in (1.0, -1.0):
+        phi = cycle.solve_pair(stage, theta, op=cycle.OperatingPoint(sign * T_R)).results[0].carrier_rotation
+        side = np.sign(loop.torque_Nm) == sign
+        np.testing.assert_allclose(loop.torque_Nm[side] / loop.rotation_rad[side], sign * T_R / phi, rtol=1e-7)
+    fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
+    # compression-only linear springs without a gap: φ ∝ T on each side, so b/a is T/φ and the
+    # lost motion is the 3 % torque's elastic rotation, 0.03·(φ(+T) − φ(−T))
+    k = [T_R / (cycle.solve_pair(stage, theta, op=cycle.OperatingPoint(s * T_R)).results[0].carrier_rotation * s)
+         / ARCMIN_PER_RAD for s in (1.0, -1.0)]
+    assert fig.torsional_rigidity_Nm_per_arcmin == pytest.approx(0.5 * sum(k), rel=1e-7)
+    assert fig.lost_motion_arcmin == pytest.approx(0.03 * T_R * (1 / k[0] + 1 / k[1]), rel=1e-6)
+    # no play: the zero crossing's jump is the elastic rotation of the ±ZERO_FRACTION·T_R it is solved at
+    eps = ZERO_FRACTION * T_R
+    assert fig.backlash_arcmin == pytest.approx(eps * (1 / k[0] + 1 / k[1]), rel=1e-6)
+
+
+def test_equidistant_modification_lost_motion_against_closed_form(mesh_dir):
+    dr = 0.01                                                     # ΔR_rp, mm
+    stage = _stiff_stage(mesh_dir, cycloid={"modification": {"equidistant": dr}})
+    case = stage.first.case
+    closed = 2.0 * dr / (case.cycloid.eccentricity * case.cycloid.teeth) * ARCMIN_PER_RAD
+    for theta in np.radians([0.0, 4.5]):
+        loop = hysteresis_loop(stage, theta, T_R, steps=8)
+        fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
+        assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.02)
+        assert fig.backlash_arcmin == pytest.approx(closed, rel=0.02)
+        # e·Zp would be 2.6 % below: the model is on the e·Zc side of it
+        assert fig.backlash_arcmin > 2.0 * dr / (case.cycloid.eccentricity * case.pins.count) * ARCMIN_PER_RAD * 1.015
+
+
+def test_crank_bearing_clearance_lost_motion_against_closed_form(mesh_dir):
+    clearance = 0.01                                              # diametral, mm: play g = 5 µm
+    stage = _stiff_stage(mesh_dir, crank_bearing={"radial_clearance": clearance})
+    case = stage.first.case
+    closed = clearance / case.cranks.circle_radius * ARCMIN_PER_RAD     # 2·g/r0
+    loop = hysteresis_loop(stage, 0.0, T_R, steps=8)
+    fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
+    assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.02)
+    assert fig.backlash_arcmin == pytest.approx(closed, rel=0.02)
+
+
+def test_friction_opens_the_loop_and_closes_it_at_zero_torque(mesh_dir):
+    case = coarse_case("rv40e")
+    stage = cycle.case_stage(cycle.build_system(case, mesh_case(case, mesh_dir)))
+    free = hysteresis_loop(stage, 0.0, T_R, steps=8, friction=0.0)
+    rough = hysteresis_loop(stage, 0.0, T_R, steps=8, friction=0.05)
+    load, unload = rough.branch_curve(0), rough.branch_curve(1)
+    mid = free.branch_curve(0)
+    # at the same torque: loading (friction against the rotation) below frictionless below unloading
+    assert np.all(load[1][1:] < mid[1][1:]) and np.all(unload[1][::-1][1:] > mid[1][1:])
+    fig = accuracy_figures(rough.torque_Nm, rough.rotation_rad, rough.branch, T_R)
+    # Coulomb friction ∝ the load: no width at zero torque without a clearance
+    assert abs(fig.hysteresis_loss_arcmin) < 1e-3 * math.degrees(np.ptp(rough.rotation_rad)) * 60
