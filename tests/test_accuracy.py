@@ -23,7 +23,15 @@ from conftest import coarse_case
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures
 from rvfem.mesh import mesh_case
 from rvfem.solve import cycle
-from rvfem.solve.accuracy import ZERO_FRACTION, hysteresis_loop
+from rvfem.solve.accuracy import (
+    COMPONENTS,
+    ZERO_FRACTION,
+    compliance_shares,
+    hysteresis_loop,
+    rigid_kinematic_te,
+    stiffened_stage,
+    transmission_error,
+)
 
 T_R = 412.0
 
@@ -102,3 +110,38 @@ def test_friction_opens_the_loop_and_closes_it_at_zero_torque(mesh_dir):
     fig = accuracy_figures(rough.torque_Nm, rough.rotation_rad, rough.branch, T_R)
     # Coulomb friction ∝ the load: no width at zero torque without a clearance
     assert abs(fig.hysteresis_loss_arcmin) < 1e-3 * math.degrees(np.ptp(rough.rotation_rad)) * 60
+
+
+def test_kinematic_te_with_pitch_error_against_rigid_kinematics(mesh_dir):
+    # pitch error (Li et al.'s sin pattern, 3 µm) inside a 4 µm equidistant modification: every
+    # flank has a gap, so the rigid stage's no-load rotation is the first gap to close
+    case = coarse_case("rv40e", mesh={"size_flank": 0.3},
+                       pins={"model": "linear", "linear_stiffness_N_per_mm": 2e8},
+                       crank_bearing={"stiffness_law": "linear", "linear_stiffness_N_per_mm": 3e7},
+                       cycloid={"modification": {"equidistant": 0.004}, "pitch_error": {"amplitude": 0.003}})
+    system = cycle.build_system(case, mesh_case(case, mesh_dir), stiffness_scale=1e3)
+    stage = cycle.build_stage(system, discs=1, influence=None)
+    theta = np.radians(np.arange(0.0, 360.0, 30.0))
+    no_load, loaded = transmission_error(stage, theta, T_R)
+    rigid = rigid_kinematic_te(system.geometry, theta)
+    arcsec = 180.0 * 3600.0 / math.pi
+    assert np.ptp(rigid) * arcsec > 0.5                         # the pitch error shows
+    # the footprint spreads a pin's load over ±3 flank elements, whose mean lever differs from the
+    # contact point's by O(h²): 7e-4 arcsec at 0.6 mm, 1.4e-4 at 0.3 mm
+    np.testing.assert_allclose(no_load * arcsec, rigid * arcsec, atol=1e-3)
+    assert np.all(loaded > no_load)
+
+
+def test_compliance_shares_add_up_and_vanish_when_stiffened(mesh_dir):
+    case = coarse_case("rv40e", pins={"model": "linear", "linear_stiffness_N_per_mm": 2e5},
+                       crank_bearing={"stiffness_law": "linear", "linear_stiffness_N_per_mm": 3e5})
+    stage = cycle.case_stage(cycle.build_system(case, mesh_case(case, mesh_dir)))
+    shares = compliance_shares(stage, 0.0, T_R)
+    assert set(shares.shares) == set(COMPONENTS)
+    assert all(s > 0 for s in shares.shares.values())
+    # series compliances: the shares add up to one but for the load redistribution between parallel
+    # paths (pins, rollers, the two discs) that stiffening one component causes
+    assert shares.total == pytest.approx(1.0, abs=0.05)
+    stiff = stiffened_stage(stage, COMPONENTS[0])
+    again = compliance_shares(stiff, 0.0, T_R, components=COMPONENTS[:1])
+    assert again.shares[COMPONENTS[0]] < 2e-3

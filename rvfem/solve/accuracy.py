@@ -37,12 +37,14 @@ import numpy as np
 from rvfem.errors import ContactError
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import models
+from rvfem.geometry import pin_profile_contacts
 from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, build_system, solve_pair
 
 log = logging.getLogger(__name__)
 
 __all__ = ["ZERO_FRACTION", "HysteresisLoop", "loop_torques", "hysteresis_loop", "loop_at_torques", "COMPONENTS",
-           "stiffened_stage", "compliance_shares", "ComplianceShares"]
+           "stiffened_stage", "compliance_shares", "ComplianceShares", "transmission_error", "rigid_kinematic_te",
+           "te_orders"]
 
 ZERO_FRACTION = 1e-4
 """The loop's zero torque, as a fraction of the loop's torque, solved on the side the branch comes
@@ -121,7 +123,7 @@ def _slip(torque_from: float, torque_to: float) -> int:
 
 
 def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, friction: float,
-                    slips: np.ndarray | None = None, start: PairResult | None = None
+                    slips: np.ndarray | None = None, start: PairResult | None = None, start_torque=...
                     ) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
     """Solve the stage at crank angle θ (rad) at each torque in turn (N·m), each step started from
     the step before it (the first from ``start``, if given), with the pins' friction ``friction``
@@ -135,7 +137,7 @@ def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, fric
         slips = [_slip(a, b) for a, b in zip(np.concatenate([[0.0], torques[:-1]]), torques)]
         slips[0] = 1 if torques[0] >= 0 else -1
     pairs: list[PairResult] = []
-    before = None if start is None else _pair_torque_Nm(stage, start)
+    before = None if start is None else (_pair_torque_Nm(stage, start) if start_torque is ... else start_torque)
     for T, slip in zip(torques, slips):
         op = OperatingPoint(float(T), float(friction), int(slip) if friction > 0 else 0)
         pairs.append(_step(stage, theta, op, pairs[-1] if pairs else start, before))
@@ -158,13 +160,15 @@ def _step(stage: ReducerStage, theta: float, op: OperatingPoint, start: PairResu
           before: float | None, depth: int = 0) -> PairResult:
     """One load step from ``start`` (solved at the torque ``before``, N·m). A step whose active
     set does not settle (a clearance that closes within the step can make the iteration cycle)
-    is reached through the torque halfway (the geometric mean towards
+    (started from the same crank angle) is reached through the torque halfway (the geometric mean towards
     zero torque), up to :data:`MAX_SUBSTEPS` times."""
     try:
         return solve_pair(stage, theta, start, op=op)
     except ContactError:
-        if start is None or before is None or depth >= MAX_SUBSTEPS:
+        if start is None or depth >= MAX_SUBSTEPS:
             raise
+        if before is None or abs(before - op.torque_Nm) <= 1e-12 * abs(op.torque_Nm):
+            return solve_pair(stage, theta, None, op=op)      # a start from another crank angle: cold
     a, b = before, op.torque_Nm
     # towards the zero end the stage softens (a clearance opens): halve geometrically there
     mid = math.copysign(math.sqrt(a * b), b) if a * b > 0 and max(a / b, b / a) > 4.0 else 0.5 * (a + b)
@@ -326,3 +330,75 @@ def compliance_shares(stage: ReducerStage, theta: float, torque_Nm: float, frict
         except ValueError as exc:
             log.info("compliance share of %s left out: %s", c, exc)
     return ComplianceShares(a, shares, float(sum(shares.values())))
+
+
+# ------------------------------------------------------------------------------------------------
+# Transmission error over a revolution
+# ------------------------------------------------------------------------------------------------
+
+
+TE_LADDER = (1.0, 0.1, 0.01)
+"""The torques (fractions of the loaded torque) a no-load TE solve steps down through before
+ZERO_FRACTION (:func:`transmission_error`)."""
+
+
+def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float, friction: float = 0.0
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The output's deviation from the ideal ratio at each crank angle (rad), at no load and at
+    ``torque_Nm`` (N·m), rad.
+
+    TE = θ_out − θ_in/i (Liu et al., *Degradation law analysis and life estimation of transmission
+    accuracy of RV reducer based on tooth surface and bearing wear*, section 4): in the stage's frame
+    the ideal output position at crank angle θ is the kinematic one of the nominal profile, so TE is
+    the carrier rotation φ(θ) of the solve at that crank angle. No load: the stage solved at
+    +ZERO_FRACTION·T (the profile's gaps, modification and pitch error, closed on the driving side:
+    the kinematic TE), reached from the loaded solve through :data:`TE_LADDER` (a nearly unloaded
+    stage is nearly a mechanism; from a loaded start its active set settles). The running stage's
+    pins slide as the crank turns (``slip`` 0).
+
+    Returns
+    -------
+    no_load, loaded : ndarray (n,)
+        rad.
+    """
+    T = float(torque_Nm)
+    ladder = [T * f for f in TE_LADDER] + [ZERO_FRACTION * T]
+    no_load, loaded = [], []
+    start = None
+    for theta in np.asarray(thetas, dtype=float):
+        r, _, pairs = loop_at_torques(stage, float(theta), ladder, friction, np.zeros(len(ladder), dtype=int),
+                                      start=start, start_torque=None)
+        loaded.append(r[0])
+        no_load.append(r[-1])
+        start = pairs[0]
+    return np.array(no_load), np.array(loaded)
+
+
+def rigid_kinematic_te(geometry, thetas: np.ndarray) -> np.ndarray:
+    """The kinematic TE of a rigid stage (rad): the carrier rotation, positive, at which the first
+    pin gap closes with the disc turning rigidly with the carrier about its centre (the eccentrics
+    held): min over the pins with a positive lever of gap_j / ((ẑ × x_j)·n_j), x_j the contact point,
+    n_j the flank's outward normal. The independent reference of :func:`transmission_error` at no
+    load in the stiff limit (no clearance in the bearings)."""
+    out = []
+    for theta in np.asarray(thetas, dtype=float):
+        pc = pin_profile_contacts(geometry, float(theta))
+        x, n = np.asarray(pc.point), np.asarray(pc.normal)
+        lever = x[:, 0] * n[:, 1] - x[:, 1] * n[:, 0]
+        ok = lever > 1e-9 * np.abs(lever).max()
+        out.append(float(np.min(np.asarray(pc.gap)[ok] / lever[ok])))
+    return np.array(out)
+
+
+def te_orders(te: np.ndarray, thetas: np.ndarray, count: int = 8) -> list[tuple[int, float]]:
+    """The largest orders of a TE sampled at equally spaced crank angles over one revolution: (order
+    per crank revolution, amplitude in the units of ``te``), largest first, the mean left out."""
+    te = np.asarray(te, dtype=float)
+    n = te.size
+    amp = np.abs(np.fft.rfft(te - te.mean())) * 2.0 / n
+    if n % 2 == 0:
+        amp[-1] /= 2.0
+    span = float(thetas[-1] - thetas[0]) * n / max(n - 1, 1)
+    per_rev = 2.0 * math.pi / span if span > 0 else 1.0
+    order = np.argsort(-amp[1:])[:count] + 1
+    return [(int(round(k * per_rev)), float(amp[k])) for k in order]
