@@ -21,15 +21,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem.solve.accuracy import LOST_MOTION_FRACTION, loop_at_torques
+
 __all__ = ["ARCMIN_PER_RAD", "LOST_MOTION_FRACTION", "AccuracyFigures", "accuracy_figures", "mean_loop",
-           "branch_at"]
+           "branch_at", "quick_figures"]
 
 ARCMIN_PER_RAD = 180.0 * 60.0 / math.pi
 """arcmin per rad."""
 
-LOST_MOTION_FRACTION = 0.03
-"""The lost-motion torque as a fraction of the rated torque (±3 % T_R, the catalogues' and Liu et
-al.'s)."""
 
 
 @dataclass(frozen=True)
@@ -111,3 +110,16 @@ def mean_loop(rotations: np.ndarray) -> np.ndarray:
     """The loop averaged over crank angles: the mean rotation of each load step over the loops
     (``rotations`` (angles, steps), the same torques at every angle)."""
     return np.asarray(rotations, dtype=float).mean(axis=0)
+
+
+def quick_figures(stage, torque_Nm: float, friction: float = 0.0, theta: float = 0.0) -> dict:
+    """Torsional rigidity and lost motion of the stage at crank angle θ (rad) from six solves:
+    the loading and unloading branches at ±3 % and ±100 % of ``torque_Nm`` (N·m) only, on the
+    stage's factorised discs (``rvfem run``'s screen line). Returns the two summary keys."""
+    T = abs(float(torque_Nm))
+    lm = LOST_MOTION_FRACTION * T
+    plus, _, _ = loop_at_torques(stage, theta, [T, lm, lm], friction, [1, 1, -1])
+    minus, _, _ = loop_at_torques(stage, theta, [-T, -lm, -lm], friction, [-1, -1, 1])
+    a = (plus[0] - plus[1] + minus[1] - minus[0]) * 0.5 * ARCMIN_PER_RAD
+    return {"torsional_rigidity_Nm_per_arcmin": float((T - lm) / a),
+            "lost_motion_arcmin": float(0.5 * (plus[1] + plus[2] - minus[1] - minus[2]) * ARCMIN_PER_RAD)}

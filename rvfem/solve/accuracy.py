@@ -42,9 +42,13 @@ from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, build_sy
 
 log = logging.getLogger(__name__)
 
-__all__ = ["ZERO_FRACTION", "HysteresisLoop", "loop_torques", "hysteresis_loop", "loop_at_torques", "COMPONENTS",
+__all__ = ["LOST_MOTION_FRACTION", "ZERO_FRACTION", "HysteresisLoop", "loop_torques", "hysteresis_loop", "loop_at_torques", "COMPONENTS",
            "stiffened_stage", "compliance_shares", "ComplianceShares", "transmission_error", "rigid_kinematic_te",
            "te_orders"]
+
+LOST_MOTION_FRACTION = 0.03
+"""The lost-motion torque as a fraction of the rated torque (±3 % T_R, the catalogues' and Liu et
+al.'s, section 4.4)."""
 
 ZERO_FRACTION = 1e-4
 """The loop's zero torque, as a fraction of the loop's torque, solved on the side the branch comes
@@ -100,10 +104,10 @@ def loop_torques(torque_Nm: float, steps: int = 40) -> tuple[np.ndarray, np.ndar
 
     Returns
     -------
-    torques : ndarray (steps + 4,)
-        N·m; every branch starts at its own first point (a branch's start is the previous branch's
+    torques : ndarray (steps + 8,)
+        N·m, the ±3 % of T (the lost-motion torque) among them; every branch starts at its own first point (a branch's start is the previous branch's
         end except at the zeros, which are solved on both sides).
-    branch : ndarray (steps + 4,) of int
+    branch : ndarray (steps + 8,) of int
     """
     if steps < 8 or steps % 4:
         raise ValueError(f"a hysteresis loop needs a multiple of 4 load steps, at least 8; got {steps}")
@@ -112,8 +116,11 @@ def loop_torques(torque_Nm: float, steps: int = 40) -> tuple[np.ndarray, np.ndar
     eps = ZERO_FRACTION * T
     up = np.linspace(0.0, T, m + 1)
     up[0] = eps
+    up = np.unique(np.concatenate([up, [LOST_MOTION_FRACTION * T]]))   # the lost-motion torque solved, not interpolated
+    if T < 0:
+        up = up[::-1]
     torques = [up, up[::-1], -up, -up[::-1]]
-    branch = [np.full(m + 1, k) for k in range(4)]
+    branch = [np.full(len(up), k) for k in range(4)]
     return np.concatenate(torques), np.concatenate(branch)
 
 
