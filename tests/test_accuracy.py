@@ -183,3 +183,14 @@ def test_mirror_image_of_the_stage_gives_the_mirrored_loop(mesh_dir):
     # the loop itself is symmetric about the origin to the mesh's asymmetry
     asym = np.abs(loop.rotation_rad[n:] + loop.rotation_rad[:n]).max() / scale
     assert asym < 1e-4                                   # 8e-6 on this mesh
+
+
+def test_te_by_symmetry_equals_every_angle_solved(mesh_dir):
+    case = coarse_case("rv40e")
+    stage = cycle.case_stage(cycle.build_system(case, mesh_case(case, mesh_dir)))
+    theta = np.radians(np.arange(0.0, 360.0, 20.0))
+    no_load, loaded = transmission_error(stage, theta, T_R, 0.05)
+    direct = [cycle.solve_pair(stage, float(t), op=cycle.OperatingPoint(T_R, 0.05)).results[0].carrier_rotation
+              for t in theta]
+    np.testing.assert_allclose(loaded, direct, rtol=1e-7)
+    assert np.ptp(loaded) > 1e-3 * np.mean(loaded)           # the loaded TE ripples

@@ -38,7 +38,7 @@ from rvfem.errors import ContactError
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import models
 from rvfem.geometry import pin_profile_contacts
-from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, build_system, solve_pair
+from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, build_system, solve_pair, symmetry_plan
 
 log = logging.getLogger(__name__)
 
@@ -361,7 +361,9 @@ def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float
     +ZERO_FRACTION·T (the profile's gaps, modification and pitch error, closed on the driving side:
     the kinematic TE), reached from the loaded solve through :data:`TE_LADDER` (a nearly unloaded
     stage is nearly a mechanism; from a loaded start its active set settles). The running stage's
-    pins slide as the crank turns (``slip`` 0).
+    pins slide as the crank turns (``slip`` 0). Only the crank angles symmetry does not give are
+    solved (:func:`rvfem.solve.cycle.symmetry_plan`: the carrier rotation is unchanged by the turn
+    and by the swap of the discs).
 
     Returns
     -------
@@ -370,15 +372,19 @@ def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float
     """
     T = float(torque_Nm)
     ladder = [T * f for f in TE_LADDER] + [ZERO_FRACTION * T]
-    no_load, loaded = [], []
+    thetas = np.asarray(thetas, dtype=float)
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    # the carrier rotation repeats where the stage does (a turn by 2π/N, the pair swapped at π)
+    solve_at, source = symmetry_plan(thetas, min(s.symmetry for s in systems),
+                                     stage.discs == 2 and stage.mirrored_pairs)
+    no_load, loaded = {}, {}
     start = None
-    for theta in np.asarray(thetas, dtype=float):
-        r, _, pairs = loop_at_torques(stage, float(theta), ladder, friction, np.zeros(len(ladder), dtype=int),
+    for i in solve_at:
+        r, _, pairs = loop_at_torques(stage, float(thetas[i]), ladder, friction, np.zeros(len(ladder), dtype=int),
                                       start=start, start_torque=None)
-        loaded.append(r[0])
-        no_load.append(r[-1])
+        loaded[i], no_load[i] = r[0], r[-1]
         start = pairs[0]
-    return np.array(no_load), np.array(loaded)
+    return np.array([no_load[i] for i, _, _ in source]), np.array([loaded[i] for i, _, _ in source])
 
 
 def rigid_kinematic_te(geometry, thetas: np.ndarray) -> np.ndarray:
