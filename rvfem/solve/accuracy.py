@@ -130,12 +130,16 @@ def _slip(torque_from: float, torque_to: float) -> int:
 
 
 def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, friction: float,
-                    slips: np.ndarray | None = None, start: PairResult | None = None, start_torque=...
-                    ) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
+                    slips: np.ndarray | None = None, start: PairResult | None = None, start_torque=...,
+                    g_cache: dict | None = None) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
     """Solve the stage at crank angle θ (rad) at each torque in turn (N·m), each step started from
     the step before it (the first from ``start``, if given), with the pins' friction ``friction``
     sliding as ``slips`` says (+1/−1 per step; default: the way the torque moves from the step
-    before, the first step as a loading one).
+    before, the first step as a loading one). ``start_torque``: the torque ``start`` was solved at
+    (default: the torque it carries); None when ``start`` comes from another crank angle (a step
+    that does not settle from it is then solved cold). ``g_cache``: the contact compliance kept
+    between the steps (one per crank angle; a new one by default), so that the steps after the
+    first do not build it again (:func:`rvfem.solve.contact.solve_bodies`).
 
     Returns the carrier rotation of each step (rad), the Newton iterations and the pair results.
     """
@@ -143,11 +147,12 @@ def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, fric
     if slips is None:
         slips = [_slip(a, b) for a, b in zip(np.concatenate([[0.0], torques[:-1]]), torques)]
         slips[0] = 1 if torques[0] >= 0 else -1
+    cache = {} if g_cache is None else g_cache
     pairs: list[PairResult] = []
     before = None if start is None else (_pair_torque_Nm(stage, start) if start_torque is ... else start_torque)
     for T, slip in zip(torques, slips):
         op = OperatingPoint(float(T), float(friction), int(slip) if friction > 0 else 0)
-        pairs.append(_step(stage, theta, op, pairs[-1] if pairs else start, before))
+        pairs.append(_step(stage, theta, op, pairs[-1] if pairs else start, before, cache))
         before = float(T)
     rotation = np.array([p.results[0].carrier_rotation for p in pairs])
     iterations = np.array([p.results[0].solution.iterations for p in pairs])
@@ -164,25 +169,25 @@ def _pair_torque_Nm(stage: ReducerStage, pair: PairResult) -> float:
 
 
 def _step(stage: ReducerStage, theta: float, op: OperatingPoint, start: PairResult | None,
-          before: float | None, depth: int = 0) -> PairResult:
+          before: float | None, cache: dict, depth: int = 0) -> PairResult:
     """One load step from ``start`` (solved at the torque ``before``, N·m). A step whose active
     set does not settle (a clearance that closes within the step can make the iteration cycle)
-    (started from the same crank angle) is reached through the torque halfway (the geometric mean towards
+    is solved cold if ``start`` is another crank angle's, else reached through the torque halfway (the geometric mean towards
     zero torque), up to :data:`MAX_SUBSTEPS` times."""
     try:
-        return solve_pair(stage, theta, start, op=op)
+        return solve_pair(stage, theta, start, op=op, g_cache=cache)
     except ContactError:
         if start is None or depth >= MAX_SUBSTEPS:
             raise
         if before is None or abs(before - op.torque_Nm) <= 1e-12 * abs(op.torque_Nm):
-            return solve_pair(stage, theta, None, op=op)      # a start from another crank angle: cold
+            return solve_pair(stage, theta, None, op=op, g_cache=cache)   # a start from another angle: cold
     a, b = before, op.torque_Nm
     # towards the zero end the stage softens (a clearance opens): halve geometrically there
     mid = math.copysign(math.sqrt(a * b), b) if a * b > 0 and max(a / b, b / a) > 4.0 else 0.5 * (a + b)
     half = dataclasses.replace(op, torque_Nm=mid)
     log.debug("load step to %.4g N·m halved at %.2f°", op.torque_Nm, math.degrees(theta))
-    mid = _step(stage, theta, half, start, before, depth + 1)
-    return _step(stage, theta, op, mid, half.torque_Nm, depth + 1)
+    mid = _step(stage, theta, half, start, before, cache, depth + 1)
+    return _step(stage, theta, op, mid, half.torque_Nm, cache, depth + 1)
 
 
 def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, friction: float = 0.0,
@@ -206,6 +211,7 @@ def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, fric
     rotation = np.zeros(len(torques))
     iterations = np.zeros(len(torques), dtype=int)
     start = None
+    cache: dict = {}
     for k in range(len(BRANCHES)):
         # each branch from its loaded end to its zero (the state of a step depends only on its
         # torque and its sliding direction, so the order is free): every step near zero torque,
@@ -213,7 +219,7 @@ def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, fric
         sel = np.flatnonzero(branch == k)
         sel = sel[np.argsort(-np.abs(torques[sel]), kind="stable")]
         r, it, pairs = loop_at_torques(stage, theta, torques[sel], friction,
-                                       np.full(len(sel), BRANCH_SLIP[k]), start=start)
+                                       np.full(len(sel), BRANCH_SLIP[k]), start=start, g_cache=cache)
         rotation[sel], iterations[sel] = r, it
         start = pairs[0] if k % 2 == 0 else None
     log.info("hysteresis loop at %.2f°: %d steps, %d Newton iterations", math.degrees(theta),

@@ -1182,9 +1182,10 @@ def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | 
 
 
 def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None, *,
-               op: OperatingPoint | None = None) -> PairResult:
+               op: OperatingPoint | None = None, g_cache: dict | None = None) -> PairResult:
     """Solve the stage at crank angle θ (rad) and the operating point ``op`` (default the case's):
-    disc A at θ with disc B at θ + 180°."""
+    disc A at θ with disc B at θ + 180°. ``g_cache`` keeps the contact compliance between solves
+    of the same crank angle (:func:`rvfem.solve.contact.solve_bodies`)."""
     op = OperatingPoint.of(stage.first.case) if op is None else op
     systems, thetas, phases, sets = _bodies(stage, theta, op)
     case = stage.first.case
@@ -1194,7 +1195,7 @@ def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = Non
         [contact.Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.carrier_torque_Nmm(op),
         coupling=H, start=None if start is None else [r.solution for r in start.results],
         max_iterations=case.analysis.max_active_set_iterations,
-        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names)
+        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names, g_cache=g_cache)
     return _pair(stage, tuple(angle_result(s, th, sol, c)
                               for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)))
 
