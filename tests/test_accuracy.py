@@ -15,11 +15,12 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 
 import numpy as np
 import pytest
-from conftest import coarse_case
+from conftest import CASES_DIR, coarse_case
 
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures
 from rvfem.mesh import mesh_case
@@ -194,3 +195,26 @@ def test_te_by_symmetry_equals_every_angle_solved(mesh_dir):
               for t in theta]
     np.testing.assert_allclose(loaded, direct, rtol=1e-7)
     assert np.ptp(loaded) > 1e-3 * np.mean(loaded)           # the loaded TE ripples
+
+
+def test_hysteresis_command_writes_the_folder(tmp_path, capsys):
+    from rvfem.app.cli import main
+
+    out = tmp_path / "acc"
+    code = main(["hysteresis", str(CASES_DIR / "rv40e.toml"), "-o", str(out), "--angles", "2", "--steps", "8", "--te",
+                 "--cache-dir", str(tmp_path / "meshes"), "--set", "mesh.size_flank=0.6", "--set", "mesh.size_bore=0.6",
+                 "--set", "mesh.size_interior=4.0", "--set", "analysis.angle_step_deg=30"])
+    assert code == 0
+    s = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    for key in ("torsional_rigidity_Nm_per_arcmin", "lost_motion_arcmin", "hysteresis_loss_arcmin", "backlash_arcmin"):
+        assert math.isfinite(s[key]) and key in s["per_angle"][0]
+    assert s["torsional_rigidity_Nm_per_arcmin"] > 0 and s["lost_motion_arcmin"] > 0
+    assert abs(s["compliance_shares"]["total"] - 1.0) < 0.2
+    assert len(s["per_angle"]) == 2 and s["angles_deg"][1] == pytest.approx(360.0 / 39 / 2)
+    rows = (out / "hysteresis.csv").read_text(encoding="utf-8").splitlines()
+    assert len(rows) == 1 + 8 + 8 and rows[0].startswith("step,branch,torque_Nm,rotation_arcmin")
+    assert len((out / "te.csv").read_text(encoding="utf-8").splitlines()) == 1 + 12
+    for png in ("hysteresis", "compliance_shares", "transmission_error"):
+        assert (out / "plots" / f"{png}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "What the model leaves out" in (out / "accuracy.md").read_text(encoding="utf-8")
+    assert "torsional rigidity" in capsys.readouterr().out
