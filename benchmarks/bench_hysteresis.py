@@ -21,12 +21,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from rvfem.app.hysteresis import mesh_period_angles  # noqa: E402
-from rvfem.case.definition import load_case  # noqa: E402
-from rvfem.mesh import mesh_case  # noqa: E402
-from rvfem.solve import accuracy, cycle  # noqa: E402
-from rvfem.app.analysis import default_cache_dir  # noqa: E402
-from rvfem import fem  # noqa: E402
+from rvfem import fem
+from rvfem.app.analysis import default_cache_dir
+from rvfem.app.hysteresis import mesh_period_angles
+from rvfem.case.definition import load_case
+from rvfem.mesh import mesh_case
+from rvfem.solve import accuracy, cycle
 
 
 def main(argv=None) -> int:

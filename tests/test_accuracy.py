@@ -190,7 +190,7 @@ def test_te_by_symmetry_equals_every_angle_solved(mesh_dir):
     case = coarse_case("rv40e")
     stage = cycle.case_stage(cycle.build_system(case, mesh_case(case, mesh_dir)))
     theta = np.radians(np.arange(0.0, 360.0, 20.0))
-    no_load, loaded = transmission_error(stage, theta, T_R, 0.05)
+    _, loaded = transmission_error(stage, theta, T_R, 0.05)
     direct = [cycle.solve_pair(stage, float(t), op=cycle.OperatingPoint(T_R, 0.05)).results[0].carrier_rotation
               for t in theta]
     np.testing.assert_allclose(loaded, direct, rtol=1e-7)

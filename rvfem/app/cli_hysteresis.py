@@ -56,7 +56,7 @@ def _run(args: argparse.Namespace) -> int:
         te = s["transmission_error"]
         print(f"  transmission error p-p: no load {te['no_load_peak_to_peak_arcsec']:.3f} arcsec, loaded "
               f"{te['loaded_peak_to_peak_arcsec']:.3f} arcsec")
-    print(f"  not modelled: main bearings, carrier end plates, pin housing, input spur stage (see accuracy.md)")
+    print("  not modelled: main bearings, carrier end plates, pin housing, input spur stage (see accuracy.md)")
     print(f"  wall time {s['timings']['total_s']:.1f} s; results: {out}/ (summary.json, accuracy.md, hysteresis.csv)")
     return EXIT_OK
 

@@ -28,7 +28,7 @@ from rvfem.solve.cycle import build_system, case_stage
 
 log = logging.getLogger(__name__)
 
-__all__ = ["LEFT_OUT", "mesh_period_angles", "accuracy_study"]
+__all__ = ["LEFT_OUT", "accuracy_study", "mesh_period_angles"]
 
 LEFT_OUT = ("The stage model holds both discs, the pins (Hertz contact at the gaps of the modified profile), "
             "the crank-bearing rollers with their clearance, the crankshafts as beams and their support "

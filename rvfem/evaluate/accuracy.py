@@ -23,8 +23,15 @@ import numpy as np
 
 from rvfem.solve.accuracy import LOST_MOTION_FRACTION, loop_at_torques
 
-__all__ = ["ARCMIN_PER_RAD", "LOST_MOTION_FRACTION", "AccuracyFigures", "accuracy_figures", "mean_loop",
-           "branch_at", "quick_figures"]
+__all__ = [
+    "ARCMIN_PER_RAD",
+    "LOST_MOTION_FRACTION",
+    "AccuracyFigures",
+    "accuracy_figures",
+    "branch_at",
+    "mean_loop",
+    "quick_figures",
+]
 
 ARCMIN_PER_RAD = 180.0 * 60.0 / math.pi
 """arcmin per rad."""
@@ -84,7 +91,7 @@ def accuracy_figures(torque_Nm: np.ndarray, rotation_rad: np.ndarray, branch: np
     tq = np.asarray(torque_Nm, dtype=float)
     br = np.asarray(branch)
     lm = LOST_MOTION_FRACTION * T
-    at = lambda k, t: branch_at(tq, phi, br, k, t)                       # noqa: E731
+    at = lambda k, t: branch_at(tq, phi, br, k, t)
     low_p, top_p = at(0, lm), at(0, T)
     low_m, top_m = at(2, -lm), at(2, -T)
     rigidity = 0.5 * ((T - lm) / (top_p - low_p) + (T - lm) / (low_m - top_m))

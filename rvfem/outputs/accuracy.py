@@ -16,7 +16,7 @@ import numpy as np
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, LOST_MOTION_FRACTION
 from rvfem.outputs.plots import _figure, _save
 
-__all__ = ["write_loop_csv", "hysteresis_plot", "shares_plot", "write_te_csv", "te_plot", "accuracy_report"]
+__all__ = ["accuracy_report", "hysteresis_plot", "shares_plot", "te_plot", "write_loop_csv", "write_te_csv"]
 
 BRANCH_NAMES = ("loading +", "unloading +", "loading -", "unloading -")
 
@@ -51,9 +51,9 @@ def hysteresis_plot(path: str | os.PathLike, torque_Nm: np.ndarray, branch: np.n
     (t0, p0), (t1, p1) = figures.rigidity_points
     ax.plot([p0, p1], [t0, t1], ":", color="k", lw=1.5,
             label=f"rigidity b/a = {figures.torsional_rigidity_Nm_per_arcmin:.1f} N·m/arcmin")
-    ax.annotate("", xy=(p1, t0), xytext=(p0, t0), arrowprops=dict(arrowstyle="<->", color="k"))
+    ax.annotate("", xy=(p1, t0), xytext=(p0, t0), arrowprops={"arrowstyle": "<->", "color": "k"})
     ax.text(0.5 * (p0 + p1), t0, " a", va="bottom", ha="center")
-    ax.annotate("", xy=(p1, t1), xytext=(p1, t0), arrowprops=dict(arrowstyle="<->", color="k"))
+    ax.annotate("", xy=(p1, t1), xytext=(p1, t0), arrowprops={"arrowstyle": "<->", "color": "k"})
     ax.text(p1, 0.5 * (t0 + t1), " b", va="center", ha="left")
     (tp, mp), (tm, mm) = figures.lost_motion_points
     ax.plot([mm, mp], [tm, tp], "o-", color="tab:red", ms=5,

@@ -36,15 +36,34 @@ import numpy as np
 
 from rvfem.errors import ContactError
 from rvfem.fem.crankshaft import crankshaft_influence
-from rvfem.solve import models
 from rvfem.geometry import pin_profile_contacts
-from rvfem.solve.cycle import OperatingPoint, PairResult, ReducerStage, build_system, solve_pair, symmetry_plan
+from rvfem.solve import models
+from rvfem.solve.cycle import (
+    OperatingPoint,
+    PairResult,
+    ReducerStage,
+    build_system,
+    solve_pair,
+    symmetry_plan,
+)
 
 log = logging.getLogger(__name__)
 
-__all__ = ["LOST_MOTION_FRACTION", "ZERO_FRACTION", "HysteresisLoop", "loop_torques", "hysteresis_loop", "loop_at_torques", "COMPONENTS",
-           "stiffened_stage", "compliance_shares", "ComplianceShares", "transmission_error", "rigid_kinematic_te",
-           "te_orders"]
+__all__ = [
+    "COMPONENTS",
+    "LOST_MOTION_FRACTION",
+    "ZERO_FRACTION",
+    "ComplianceShares",
+    "HysteresisLoop",
+    "compliance_shares",
+    "hysteresis_loop",
+    "loop_at_torques",
+    "loop_torques",
+    "rigid_kinematic_te",
+    "stiffened_stage",
+    "te_orders",
+    "transmission_error",
+]
 
 LOST_MOTION_FRACTION = 0.03
 """The lost-motion torque as a fraction of the rated torque (±3 % T_R, the catalogues' and Liu et
@@ -276,7 +295,7 @@ def stiffened_stage(stage: ReducerStage, component: str) -> ReducerStage:
             cs = dataclasses.replace(cs, youngs_modulus=cs.youngs_modulus * STIFFEN, bending_stiffness_Nmm2=(
                 None if cs.bending_stiffness_Nmm2 is None else cs.bending_stiffness_Nmm2 * STIFFEN))
         else:
-            scale = (lambda v: None if v is None else (v * STIFFEN if np.isscalar(v)      # noqa: E731
+            scale = (lambda v: None if v is None else (v * STIFFEN if np.isscalar(v)
                                                        else tuple(x * STIFFEN for x in v)))
             cs = dataclasses.replace(cs, support_stiffness_N_per_mm=scale(cs.support_stiffness_N_per_mm),
                                      carrier_stiffness_N_per_mm=scale(cs.carrier_stiffness_N_per_mm))
