@@ -48,7 +48,7 @@ from rvfem.case.definition import (
     parse_override,
 )
 from rvfem.case.registry import bearing_model_names
-from rvfem.errors import CaseError
+from rvfem.errors import CaseError, ContactError
 from rvfem.evaluate import (
     attribution,
     compare,
@@ -59,6 +59,7 @@ from rvfem.evaluate import (
     roller_life,
     validity,
 )
+from rvfem.evaluate import accuracy as accuracy_eval
 from rvfem.evaluate.compare import equal_share_forces
 from rvfem.evaluate.postprocess import max_load_index
 from rvfem.evaluate.rigid import equivalent_load
@@ -718,6 +719,10 @@ class Analysis:
     roller_depth : rvfem.evaluate.roller_life.CrankBearingDepth or None
         The crank bearing in depth (slice pressures, film, κ, a_ISO, L_nm, L10r; rigid and flexible);
         None for a bearing model without discrete rollers.
+    accuracy : dict or None
+        Torsional rigidity (N·m/arcmin) and lost motion (arcmin) of the stage at the case's torque
+        from a few points of the hysteresis loop at crank angle 0 (:func:`run_accuracy`); None when
+        they could not be solved.
     """
 
     case: Case
@@ -739,6 +744,7 @@ class Analysis:
     references: rigid.References | None = None
     warnings: tuple = ()
     roller_depth: Any = None
+    accuracy: dict | None = None
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -1192,7 +1198,9 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
                                                                    duty.flexible.service_life_h))
         stages.end("duty_cycle", t)
 
+    accuracy, accuracy_seconds = _timed(run_accuracy, system)
     timings = dict(stages.seconds)
+    timings["accuracy"] = accuracy_seconds
     if pending is not None:
         timings["attribution_compute"] = attribution_seconds
     timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
@@ -1201,7 +1209,7 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
                       theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
                       comparison=comparison, stress=stress, hertz=roller_hertz,
                       torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
-                      attribution=attribution, references=references)
+                      attribution=attribution, references=references, accuracy=accuracy)
     return _with_roller_depth(result)
 
 
@@ -1214,6 +1222,21 @@ def _with_roller_depth(result: Analysis) -> Analysis:
         result.timings["roller_depth"] = depth.seconds
     return dataclasses.replace(result, roller_depth=depth, warnings=validity.analysis_warnings(result)
                                + validity.roller_depth_warnings(depth))
+
+
+def run_accuracy(system) -> dict | None:
+    """Torsional rigidity and lost motion of the case's stage at its torque and pin friction, at
+    crank angle 0, from six solves on the factorised disc (:func:`rvfem.evaluate.accuracy.quick_figures`;
+    ``rvfem hysteresis`` gives the whole loop averaged over a mesh period). None if a solve fails
+    (logged): the run's other results do not depend on it."""
+    case = system.case
+    try:
+        figures = accuracy_eval.quick_figures(cycle_module.case_stage(system), abs(float(case.loads.torque_Nm)),
+                                              float(case.analysis.friction))
+    except (ContactError, ValueError) as exc:
+        log.warning("torsional rigidity and lost motion not computed: %s", exc)
+        return None
+    return {**figures, "crank_angle_deg": 0.0, "torque_Nm": abs(float(case.loads.torque_Nm))}
 
 
 def attribution_of(system, thetas, cycle):

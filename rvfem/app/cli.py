@@ -410,3 +410,7 @@ if __name__ == "__main__":  # pragma: no cover
 
 
 SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY)
+
+from rvfem.app.cli_hysteresis import HYSTERESIS  # noqa: E402  (the accuracy subcommand, its own module)
+
+SUBCOMMANDS = (*SUBCOMMANDS, HYSTERESIS)

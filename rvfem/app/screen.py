@@ -157,10 +157,11 @@ def summary_text(summary: dict) -> str:
     lines += [""] + reference_lines(summary["references"])
     lines += _stage_lines(summary, handbook)
     lines += [""] + stress_lines(summary["stress"]) + [
-        f"  pins in contact {pins['min']}–{pins['max']} of {pins['of']}; torsional stiffness "
+        f"  pins in contact {pins['min']}–{pins['max']} of {pins['of']}; disc torque / mean carrier rotation "
         f"{summary['torsional_stiffness_Nm_per_arcmin']:.1f} N·m/arcmin per disc; equilibrium residual "
         f"{summary['equilibrium_residual']:.1e}",
     ]
+    lines += _accuracy_lines(summary.get("accuracy"))
     lines.append(_hertz_line(summary["hertz"]))
     lines += roller_depth_lines(summary.get("crank_bearing_depth"))
     lines += _duty_lines(summary.get("duty_cycle"))
@@ -293,3 +294,12 @@ def rigid_text(report: dict) -> str:
             f"(from the shortest rated life {_life(duty['rated_life_h'])} h)")
     lines += warning_lines(report.get("warnings", []))
     return "\n".join(lines)
+
+
+def _accuracy_lines(acc: dict | None) -> list[str]:
+    """The transmission-accuracy line of ``rvfem run``: rigidity and lost motion of the stage."""
+    if not acc:
+        return []
+    return [f"  hysteresis loop at {acc['torque_Nm']:g} N·m, input locked, crank angle {acc['crank_angle_deg']:g}°: "
+            f"torsional rigidity {acc['torsional_rigidity_Nm_per_arcmin']:.1f} N·m/arcmin, lost motion "
+            f"{acc['lost_motion_arcmin']:.3f} arcmin (stage only; rvfem hysteresis for the loop)"]

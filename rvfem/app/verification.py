@@ -35,6 +35,7 @@ from skfem import Basis, ElementVector, FacetBasis, Functional, LinearForm, asm
 from rvfem import fem
 from rvfem.case.definition import RollerProfile, load_case
 from rvfem.evaluate import compare, lubrication, rigid, roller_life, roller_slices
+from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures
 from rvfem.evaluate.hertz import composite_modulus, hertz_peak_pressure, reduced_radius
 from rvfem.evaluate.iso281 import (
     bearing_speed_rpm,
@@ -50,7 +51,7 @@ from rvfem.evaluate.rigid import (
 from rvfem.fem import crankshaft
 from rvfem.fem.model import _scalar_element
 from rvfem.mesh import gmsh_session, mesh_case
-from rvfem.solve import contact, cycle, models
+from rvfem.solve import accuracy, contact, cycle, models
 from rvfem.solve.cycle import build_system
 
 log = logging.getLogger(__name__)
@@ -753,7 +754,7 @@ def clearance_section(discs: _Discs) -> Section:
 
 
 def roller_depth_section() -> Section:
-    """10. The crank bearing in depth: Hertz check of Zhang et al., the logarithmic profile's design
+    """11. The crank bearing in depth: Hertz check of Zhang et al., the logarithmic profile's design
     property, the lamina life at the rating, the film against a second formula, the crankshaft slope."""
     zhang = ("Zhang et al., *Contact load and elastohydrodynamic lubrication analysis of eccentric bearings in RV "
              "reducer considering the effects of roller profile modification*")
@@ -787,10 +788,57 @@ def roller_depth_section() -> Section:
         Check("crankshaft slope at a support under a central load, rad/N",
               "Roark: P·L²/(16·EI)", span**2 / (16.0 * ei), slope, slope / (span**2 / (16.0 * ei)) - 1.0, 1e-6),
     )
-    return Section("10. The crank bearing in depth",
+    return Section("11. The crank bearing in depth",
                    "The slice model of a roller on an elastic half-space, the ISO/TS 16281 lamina life, the EHL film "
                    "and the crankshaft's slope at the eccentrics (docs/theory.md § 12). The slice model against a "
                    "two-dimensional half-space solve is in tests/test_roller_slices.py.", checks)
+def _stiff_accuracy_stage(discs: _Discs, *overrides: str):
+    """The coarse solid RV-40E in the stiff limit of the accuracy checks: disc ×10³, linear pins of
+    2·10⁸ N/mm and rollers of 3·10⁷ N/mm, rigid eccentrics, both discs; ``overrides`` add the play."""
+    case = _case("rv40e_solid", "pins.model='linear'", "pins.linear_stiffness_N_per_mm=2e8",
+                 "crank_bearing.stiffness_law='linear'", "crank_bearing.linear_stiffness_N_per_mm=3e7", *overrides)
+    system = build_system(case, mesh_case(case, discs.cache), stiffness_scale=1e3)
+    return cycle.build_stage(system, discs=2, influence=None)
+
+
+def accuracy_section(discs: _Discs) -> Section:
+    T = 412.0
+    linear = _case("rv40e_solid", "pins.model='linear'", "pins.linear_stiffness_N_per_mm=2e5",
+                   "crank_bearing.stiffness_law='linear'", "crank_bearing.linear_stiffness_N_per_mm=3e5")
+    stage = cycle.case_stage(build_system(linear, mesh_case(linear, discs.cache)))
+    loop = accuracy.hysteresis_loop(stage, 0.3, T, steps=8)
+    phi = cycle.solve_pair(stage, 0.3, op=cycle.OperatingPoint(T)).results[0].carrier_rotation
+    plus = loop.torque_Nm > 0
+    e_lin = float(np.abs(loop.torque_Nm[plus] / loop.rotation_rad[plus] / (T / phi) - 1.0).max())
+    dr, g2 = 0.01, 0.01
+    eq = _stiff_accuracy_stage(discs, f"cycloid.modification.equidistant={dr}")
+    fig_eq = accuracy_figures(*_loop_arrays(accuracy.hysteresis_loop(eq, 0.0, T, steps=8)), T)
+    c = eq.first.case
+    ref_eq = 2.0 * dr / (c.cycloid.eccentricity * c.cycloid.teeth) * ARCMIN_PER_RAD
+    cl = _stiff_accuracy_stage(discs, f"crank_bearing.radial_clearance={g2}")
+    fig_cl = accuracy_figures(*_loop_arrays(accuracy.hysteresis_loop(cl, 0.0, T, steps=8)), T)
+    ref_cl = g2 / c.cranks.circle_radius * ARCMIN_PER_RAD
+    liu = ("Liu et al., Degradation law analysis and life estimation of transmission accuracy of RV reducer "
+           "based on tooth surface and bearing wear, § 4.4")
+    checks = (
+        Check("linear pins and rollers, no play: T/φ at every step of the + branches / T_R/φ(T_R)",
+              "one stage solve at T_R (φ ∝ T without gaps)", 1.0, 1.0 + e_lin, e_lin, 1e-7),
+        Check("lost motion, equidistant ΔR_rp = 10 µm only, stiff limit, arcmin",
+              "ΔB_c = (180·60/π)·ΔE/(e·Zc), ΔE = 2ΔR_rp (" + liu + ")", ref_eq, fig_eq.lost_motion_arcmin,
+              fig_eq.lost_motion_arcmin / ref_eq - 1.0, 0.02),
+        Check("lost motion, crank-bearing clearance 10 µm only, stiff limit, θ = 0, arcmin",
+              "ΔB_tb = (180·60/π)·Δu/a_sp, a_sp = r0 (" + liu + ")", ref_cl, fig_cl.lost_motion_arcmin,
+              fig_cl.lost_motion_arcmin / ref_cl - 1.0, 0.02),
+    )
+    return Section("10. Transmission accuracy: the hysteresis loop",
+                   "Coarse RV-40E solid disc, both discs on one carrier, input locked (crank angle held), the "
+                   "loop 0 → +412 → 0 → −412 → 0 N·m in 8 steps. Stiff limit: disc ×10³, linear pins 2·10⁸ N/mm, "
+                   "rollers 3·10⁷ N/mm, rigid eccentrics. The closed forms use e·Zc because the carrier rotation "
+                   "turns the eccentrics about the disc centre (docs/theory.md § 9b).", checks)
+
+
+def _loop_arrays(loop) -> tuple:
+    return loop.torque_Nm, loop.rotation_rad, loop.branch
 
 
 def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
@@ -803,6 +851,7 @@ def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
         sections.append(convergence_section(discs))
         sections.append(reducer_section(discs))
         sections.append(clearance_section(discs))
+        sections.append(accuracy_section(discs))
         sections.append(roller_depth_section())
     return sections
 

@@ -657,6 +657,14 @@ def _piece_roller_depth(a, ctx: SummaryContext) -> dict:
         "max_slope_mrad": depth.max_slope_mrad,
         "bearings": bearings,
     }}
+def _piece_accuracy(a, ctx: SummaryContext) -> dict:
+    """Torsional rigidity and lost motion at the case's torque (a few points of the hysteresis loop)."""
+    acc = getattr(a, "accuracy", None)
+    if not acc:
+        return {}
+    return {"accuracy": {"torsional_rigidity_Nm_per_arcmin": acc["torsional_rigidity_Nm_per_arcmin"],
+                         "lost_motion_arcmin": acc["lost_motion_arcmin"],
+                         "crank_angle_deg": acc["crank_angle_deg"], "torque_Nm": acc["torque_Nm"]}}
 
 
 SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
@@ -672,6 +680,7 @@ SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_reducer_stage,
     _piece_attribution,
     _piece_roller_depth,
+    _piece_accuracy,
     _piece_files,
 )
 """The pieces of ``summary.json`` in order: each ``piece(analysis, context) -> dict`` of top-level

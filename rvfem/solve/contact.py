@@ -887,7 +887,7 @@ def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, to
 def solve_bodies(bodies: list[Body], torque: float | None, *, coupling: np.ndarray | None = None,
                  start: list[AngleSolution] | None = None, max_iterations: int = 50, label: str = "",
                  tol_gap: float = 1e-9, names: list[str] | None = None,
-                 rigid_dofs: tuple[int, ...] = (0, 1, 2)) -> list[AngleSolution]:
+                 rigid_dofs: tuple[int, ...] = (0, 1, 2), g_cache: dict | None = None) -> list[AngleSolution]:
     """Solve the contacts of several bodies that share one carrier rotation.
 
     Each body has its own contacts and rigid-body motion (and is in equilibrium on its own); the
@@ -908,13 +908,15 @@ def solve_bodies(bodies: list[Body], torque: float | None, *, coupling: np.ndarr
         Warm start, one per body.
     max_iterations, label, tol_gap, names, rigid_dofs
         As in :func:`solve_contact` (``names`` lists the contacts of all bodies in order).
+    g_cache : dict, optional
+        Keeps the contact compliance between solves of the same contacts (:class:`NewtonOptions`).
 
     Returns
     -------
     list of AngleSolution
         One per body; ``residual["torque_Nmm"]`` is the body's share of the torque.
     """
-    options = NewtonOptions(max_iterations, label, tol_gap, names, tuple(rigid_dofs))
+    options = NewtonOptions(max_iterations, label, tol_gap, names, tuple(rigid_dofs), g_cache)
     sizes = [b.cset.W.shape[1] for b in bodies]
     if start is not None and [s.force.shape for s in start] != [(n,) for n in sizes]:
         start = None
@@ -979,6 +981,10 @@ class NewtonOptions:
         Contact names for error messages.
     rigid_dofs : tuple of int
         Rigid-body motions of each body that are unknowns (0: x, 1: y, 2: rotation).
+    g_cache : dict or None
+        Keeps the contact compliance G of each set of bodies between solves (:class:`ContactProblem`):
+        solves of the same contacts at other torques (a hysteresis loop) fill it once. None: each
+        solve builds its own.
     """
 
     max_iterations: int = 50
@@ -986,6 +992,7 @@ class NewtonOptions:
     tol_gap: float = 1e-9
     names: list | None = None
     rigid_dofs: tuple = (0, 1, 2)
+    g_cache: dict | None = None
 
     def name(self, i: int) -> str:
         return self.names[i] if self.names else str(i)
@@ -1007,7 +1014,7 @@ class ContactProblem:
     """
 
     def __init__(self, bodies: list, torque: float | None, coupling: np.ndarray | None = None,
-                 rigid_dofs: tuple = (0, 1, 2)):
+                 rigid_dofs: tuple = (0, 1, 2), g_cache: dict | None = None):
         self.bodies = bodies
         self.nb = nb = len(bodies)
         csets = [b.cset for b in bodies]
@@ -1037,6 +1044,23 @@ class ContactProblem:
         self.G = np.zeros((nc, nc)) if coupling is None else np.array(coupling, dtype=float)
         self.filled = np.zeros(nc, dtype=bool)
         self._open_tangent = None
+        if g_cache is not None:
+            self._share_G(g_cache, csets, coupling)
+
+    def _share_G(self, cache: dict, csets: list, coupling) -> None:
+        """Take G and its filled columns from ``cache`` if the same contact sets (by identity), the
+        same compliances and the same coupling filled them before, else put this problem's there.
+        G depends on the contacts' weights, the compliance and the coupling only, and its columns
+        never change once computed, so the arrays are shared and filled further in place."""
+        key = tuple(id(c) for c in csets) + tuple(id(b.compliance) for b in self.bodies)
+        entry = cache.get(key)
+        same = (entry is not None and all(a is b for a, b in zip(entry[0], csets))
+                and ((entry[1] is None and coupling is None)
+                     or (entry[1] is not None and coupling is not None and np.array_equal(entry[1], coupling))))
+        if same:
+            self.G, self.filled = entry[2], entry[3]
+        else:
+            cache[key] = (list(csets), None if coupling is None else np.array(coupling), self.G, self.filled)
 
     def _weights(self, k: int, body) -> tuple:
         """Fill body k's rows of R_c and R_L; its weights on the interface columns it touches."""
@@ -1302,7 +1326,7 @@ def _newton(bodies, torque, coupling, start, options: NewtonOptions, engaged=Non
     Converged when the active set is unchanged by a step, every body and the carrier are in
     equilibrium, the spring laws hold to 1e-8 of the force scale and the active gaps are closed to
     ``tol_gap``."""
-    problem = ContactProblem(bodies, torque, coupling, options.rigid_dofs)
+    problem = ContactProblem(bodies, torque, coupling, options.rigid_dofs, options.g_cache)
     p = problem
     it = initial_iterate(problem, start, options.tol_gap)
     kappa = penalty_scale(problem, it.active)

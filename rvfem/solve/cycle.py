@@ -137,10 +137,16 @@ class OperatingPoint:
         modelled alone carries T_out/discs.
     friction : float
         Coulomb coefficient μ at the pins (0: frictionless).
+    slip : int
+        Which way the pins slide on the flanks. 0 (default): as the crank turns (the running
+        reducer). +1 / −1: as the disc turns with the carrier in the positive / negative sense at a
+        held crank angle (a load step of the hysteresis loop with the input locked,
+        :mod:`rvfem.solve.accuracy`).
     """
 
     torque_Nm: float
     friction: float = 0.0
+    slip: int = 0
 
     @classmethod
     def of(cls, case: Case) -> "OperatingPoint":
@@ -325,9 +331,10 @@ def pin_contacts(system: DiscSystem, theta: float, friction: float, pc=None):
     return pin_contacts_many(system, [pc], friction)[0]
 
 
-def pin_contacts_many(system: DiscSystem, pcs, friction: float) -> list:
+def pin_contacts_many(system: DiscSystem, pcs, friction: float, slip: int = 0) -> list:
     """:func:`pin_contacts` of many crank angles from their :class:`rvfem.geometry.PinContacts`:
-    the closest points of all of them located on the footprint grid at once."""
+    the closest points of all of them located on the footprint grid at once. ``slip`` as in
+    :class:`OperatingPoint` (0: the pins slide as the crank turns)."""
 
     case = system.case
     prof = system.interface.grids["profile"]
@@ -346,8 +353,14 @@ def pin_contacts_many(system: DiscSystem, pcs, friction: float) -> list:
         # to the disc (the pins are taken as not rolling in their grooves); the friction force on
         # the disc drags its surface along with the pin: μ·λ·sign(v·t)·t, t the profile tangent
         h = 1e-6
-        vel = np.concatenate([(pin_centres(case, pc.theta + h) - pin_centres(case, pc.theta - h)) / (2 * h)
-                              for pc in pcs])
+        if slip:
+            # a load step at a held crank angle: the disc turns with the carrier about its centre
+            # (the torque convention), so a pin moves relative to the disc by −slip·ẑ × c
+            c = np.concatenate([pin_centres(case, pc.theta) for pc in pcs])
+            vel = -float(np.sign(slip)) * np.stack([-c[:, 1], c[:, 0]], axis=1)
+        else:
+            vel = np.concatenate([(pin_centres(case, pc.theta + h) - pin_centres(case, pc.theta - h)) / (2 * h)
+                                  for pc in pcs])
         tangent = np.stack([-inward[:, 1], inward[:, 0]], axis=1)
         slide = np.sign(np.einsum("ij,ij->i", vel, tangent))
         load_cols, pin_load = prof.columns_at(s, inward + mu * slide[:, None] * tangent)
@@ -391,11 +404,12 @@ def contact_sets(system: DiscSystem, thetas, op: OperatingPoint) -> list[tuple[C
     contacts come from (:func:`_contact_model_key`)."""
 
     model = _contact_model_key(system)
-    keys = [(round(float(theta), 12), float(op.friction)) + model for theta in thetas]
+    keys = [(round(float(theta), 12), float(op.friction)) + model + ((op.slip,) if op.slip else ())
+            for theta in thetas]
     missing = {key: float(theta) for key, theta in zip(keys, thetas) if key not in system.contact_sets}
     if missing:
         angles = list(missing.values())
-        pins = pin_contacts_many(system, pin_profile_contacts_many(system.geometry, angles), op.friction)
+        pins = pin_contacts_many(system, pin_profile_contacts_many(system.geometry, angles), op.friction, op.slip)
         bearings = bearing_contacts_many(system.bearings, system.interface, crank_centres(system.case), angles)
         for key, p, b in zip(missing, pins, bearings):
             system.contact_sets[key] = _contact_set(system, p, b)
@@ -1168,9 +1182,10 @@ def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | 
 
 
 def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None, *,
-               op: OperatingPoint | None = None) -> PairResult:
+               op: OperatingPoint | None = None, g_cache: dict | None = None) -> PairResult:
     """Solve the stage at crank angle θ (rad) and the operating point ``op`` (default the case's):
-    disc A at θ with disc B at θ + 180°."""
+    disc A at θ with disc B at θ + 180°. ``g_cache`` keeps the contact compliance between solves
+    of the same crank angle (:func:`rvfem.solve.contact.solve_bodies`)."""
     op = OperatingPoint.of(stage.first.case) if op is None else op
     systems, thetas, phases, sets = _bodies(stage, theta, op)
     case = stage.first.case
@@ -1180,7 +1195,7 @@ def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = Non
         [contact.Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.carrier_torque_Nmm(op),
         coupling=H, start=None if start is None else [r.solution for r in start.results],
         max_iterations=case.analysis.max_active_set_iterations,
-        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names)
+        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names, g_cache=g_cache)
     return _pair(stage, tuple(angle_result(s, th, sol, c)
                               for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)))
 
