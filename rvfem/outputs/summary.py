@@ -53,6 +53,7 @@ from rvfem.evaluate.postprocess import user_feature_name
 from rvfem.evaluate.rigid import references
 from rvfem.geometry import crank_centres
 from rvfem.outputs import plots, render, tables, vtkio
+from rvfem.outputs.design_summary import piece_mass_strength
 from rvfem.outputs.plots import mesh_plot
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
@@ -624,6 +625,7 @@ SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_bearings,
     _piece_cycle,
     _piece_stress,
+    piece_mass_strength,
     _piece_hertz,
     _piece_duty_cycle,
     _piece_reducer_stage,

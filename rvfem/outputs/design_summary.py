@@ -1,0 +1,62 @@
+"""The mass-and-strength piece of ``summary.json`` (:data:`rvfem.outputs.summary.SUMMARY_PIECES`).
+
+Top-level keys scripts can rely on: ``disc_mass_kg``, ``disc_polar_inertia_kg_mm2``,
+``static_safety_factor``, ``fatigue_safety_factor`` and ``fatigue_safety_factor_at`` (the hot spot
+with the smallest factor), and the details under ``mass_strength`` (docs/outputs.md).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
+from rvfem.evaluate.postprocess import user_feature_name
+from rvfem.evaluate.strength import FATIGUE_CRITERION
+
+__all__ = ["piece_mass_strength", "mass_strength_dict"]
+
+
+def _where(peak) -> dict | None:
+    if peak is None:
+        return None
+    return {"x_mm": peak.x_mm, "y_mm": peak.y_mm, "theta_deg": peak.theta_deg,
+            "feature": None if peak.feature is None else user_feature_name(peak.feature)}
+
+
+def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
+    """The keys of the piece from a :class:`~rvfem.evaluate.design_checks.DesignChecks`."""
+    m = checks.mass
+    gov = checks.fatigue_governing
+    return {
+        "disc_mass_kg": m.mass_kg,
+        "disc_polar_inertia_kg_mm2": m.polar_inertia_kg_mm2,
+        "static_safety_factor": finite_or_none(checks.static_safety_factor),
+        "fatigue_safety_factor": None if gov is None else finite_or_none(gov.safety_factor),
+        "fatigue_safety_factor_at": None if gov is None else {"hot_spot": gov.name, **_where(gov.peak)},
+        "mass_strength": {
+            "disc_area_mm2": m.area_mm2,
+            "disc_polar_moment_mm4": m.polar_mm4,
+            "solid_disc_mass_kg": m.solid_mass_kg,
+            "solid_disc_polar_inertia_kg_mm2": m.solid_polar_inertia_kg_mm2,
+            "mass_saving_percent": m.mass_saving_percent,
+            "inertia_saving_percent": m.inertia_saving_percent,
+            "density_kg_m3": m.density_kg_m3,
+            "thickness_mm": m.thickness_mm,
+            "yield_strength_MPa": material.yield_strength,
+            "ultimate_strength_MPa": material.ultimate_strength,
+            "fatigue_limit_MPa": material.fatigue_limit,
+            "static_peak_von_mises_MPa": checks.static_peak_MPa,
+            "static_peak_at": _where(checks.static_peak),
+            "fatigue_criterion": FATIGUE_CRITERION,
+            "fatigue_hot_spots": [{
+                "name": f.name, "at": _where(f.peak), "amplitude_MPa": f.amplitude_MPa, "mean_MPa": f.mean_MPa,
+                "signed_von_mises_max_MPa": f.max_MPa, "signed_von_mises_min_MPa": f.min_MPa,
+                "p2_factor": f.p2_factor, "safety_factor": finite_or_none(f.safety_factor),
+            } for f in checks.fatigue],
+        },
+    }
+
+
+def piece_mass_strength(a, ctx) -> dict[str, Any]:
+    """Summary piece: mass, inertia and safety factors of an analysis."""
+    return mass_strength_dict(design_checks(a), a.case.material)
