@@ -22,6 +22,7 @@ from rvfem.app.result_compare import (
     compare_results,
     comparison_html,
     comparison_plot,
+    headline,
     overall_titles,
     read_result,
     result_from_case,
@@ -60,6 +61,10 @@ def _is_case_file(path: str) -> bool:
     return p.is_file() or p.suffix == ".toml"
 
 
+_SMALL_KEYS = ("disc_mass_kg", "static_safety_factor", "fatigue_safety_factor")
+"""Whole-disc quantities shown with four significant figures (not one decimal)."""
+
+
 def _format_compare(c: dict, out) -> None:
     w = out.write
     w(f"A: {c['a']['label']} ({c['a']['path']})\n")
@@ -67,6 +72,8 @@ def _format_compare(c: dict, out) -> None:
     w(f"models: bearings {c['a']['bearing_model']} / {c['b']['bearing_model']}, pins {c['a']['pin_model']} / "
       f"{c['b']['pin_model']}, P{c['a']['element_order']} / P{c['b']['element_order']}, step "
       f"{c['a']['angle_step_deg']:g}° / {c['b']['angle_step_deg']:g}°\n\n")
+    if headline(c):
+        w(headline(c) + "\n\n")
     head = f"{'bearing':>7} " + " ".join(f"{t + ' A':>10} {t + ' B':>10} {'B/A':>7}" for _, t in STATISTICS)
     w(head + "\n" + "-" * len(head) + "\n")
     for row in c["bearings"]:
@@ -81,7 +88,7 @@ def _format_compare(c: dict, out) -> None:
     w(f"\n{'whole disc':<{width}} {'A':>10} {'B':>10} {'B/A':>8}\n")
     for key, title in titles.items():
         a, b, r = o["a"].get(key), o["b"].get(key), o["ratio"].get(key)
-        fmt = (lambda v: "–" if v is None else f"{v:10.1f}")
+        fmt = (lambda v, k=key: "–" if v is None else f"{v:10.4g}" if k in _SMALL_KEYS else f"{v:10.1f}")
         w(f"{title:<{width}} {fmt(a):>10} {fmt(b):>10} {'–' if r is None else format(r, '8.4f'):>8}\n")
     r = o["ratio"]
     if r["max_load_N"] is not None and r["equivalent_load_N"] is not None and r["L10h_h"] is not None:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 from rvfem.evaluate.rigid import REFERENCE_NAMES
+from rvfem.outputs.design_summary import mass_strength_lines
 from rvfem.outputs.report import toml_text
 
 __all__ = ["SCREEN_DIGITS", "summary_text", "rigid_text", "warning_lines", "reference_lines", "stress_lines"]
@@ -161,6 +162,7 @@ def summary_text(summary: dict) -> str:
         f"{summary['torsional_stiffness_Nm_per_arcmin']:.1f} N·m/arcmin per disc; equilibrium residual "
         f"{summary['equilibrium_residual']:.1e}",
     ]
+    lines += mass_strength_lines(summary)
     lines.append(_hertz_line(summary["hertz"]))
     lines += _duty_lines(summary.get("duty_cycle"))
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "

@@ -13,7 +13,7 @@ from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_
 from rvfem.evaluate.postprocess import user_feature_name
 from rvfem.evaluate.strength import FATIGUE_CRITERION
 
-__all__ = ["piece_mass_strength", "mass_strength_dict"]
+__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines"]
 
 
 def _where(peak) -> dict | None:
@@ -60,3 +60,27 @@ def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
 def piece_mass_strength(a, ctx) -> dict[str, Any]:
     """Summary piece: mass, inertia and safety factors of an analysis."""
     return mass_strength_dict(design_checks(a), a.case.material)
+
+
+def _factor(x: float | None) -> str:
+    return "–" if x is None else f"{x:.3g}"
+
+
+def mass_strength_lines(summary: dict) -> list[str]:
+    """The screen lines of the mass-and-strength keys of a ``summary.json`` (none where absent)."""
+    ms = summary.get("mass_strength")
+    if not ms:
+        return []
+    lines = [f"  disc mass {summary['disc_mass_kg']:.4g} kg, polar inertia {summary['disc_polar_inertia_kg_mm2']:.4g} "
+             f"kg·mm² about its centre; the lightening holes save {ms['mass_saving_percent']:.1f} % of the mass and "
+             f"{ms['inertia_saving_percent']:.1f} % of the inertia of the solid disc "
+             f"({ms['solid_disc_mass_kg']:.4g} kg, {ms['solid_disc_polar_inertia_kg_mm2']:.4g} kg·mm²)"]
+    where = summary.get("fatigue_safety_factor_at") or {}
+    fat = ""
+    if where:
+        fat = (f"; fatigue safety {_factor(summary.get('fatigue_safety_factor'))} ({where['hot_spot']} hot spot, "
+               f"{where.get('feature') or '?'} at ({where['x_mm']:.1f}, {where['y_mm']:.1f}) mm; "
+               f"{ms['fatigue_criterion']}, σ_W = {ms['fatigue_limit_MPa']:g} MPa)")
+    lines.append(f"  static safety against yield {_factor(summary.get('static_safety_factor'))} "
+                 f"(R_p0.2 = {ms['yield_strength_MPa']:g} MPa at the structural peak){fat}")
+    return lines
