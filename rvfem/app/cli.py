@@ -25,7 +25,7 @@ from typing import Callable, TextIO
 
 from rvfem import __version__
 from rvfem.app.analysis import analyse_rigid, default_cache_dir
-from rvfem.app.cli_study import COMPARE, STUDY
+from rvfem.app.cli_study import COMPARE, OPTIMISE, STUDY
 from rvfem.app.commands import (
     EXIT_BROKEN_PIPE,
     EXIT_INTERNAL_ERROR,
@@ -409,4 +409,4 @@ if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
 
 
-SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY)
+SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY, OPTIMISE)

@@ -17,6 +17,7 @@ import tempfile
 from pathlib import Path
 
 from rvfem.app.commands import EXIT_OK, Subcommand
+from rvfem.app.optimise import load_problem, run_optimisation
 from rvfem.app.result_compare import (
     STATISTICS,
     compare_results,
@@ -258,3 +259,61 @@ COMPARE = Subcommand("compare", "compare two results (folders or case files): lo
                      "their ratios B / A, overlaid load curves", _add_compare_arguments, _run_compare)
 STUDY = Subcommand("study", "run a design study (grid, sensitivity or list of variants) on Dask distributed",
                    _add_study_arguments, _run_study)
+
+
+# --------------------------------------------------------------------------------------------
+# rvfem optimise FILE.toml [-o DIR] [--scheduler tcp://HOST:PORT] [--workers N] [--trials N]
+# --------------------------------------------------------------------------------------------
+
+
+def _add_optimise_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("problem", help="optimisation file (TOML; see docs/studies.md, \"Optimisation\")")
+    parser.add_argument("-o", "--output", metavar="DIR", help="folder (default: results/<name>); a rerun into "
+                        "the same folder takes the designs already in its trials.csv from there")
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                        help="address of a running Dask scheduler (default: a local cluster)")
+    parser.add_argument("--workers", type=_positive_int, metavar="N",
+                        help="workers of the local cluster (default: one per core)")
+    parser.add_argument("--trials", type=_positive_int, metavar="N", help="designs to evaluate (default: the file's)")
+    _add_set_argument(parser, "of the base case and every design")
+    parser.add_argument("--cache-dir", default="meshes", help="mesh cache shared by the workers (default: meshes)")
+    parser.add_argument("--no-plots", action="store_true", help="no Pareto plot")
+
+
+def _optimise_progress(done: int, total: int, row: dict) -> None:
+    wall = row.get("wall_time_s")
+    obj = row.get("objective")
+    sys.stderr.write(f"rvfem optimise: {done}/{total} {row['id']}: {row['status']}"
+                     f"{'' if obj is None else f', objective {obj:.6g}'}{', feasible' if row['feasible'] else ''}"
+                     f"{'' if not row['computed'] else '' if wall is None or math.isnan(wall) else f' in {wall:.1f} s'}"
+                     f"{'' if row['computed'] else ' (earlier run)'}" + (f" ({row['error']})" if row["error"] else "") + "\n")
+    sys.stderr.flush()
+
+
+def _run_optimise(args: argparse.Namespace) -> int:
+    problem = load_problem(args.problem, extra_overrides=args.overrides, trials=args.trials)
+    logging.getLogger("distributed").setLevel(max(logging.getLogger().getEffectiveLevel(), logging.DEBUG))
+    if args.verbose < 2:
+        logging.getLogger("tornado").setLevel(logging.CRITICAL)
+    out_dir = Path(args.output) if args.output else Path("results") / problem.name
+    print(f"rvfem optimise: {problem.trials} designs of '{problem.name}' (minimise {problem.objective}) into "
+          f"{out_dir}/", file=sys.stderr)
+    r = run_optimisation(problem, out_dir, scheduler=args.scheduler, workers=args.workers, cache_dir=args.cache_dir,
+                         progress=_optimise_progress, plots=not args.no_plots)
+    feasible = sum(1 for row in r.rows if row["feasible"])
+    print(f"{len(r.rows)} designs: {r.computed} computed, {feasible} feasible; wall time {r.wall_time_s:.1f} s")
+    keys = [p.key for p in problem.parameters]
+    for title, row in (("base", r.base), ("best", r.best)):
+        if row is not None:
+            print(f"  {title}: {problem.objective} = {row['objective']:.6g}; " + ", ".join(
+                f"{k} = {row[k]:g}" for k in keys if row.get(k) is not None) + ("; " if keys and row.get(keys[0]) is not None else "")
+                + ", ".join(f"{n} {row.get(n):.4g}" for n in ("max_load_delta_percent", "life_ratio",
+                                                               "fatigue_safety_factor") if row.get(n) is not None))
+    if r.best is None:
+        print("  no design met every budget")
+    print(f"  results: {r.out_dir}/ (trials.csv, best.toml, pareto.png, report.html)")
+    return EXIT_OK
+
+
+OPTIMISE = Subcommand("optimise", "minimise the disc mass (or inertia) over the hole parameters within budgets "
+                      "of load, life and safety, on Dask distributed", _add_optimise_arguments, _run_optimise)
