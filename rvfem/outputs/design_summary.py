@@ -13,7 +13,7 @@ from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_
 from rvfem.evaluate.postprocess import user_feature_name
 from rvfem.evaluate.strength import FATIGUE_CRITERION
 
-__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines"]
+__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report"]
 
 
 def _where(peak) -> dict | None:
@@ -83,4 +83,21 @@ def mass_strength_lines(summary: dict) -> list[str]:
                f"{ms['fatigue_criterion']}, σ_W = {ms['fatigue_limit_MPa']:g} MPa)")
     lines.append(f"  static safety against yield {_factor(summary.get('static_safety_factor'))} "
                  f"(R_p0.2 = {ms['yield_strength_MPa']:g} MPa at the structural peak){fat}")
+    return lines
+
+
+def mass_strength_report(summary: dict) -> list[str]:
+    """The paragraphs of the report's "Mass, inertia and strength" section (none where absent):
+    the screen lines and one line per hot spot."""
+    ms = summary.get("mass_strength")
+    if not ms:
+        return []
+    lines = [line.strip() for line in mass_strength_lines(summary)]
+    for f in ms["fatigue_hot_spots"]:
+        at = f["at"] or {}
+        lines.append(f"Hot spot {f['name']} ({at.get('feature') or '?'} at ({at.get('x_mm', 0.0):.1f}, "
+                     f"{at.get('y_mm', 0.0):.1f}) mm): signed von Mises {f['signed_von_mises_min_MPa']:.1f} … "
+                     f"{f['signed_von_mises_max_MPa']:.1f} MPa (P1 history × {f['p2_factor']:.3f}), σ_a = "
+                     f"{f['amplitude_MPa']:.1f} MPa, σ_m = {f['mean_MPa']:.1f} MPa, fatigue safety factor "
+                     f"{_factor(f['safety_factor'])}.")
     return lines

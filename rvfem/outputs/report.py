@@ -29,6 +29,7 @@ from rvfem.case.definition import Case
 from rvfem.case.schema import toml_literal
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
+from rvfem.outputs.design_summary import mass_strength_report
 from rvfem.solve.models import bearing_model, pin_model
 
 __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "report_context", "toml_text",
@@ -526,6 +527,7 @@ def report_context(summary: dict, case: Case, root: str | os.PathLike) -> dict:
         "attribution": _attribution(summary),
         "depends_on": _depends_on(summary, case),
         "hertz": _hertz(summary),
+        "mass_strength": mass_strength_report(summary),
         "duty_cycle": _duty_cycle(summary),
         "plots": _plots(summary, root),
         "images": _images(summary, case, root),
