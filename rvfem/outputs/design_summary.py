@@ -11,9 +11,10 @@ from typing import Any
 
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
 from rvfem.evaluate.postprocess import user_feature_name
-from rvfem.evaluate.strength import FATIGUE_CRITERION
+from rvfem.evaluate.strength import FATIGUE_CRITERION, fatigue_field
 
-__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report"]
+__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
+           "fatigue_point_data"]
 
 
 def _where(peak) -> dict | None:
@@ -101,3 +102,14 @@ def mass_strength_report(summary: dict) -> list[str]:
                      f"{f['amplitude_MPa']:.1f} MPa, σ_m = {f['mean_MPa']:.1f} MPa, fatigue safety factor "
                      f"{_factor(f['safety_factor'])}.")
     return lines
+
+
+def fatigue_point_data(analysis) -> dict:
+    """The envelope's fatigue field: ``fatigue_safety_factor_P<order>`` (the Goodman safety factor
+    of every vertex from the cycle's own vertex stresses, not scaled to P2; capped at 1000 for
+    the colour scale), empty where the cycle has no signed von Mises envelope."""
+    cy = analysis.cycle
+    if getattr(cy, "signed_von_mises_max", None) is None:
+        return {}
+    return {f"fatigue_safety_factor_P{analysis.system.model.order}":
+            fatigue_field(cy.signed_von_mises_max, cy.signed_von_mises_min, analysis.case.material)}
