@@ -196,3 +196,22 @@ def test_material_strength_keys_are_checked(tmp_path):
         load_case(CASES_DIR / "rv40e_fanholes.toml", ("material.yield_strength=2500",))
     with pytest.raises(CaseError, match="material.fatigue_limit"):
         load_case(CASES_DIR / "rv40e_fanholes.toml", ("material.fatigue_limit=2400",))
+
+
+@pytest.mark.slow
+def test_envelope_field_agrees_with_the_hot_spot_histories(tmp_path):
+    """Two independent paths to the same stresses: the cycle's vertex envelope (every angle's full
+    field) and the hot spots' influence-coefficient history. At each hot spot the envelope's fatigue
+    field equals the hot spot's P1 factor (its P2/P1 factor undone); the static factor is R_p0.2
+    over the structural peak."""
+    from rvfem.app.analysis import analyse
+    from rvfem.evaluate.design_checks import design_checks
+    from rvfem.outputs.design_summary import fatigue_point_data
+
+    a = analyse(coarse_case("rv40e_fanholes"), angle_step_deg=10.0, cache_dir=tmp_path / "meshes")
+    field = fatigue_point_data(a)["fatigue_safety_factor_P1"]
+    checks = design_checks(a)
+    for f, vertex in zip(checks.fatigue, a.stress.history.vertices):
+        assert field[vertex] == pytest.approx(f.safety_factor * f.p2_factor, rel=1e-9)
+    assert checks.static_safety_factor == pytest.approx(1800.0 / a.stress.structural.von_mises_MPa, rel=1e-12)
+    assert checks.mass.mass_kg == pytest.approx(disc_mass_properties(disc_geometry(a.case)).mass_kg, rel=1e-15)
