@@ -117,8 +117,8 @@ def test_bad_files_give_one_line_errors(tmp_path):
 
 @pytest.mark.slow
 def test_case_designs_through_the_command_line(tmp_path, capsys):
-    """Four coarse designs of the fan-hole disc through ``rvfem optimise``: the inner radius ranges
-    down to a 1 mm wall to the central hole, which the geometry check rejects (recorded, not
+    """Six coarse designs of the fan-hole disc through ``rvfem optimise``: the inner radius ranges
+    down to a 0.5 mm wall to the central hole, which the geometry check rejects (recorded, not
     fatal); every design's mass is the one its own summary.json has; best.toml runs again."""
     base = tmp_path / "coarse.toml"
     base.write_text(case_file_text(coarse_case("rv40e_fanholes")), encoding="utf-8")
@@ -126,16 +126,16 @@ def test_case_designs_through_the_command_line(tmp_path, capsys):
     problem.write_text(f"""
 name = "p"
 base_case = "{base.name}"
-trials = 4
+trials = 6
 seed = 1
 batch = 2
 [overrides]
 "analysis.angle_step_deg" = 30.0
 [[parameter]]
 key = "fan_holes.inner_radius"
-low = 13.0
-high = 18.0
-step = 0.5
+low = 12.5
+high = 17.5
+step = 1.0
 [budget]
 max_load_delta_percent = 30.0
 life_ratio = 0.5
@@ -145,7 +145,7 @@ fatigue_safety_factor = 1.5
     assert cli.main(["optimise", str(problem), "-o", str(out), "--workers", "2",
                      "--cache-dir", str(tmp_path / "meshes")]) == 0
     rows = read_trials(out / "trials.csv")
-    assert rows[0]["id"] == "base" and len(rows) == 5
+    assert rows[0]["id"] == "base" and len(rows) == 7
     for r in rows[1:]:
         if r["fan_holes.inner_radius"] < 14.0:        # wall to the central hole (12 mm) under 2 mm
             assert r["status"] == "failed" and not r["feasible"] and "central hole" in r["error"]
