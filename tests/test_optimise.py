@@ -146,6 +146,7 @@ fatigue_safety_factor = 1.5
                      "--cache-dir", str(tmp_path / "meshes")]) == 0
     rows = read_trials(out / "trials.csv")
     assert rows[0]["id"] == "base" and len(rows) == 7
+    assert any(r["status"] == "failed" for r in rows[1:]) and any(r["status"] == "ok" for r in rows[1:])
     for r in rows[1:]:
         if r["fan_holes.inner_radius"] < 14.0:        # wall to the central hole (12 mm) under 2 mm
             assert r["status"] == "failed" and not r["feasible"] and "central hole" in r["error"]
