@@ -415,8 +415,14 @@ def read_trials(path: str | os.PathLike) -> list[dict]:
     return rows
 
 
+def _tidy(value: float, p: OptParameter) -> float:
+    """A stepped value without the float noise of low + k·step (3.4000000000000004 → 3.4): the
+    case files and tables show what the grid means."""
+    return float(round(value, 10)) if p.step is not None else float(value)
+
+
 def _key(params: Sequence[tuple[str, float]]) -> str:
-    return json.dumps([[k, float(v)] for k, v in params])
+    return json.dumps([[k, round(float(v), 10)] for k, v in params])
 
 
 def _earlier(problem: Problem, rows: Sequence[dict]) -> dict[str, dict]:
@@ -544,7 +550,7 @@ def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, f
     batch = problem.batch or max(1, len(client.scheduler_info().get("workers", {})) or 1)
     while len(rows) < problem.trials:
         trials = [study.ask() for _ in range(min(batch, problem.trials - len(rows)))]
-        params = [tuple((p.key, t.suggest_float(p.key, p.low, p.high, step=p.step)) for p in problem.parameters)
+        params = [tuple((p.key, _tidy(t.suggest_float(p.key, p.low, p.high, step=p.step), p)) for p in problem.parameters)
                   for t in trials]
         done = _run_batch(problem, client, [(f"t{t.number:03d}", prm) for t, prm in zip(trials, params)], earlier,
                           out_dir / "trials", cache)
