@@ -17,7 +17,7 @@ PACKAGE = ROOT / "rvfem"
 MODULES = sorted(PACKAGE.rglob("*.py"))
 
 LAZY_LIBRARIES = {"matplotlib", "pyvista", "vtkmodules", "PIL", "dask", "distributed", "tqdm", "sksparse",
-                  "pypardiso", "cholespy"}
+                  "pypardiso", "cholespy", "optuna"}
 """The only libraries a function may import itself: heavy (drawing, rendering, Dask), optional
 (alternative sparse solvers) or needed by one command only (progress bars)."""
 

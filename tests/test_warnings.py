@@ -122,7 +122,8 @@ def _fake_analysis(scale: float):
         stress=SimpleNamespace(structural=SimpleNamespace(von_mises_MPa=107.0 * scale),
                                snapshots=[SimpleNamespace(deformation=np.array([[0.0, 0.008 * scale], [0.0, 0.0]]))]),
         case=SimpleNamespace(mesh=SimpleNamespace(size_flank=0.35, size_bore=0.4),
-                             material=SimpleNamespace(youngs_modulus=206000.0, poissons_ratio=0.3)),
+                             material=SimpleNamespace(youngs_modulus=206000.0, poissons_ratio=0.3,
+                                                               yield_strength=1600.0)),
     )
 
 
@@ -192,7 +193,8 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
     screen = capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     codes = [w["code"] for w in summary["warnings"]]
-    assert codes == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield", "large_displacement"]
+    assert codes == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield", "large_displacement",
+                     "fatigue_safety"]
     for w in summary["warnings"]:
         assert set(w) == {"code", "message", "value", "limit", "unit"}
         assert f"  warning: {w['message']}" in screen.splitlines()
@@ -200,7 +202,7 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
     assert summary["warnings"][0]["value"] == pytest.approx(pc)
     assert summary["warnings"][3]["value"] == pytest.approx(summary["peak_von_mises_MPa"])
     html = (out / "report.html").read_text(encoding="utf-8")
-    assert "class='warnings'" in html and html.count("<li><code>") >= 5
+    assert "class='warnings'" in html and html.count("<li><code>") >= 6
     assert ResultWarning(**summary["warnings"][0]).code == "load_ratio"
 
 
@@ -223,7 +225,7 @@ def test_overload_cases_warn(changes, tmp_path):
 
     a = analyse(coarse_case("rv40e_fanholes", **changes), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
     assert _codes(a.warnings) == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield",
-                                  "large_displacement"]
+                                  "large_displacement", "fatigue_safety"]
 
 
 def test_hertz_limit_scales_with_a_material_that_is_not_steel():

@@ -25,7 +25,8 @@ from typing import Callable, TextIO
 
 from rvfem import __version__
 from rvfem.app.analysis import analyse_rigid, default_cache_dir
-from rvfem.app.cli_study import COMPARE, STUDY
+from rvfem.app.cli_hysteresis import HYSTERESIS
+from rvfem.app.cli_study import COMPARE, OPTIMISE, STUDY
 from rvfem.app.commands import (
     EXIT_BROKEN_PIPE,
     EXIT_INTERNAL_ERROR,
@@ -409,8 +410,4 @@ if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
 
 
-SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY)
-
-from rvfem.app.cli_hysteresis import HYSTERESIS  # noqa: E402  (the accuracy subcommand, its own module)
-
-SUBCOMMANDS = (*SUBCOMMANDS, HYSTERESIS)
+SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY, OPTIMISE, HYSTERESIS)

@@ -17,11 +17,13 @@ import tempfile
 from pathlib import Path
 
 from rvfem.app.commands import EXIT_OK, Subcommand
+from rvfem.app.optimise import load_problem, run_optimisation
 from rvfem.app.result_compare import (
     STATISTICS,
     compare_results,
     comparison_html,
     comparison_plot,
+    headline,
     overall_titles,
     read_result,
     result_from_case,
@@ -60,6 +62,10 @@ def _is_case_file(path: str) -> bool:
     return p.is_file() or p.suffix == ".toml"
 
 
+_SMALL_KEYS = ("disc_mass_kg", "static_safety_factor", "fatigue_safety_factor")
+"""Whole-disc quantities shown with four significant figures (not one decimal)."""
+
+
 def _format_compare(c: dict, out) -> None:
     w = out.write
     w(f"A: {c['a']['label']} ({c['a']['path']})\n")
@@ -67,6 +73,8 @@ def _format_compare(c: dict, out) -> None:
     w(f"models: bearings {c['a']['bearing_model']} / {c['b']['bearing_model']}, pins {c['a']['pin_model']} / "
       f"{c['b']['pin_model']}, P{c['a']['element_order']} / P{c['b']['element_order']}, step "
       f"{c['a']['angle_step_deg']:g}° / {c['b']['angle_step_deg']:g}°\n\n")
+    if headline(c):
+        w(headline(c) + "\n\n")
     head = f"{'bearing':>7} " + " ".join(f"{t + ' A':>10} {t + ' B':>10} {'B/A':>7}" for _, t in STATISTICS)
     w(head + "\n" + "-" * len(head) + "\n")
     for row in c["bearings"]:
@@ -81,7 +89,7 @@ def _format_compare(c: dict, out) -> None:
     w(f"\n{'whole disc':<{width}} {'A':>10} {'B':>10} {'B/A':>8}\n")
     for key, title in titles.items():
         a, b, r = o["a"].get(key), o["b"].get(key), o["ratio"].get(key)
-        fmt = (lambda v: "–" if v is None else f"{v:10.1f}")
+        fmt = (lambda v, k=key: "–" if v is None else f"{v:10.4g}" if k in _SMALL_KEYS else f"{v:10.1f}")
         w(f"{title:<{width}} {fmt(a):>10} {fmt(b):>10} {'–' if r is None else format(r, '8.4f'):>8}\n")
     r = o["ratio"]
     if r["max_load_N"] is not None and r["equivalent_load_N"] is not None and r["L10h_h"] is not None:
@@ -251,3 +259,61 @@ COMPARE = Subcommand("compare", "compare two results (folders or case files): lo
                      "their ratios B / A, overlaid load curves", _add_compare_arguments, _run_compare)
 STUDY = Subcommand("study", "run a design study (grid, sensitivity or list of variants) on Dask distributed",
                    _add_study_arguments, _run_study)
+
+
+# --------------------------------------------------------------------------------------------
+# rvfem optimise FILE.toml [-o DIR] [--scheduler tcp://HOST:PORT] [--workers N] [--trials N]
+# --------------------------------------------------------------------------------------------
+
+
+def _add_optimise_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("problem", help="optimisation file (TOML; see docs/studies.md, \"Optimisation\")")
+    parser.add_argument("-o", "--output", metavar="DIR", help="folder (default: results/<name>); a rerun into "
+                        "the same folder takes the designs already in its trials.csv from there")
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                        help="address of a running Dask scheduler (default: a local cluster)")
+    parser.add_argument("--workers", type=_positive_int, metavar="N",
+                        help="workers of the local cluster (default: one per core)")
+    parser.add_argument("--trials", type=_positive_int, metavar="N", help="designs to evaluate (default: the file's)")
+    _add_set_argument(parser, "of the base case and every design")
+    parser.add_argument("--cache-dir", default="meshes", help="mesh cache shared by the workers (default: meshes)")
+    parser.add_argument("--no-plots", action="store_true", help="no Pareto plot")
+
+
+def _optimise_progress(done: int, total: int, row: dict) -> None:
+    wall = row.get("wall_time_s")
+    obj = row.get("objective")
+    sys.stderr.write(f"rvfem optimise: {done}/{total} {row['id']}: {row['status']}"
+                     f"{'' if obj is None else f', objective {obj:.6g}'}{', feasible' if row['feasible'] else ''}"
+                     f"{'' if not row['computed'] else '' if wall is None or math.isnan(wall) else f' in {wall:.1f} s'}"
+                     f"{'' if row['computed'] else ' (earlier run)'}" + (f" ({row['error']})" if row["error"] else "") + "\n")
+    sys.stderr.flush()
+
+
+def _run_optimise(args: argparse.Namespace) -> int:
+    problem = load_problem(args.problem, extra_overrides=args.overrides, trials=args.trials)
+    logging.getLogger("distributed").setLevel(max(logging.getLogger().getEffectiveLevel(), logging.DEBUG))
+    if args.verbose < 2:
+        logging.getLogger("tornado").setLevel(logging.CRITICAL)
+    out_dir = Path(args.output) if args.output else Path("results") / problem.name
+    print(f"rvfem optimise: {problem.trials} designs of '{problem.name}' (minimise {problem.objective}) into "
+          f"{out_dir}/", file=sys.stderr)
+    r = run_optimisation(problem, out_dir, scheduler=args.scheduler, workers=args.workers, cache_dir=args.cache_dir,
+                         progress=_optimise_progress, plots=not args.no_plots)
+    feasible = sum(1 for row in r.rows if row["feasible"])
+    print(f"{len(r.rows)} designs: {r.computed} computed, {feasible} feasible; wall time {r.wall_time_s:.1f} s")
+    keys = [p.key for p in problem.parameters]
+    for title, row in (("base", r.base), ("best", r.best)):
+        if row is not None:
+            print(f"  {title}: {problem.objective} = {row['objective']:.6g}; " + ", ".join(
+                f"{k} = {row[k]:g}" for k in keys if row.get(k) is not None) + ("; " if keys and row.get(keys[0]) is not None else "")
+                + ", ".join(f"{n} {row.get(n):.4g}" for n in ("max_load_delta_percent", "life_ratio",
+                                                               "fatigue_safety_factor") if row.get(n) is not None))
+    if r.best is None:
+        print("  no design met every budget")
+    print(f"  results: {r.out_dir}/ (trials.csv, best.toml, pareto.png, report.html)")
+    return EXIT_OK
+
+
+OPTIMISE = Subcommand("optimise", "minimise the disc mass (or inertia) over the hole parameters within budgets "
+                      "of load, life and safety, on Dask distributed", _add_optimise_arguments, _run_optimise)

@@ -34,7 +34,7 @@ from rvfem.case.definition import Case, load_case
 from rvfem.errors import OutputError
 
 __all__ = ["ResultFolder", "STATISTICS", "read_result", "result_from_case", "compare_results",
-           "overall_titles", "comparison_figure", "comparison_plot", "comparison_html"]
+           "overall_titles", "comparison_figure", "comparison_plot", "comparison_html", "headline"]
 
 STATISTICS = (("max_load_N", "max N"), ("min_load_N", "min N"), ("equivalent_load_N", "F_m N"), ("L10h_h", "L10h h"))
 """Per-bearing statistics compared (summary.json key of ``bearings[].flexible``, column title)."""
@@ -129,6 +129,10 @@ def _overall(r: ResultFolder) -> dict:
         "handbook_equivalent_load_N": max((f["equivalent_load_N"] for f in rigid), default=None),
         "peak_von_mises_MPa": s.get("peak_von_mises_MPa"),
         "peak_away_from_contacts_MPa": away.get("peak_von_mises_MPa"),
+        "disc_mass_kg": s.get("disc_mass_kg"),
+        "disc_polar_inertia_kg_mm2": s.get("disc_polar_inertia_kg_mm2"),
+        "static_safety_factor": s.get("static_safety_factor"),
+        "fatigue_safety_factor": s.get("fatigue_safety_factor"),
     }
 
 
@@ -167,7 +171,22 @@ def overall_titles(comparison: dict) -> dict:
             "handbook_equivalent_load_N": "handbook F_m, N",
             "peak_von_mises_MPa": f"structural peak ({_orders(a, b, 'peak_element_order')}, away from contacts), MPa",
             "peak_away_from_contacts_MPa":
-                f"structural peak, {_orders(a, b, 'cycle_element_order')} cycle (away from contacts), MPa"}
+                f"structural peak, {_orders(a, b, 'cycle_element_order')} cycle (away from contacts), MPa",
+            "disc_mass_kg": "disc mass, kg", "disc_polar_inertia_kg_mm2": "disc polar inertia, kg·mm²",
+            "static_safety_factor": "static safety factor (yield)", "fatigue_safety_factor": "fatigue safety factor"}
+
+
+def headline(comparison: dict) -> str | None:
+    """The line a comparison leads with: "mass −x %, inertia −y %" (where both results have them),
+    then the largest load, the equivalent load and the L10h ratio, B against A."""
+    r = comparison["overall"]["ratio"]
+    parts = [f"{name} {100 * (r[key] - 1):+.1f} %".replace("+-", "−").replace("-", "−")
+             for key, name in (("disc_mass_kg", "mass"), ("disc_polar_inertia_kg_mm2", "inertia"))
+             if r.get(key) is not None]
+    if r["max_load_N"] is not None and r["equivalent_load_N"] is not None and r["L10h_h"] is not None:
+        parts += [f"largest load {100 * (r['max_load_N'] - 1):+.1f} %",
+                  f"equivalent load {100 * (r['equivalent_load_N'] - 1):+.1f} %", f"L10h × {r['L10h_h']:.2f}"]
+    return ("B against A: " + ", ".join(parts)) if parts else None
 
 
 def compare_results(a: ResultFolder, b: ResultFolder) -> dict:
@@ -276,6 +295,8 @@ def comparison_html(comparison: dict, plot: str | os.PathLike | None, path: str 
              f"<h1>B / A: {e(b['label'])} / {e(a['label'])}</h1>",
              f"<p>A: <code>{e(a['path'])}</code> ({e(str(a['bearing_model']))} bearings, step {a['angle_step_deg']}°)"
              f"<br>B: <code>{e(b['path'])}</code> ({e(str(b['bearing_model']))} bearings, step {b['angle_step_deg']}°)</p>"]
+    if headline(comparison):
+        parts.append(f"<p><b>{e(headline(comparison))}</b></p>")
     for w in comparison["warnings"]:
         parts.append(f"<p class='w'>Note: {e(w)}</p>")
     parts.append("<table><tr><th>bearing</th>" + "".join(
@@ -288,7 +309,8 @@ def comparison_html(comparison: dict, plot: str | os.PathLike | None, path: str 
     o = comparison["overall"]
     titles = overall_titles(comparison)
     for key in o["a"]:
-        parts.append(f"<tr><td class='l'>{e(titles.get(key, key))}</td><td>{_f(o['a'][key], '.1f')}</td><td>{_f(o['b'][key], '.1f')}</td>"
+        spec = ".4g" if key in ("disc_mass_kg", "static_safety_factor", "fatigue_safety_factor") else ".1f"
+        parts.append(f"<tr><td class='l'>{e(titles.get(key, key))}</td><td>{_f(o['a'][key], spec)}</td><td>{_f(o['b'][key], spec)}</td>"
                      f"<td>{_f(o['ratio'][key], '.4f')}</td></tr>")
     parts.append("</table>")
     if plot is not None:

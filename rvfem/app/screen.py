@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 from rvfem.evaluate.rigid import REFERENCE_NAMES
+from rvfem.outputs.design_summary import mass_strength_lines
 from rvfem.outputs.report import toml_text
 
 __all__ = ["SCREEN_DIGITS", "summary_text", "rigid_text", "warning_lines", "reference_lines", "stress_lines"]
@@ -162,6 +163,7 @@ def summary_text(summary: dict) -> str:
         f"{summary['equilibrium_residual']:.1e}",
     ]
     lines += _accuracy_lines(summary.get("accuracy"))
+    lines += mass_strength_lines(summary)
     lines.append(_hertz_line(summary["hertz"]))
     lines += roller_depth_lines(summary.get("crank_bearing_depth"))
     lines += _duty_lines(summary.get("duty_cycle"))

@@ -1127,6 +1127,12 @@ def study_rows(study: Study, records: dict[str, dict]) -> list[dict]:
             "life_ratio_vs_base": _ratio(life, base_life),
             "peak_von_mises_MPa": _get(s, "peak_von_mises_MPa"),
             "peak_away_from_contacts_MPa": _get(s, "stress", "away_from_contacts", "peak_von_mises_MPa"),
+            "peak_vs_base_percent": _pct(_get(s, "peak_von_mises_MPa"), _get(base_summary, "peak_von_mises_MPa")),
+            "disc_mass_kg": _get(s, "disc_mass_kg"),
+            "disc_polar_inertia_kg_mm2": _get(s, "disc_polar_inertia_kg_mm2"),
+            "mass_vs_base_percent": _pct(_get(s, "disc_mass_kg"), _get(base_summary, "disc_mass_kg")),
+            "static_safety_factor": _get(s, "static_safety_factor"),
+            "fatigue_safety_factor": _get(s, "fatigue_safety_factor"),
         })
         for i in range(n_bearings):
             pre = f"bearing{i + 1}_"
@@ -1258,7 +1264,7 @@ def _response_figure(study: Study, p: Parameter, ok: Sequence[dict]):
 
 
 def _tornado_bars(study: Study, ok: Sequence[dict], base: dict) -> list[tuple]:
-    """Per parameter ``(span, parameter, [load % low, high], [L10h % low, high])``, smallest span
+    """Per parameter ``(span, parameter, [load % low, high], [L10h %], [stress peak %], [mass %])``, smallest span
     first (a side equal to the base value is the base itself)."""
     bars = []
     for p in study.parameters:
@@ -1268,19 +1274,24 @@ def _tornado_bars(study: Study, ok: Sequence[dict], base: dict) -> list[tuple]:
         d = [r["max_vs_base_percent"] if r else float("nan") for r in (lo, hi)]
         life = [100.0 * (r["life_ratio_vs_base"] - 1.0) if r and r["life_ratio_vs_base"] else float("nan")
                 for r in (lo, hi)]
+        stress, mass = ([r.get(key) if r and r.get(key) is not None else float("nan") for r in (lo, hi)]
+                        for key in ("peak_vs_base_percent", "mass_vs_base_percent"))
         span = max((abs(x) for x in d if not math.isnan(x)), default=0.0)
-        bars.append((span, p, d, life))
+        bars.append((span, p, d, life, stress, mass))
     bars.sort(key=lambda b: b[0])
     return bars
 
 
 def _tornado_figure(study: Study, ok: Sequence[dict], base: dict):
-    """Sensitivity: change of the largest load and of L10h against the base, per parameter."""
+    """Sensitivity: change of the largest load, of L10h, of the structural stress peak and of the
+    disc mass against the base, per parameter."""
     bars = _tornado_bars(study, ok, base)
-    fig, axes = _figure((10, 1.2 + 0.55 * len(bars)), nrows=1, ncols=2, sharey=True)
+    fig, axes = _figure((16, 1.2 + 0.55 * len(bars)), nrows=1, ncols=4, sharey=True)
     y = range(len(bars))
     for ax, idx, title in ((axes[0], 2, "largest bearing load vs base, %"),
-                           (axes[1], 3, "L10h vs base, %")):
+                           (axes[1], 3, "L10h vs base, %"),
+                           (axes[2], 4, "structural stress peak vs base, %"),
+                           (axes[3], 5, "disc mass vs base, %")):
         for yi, bar in zip(y, bars):
             lo, hi = bar[idx]
             ax.barh(yi, lo, color="tab:blue", height=0.6, label="low" if yi == 0 else None)

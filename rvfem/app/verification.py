@@ -34,7 +34,7 @@ from skfem import Basis, ElementVector, FacetBasis, Functional, LinearForm, asm
 
 from rvfem import fem
 from rvfem.case.definition import RollerProfile, load_case
-from rvfem.evaluate import compare, lubrication, rigid, roller_life, roller_slices
+from rvfem.evaluate import compare, lubrication, rigid, roller_life, roller_slices, strength
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures
 from rvfem.evaluate.hertz import composite_modulus, hertz_peak_pressure, reduced_radius
 from rvfem.evaluate.iso281 import (
@@ -50,6 +50,7 @@ from rvfem.evaluate.rigid import (
 )
 from rvfem.fem import crankshaft
 from rvfem.fem.model import _scalar_element
+from rvfem.geometry import Circle, FanHole, disc_geometry, mass
 from rvfem.mesh import gmsh_session, mesh_case
 from rvfem.solve import accuracy, contact, cycle, models
 from rvfem.solve.cycle import build_system
@@ -792,6 +793,8 @@ def roller_depth_section() -> Section:
                    "The slice model of a roller on an elastic half-space, the ISO/TS 16281 lamina life, the EHL film "
                    "and the crankshaft's slope at the eccentrics (docs/theory.md § 12). The slice model against a "
                    "two-dimensional half-space solve is in tests/test_roller_slices.py.", checks)
+
+
 def _stiff_accuracy_stage(discs: _Discs, *overrides: str):
     """The coarse solid RV-40E in the stiff limit of the accuracy checks: disc ×10³, linear pins of
     2·10⁸ N/mm and rollers of 3·10⁷ N/mm, rigid eccentrics, both discs; ``overrides`` add the play."""
@@ -841,6 +844,63 @@ def _loop_arrays(loop) -> tuple:
     return loop.torque_Nm, loop.rotation_rad, loop.branch
 
 
+def _sector_disc_checks() -> tuple[Check, ...]:
+    """A disc of a 3600-gon (circumradius 60 mm), a central hole (12), three bores (9 at 36 mm) and
+    three sharp annular-sector holes (17…49 mm, 0.6 rad) against the closed forms."""
+    n, R, beta = 3600, 60.0, 2 * math.pi / 3600
+    a_out = 0.5 * n * R * R * math.sin(beta)
+    j_out = a_out * R * R * (2 + math.cos(beta)) / 6
+    a_ref = a_out - math.pi * 12**2 - 3 * math.pi * 9**2 - 3 * 0.3 * (49**2 - 17**2)
+    j_ref = (j_out - math.pi * 12**4 / 2 - 3 * (math.pi * 9**4 / 2 + math.pi * 9**2 * 36**2)
+             - 3 * 0.3 * (49**4 - 17**4) / 2)
+    ang = 2 * np.pi * np.arange(n) / n
+    outline = np.stack([R * np.cos(ang), R * np.sin(ang)], axis=1)
+    area, polar = mass.polygon_area_polar(outline)
+    for f in [Circle("central_hole", (0.0, 0.0), 12.0)] + [
+            Circle(f"bore_{i}", (36 * math.cos(a), 36 * math.sin(a)), 9.0) for i, a in enumerate(np.radians([90, 210, 330]))] + [
+            FanHole(f"hole_{i}", 17.0, 49.0, math.radians(30 + 120 * i), 0.3, 0.0) for i in range(3)]:
+        a, j = mass.outline_area_polar(f)
+        area, polar = area - a, polar - j
+    source = "closed forms: n-gon, circles by parallel axes, annular sectors α(r_o² − r_i²), α(r_o⁴ − r_i⁴)/2"
+    return (Check("disc with three annular-sector holes: area, mm²", source, a_ref, area, area / a_ref - 1, 1e-9),
+            Check("same: polar moment ∬ r² dA, mm⁴", source, j_ref, polar, polar / j_ref - 1, 1e-9))
+
+
+def mass_strength_section(discs: _Discs) -> Section:
+    """Disc mass and polar inertia against closed forms and the mesh integral; the fatigue safety
+    factor against the Goodman line by hand."""
+    case = _case("rv40e_fanholes")
+    props = mass.disc_mass_properties(disc_geometry(case))
+    m = mesh_case(case, discs.cache)
+    a_mesh, j_mesh = mass.mesh_area_polar(m.points, m.triangles)
+    theta = np.radians(np.arange(0.0, 360.0, 1.0))
+    steel = case.material
+    sa, sm = 300.0, 200.0
+    s1 = sm + sa * np.sin(theta)
+    amp, mean = strength.amplitude_mean(strength.signed_von_mises(s1, np.zeros_like(s1)))
+    hand = 1.0 / (sa / steel.fatigue_limit + sm / steel.ultimate_strength)
+    sf = strength.goodman_safety_factor(float(amp), float(mean), steel.fatigue_limit, steel.ultimate_strength)
+    sf48 = strength.goodman_safety_factor(48 * float(amp), 48 * float(mean), steel.fatigue_limit,
+                                          steel.ultimate_strength)
+    checks = _sector_disc_checks() + (
+        Check("coarse fan-hole disc: area from the P1 mesh, mm²", "Green's theorem over the outlines (rvfem.geometry.mass)",
+              props.area_mm2, a_mesh, a_mesh / props.area_mm2 - 1, 5e-4),
+        Check("same: polar moment from the P1 mesh, mm⁴", "Green's theorem over the outlines",
+              props.polar_mm4, j_mesh, j_mesh / props.polar_mm4 - 1, 5e-4),
+        Check("plate, σ = 200 + 300 sin θ MPa uniaxial: fatigue safety factor",
+              f"Goodman by hand, 1/(σ_a/σ_W + σ_m/R_m), σ_W = {steel.fatigue_limit:g}, R_m = {steel.ultimate_strength:g} MPa",
+              hand, sf, sf / hand - 1, 1e-12),
+        Check("same, load × 48: fatigue safety factor", "proportional scaling: S/48", hand / 48, sf48,
+              sf48 / (hand / 48) - 1, 1e-12),
+    )
+    return Section("12. Disc mass, inertia and fatigue strength",
+                   "Mass and polar inertia by Green's theorem over the outlines (docs/theory.md § 13) against closed "
+                   "forms and against the coarse P1 mesh (straight-sided triangles: the chords of the curved "
+                   "boundaries, an error falling as h²); the fatigue safety factor (FKM signed von Mises on the "
+                   "Goodman line) of a plate under an alternating uniaxial stress against the hand calculation.",
+                   checks)
+
+
 def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
     """Compute every section (meshes cached in ``cache_dir``, a temporary folder by default)."""
 
@@ -853,6 +913,7 @@ def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
         sections.append(clearance_section(discs))
         sections.append(accuracy_section(discs))
         sections.append(roller_depth_section())
+        sections.append(mass_strength_section(discs))
     return sections
 
 

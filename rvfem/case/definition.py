@@ -550,6 +550,17 @@ class Material:
     name: str = param("bearing steel", max_length=200, doc="label")
     youngs_modulus: float = param(206000.0, unit="MPa", low=1.0e3, high=1.2e6, doc="E")
     poissons_ratio: float = param(0.3, low=0.0, high=0.5, high_open=True, doc="ν")
+    # mass and strength (the defaults: through-hardened bearing steel 100Cr6 / GCr15 / SAE 52100,
+    # quenched and tempered at about 150 °C, 62 HRC; docs/theory.md, "Mass and strength")
+    density_kg_m3: float = param(7810.0, unit="kg/m³", low=1.0, high=3.0e4,
+                                 doc="density ρ (disc mass and inertia); 7810 kg/m³ for 100Cr6")
+    yield_strength: float = param(1800.0, unit="MPa", low=1.0, high=1.0e4,
+                                  doc="0.2 % proof stress R_p0.2 (static safety factor, yield warning)")
+    ultimate_strength: float = param(2400.0, unit="MPa", low=1.0, high=1.0e4,
+                                     doc="tensile strength R_m (the Goodman line of the fatigue check)")
+    fatigue_limit: float = param(960.0, unit="MPa", low=1.0, high=1.0e4,
+                                 doc="fully reversed (R = −1) fatigue limit σ_W of the material, "
+                                     "default 0.40·R_m (FKM guideline, wrought steel)")
 
 
 @dataclass(frozen=True)
@@ -1167,6 +1178,20 @@ def _positive_definite(matrix: tuple[tuple[float, ...], ...]) -> bool:
 
 _CROSS_CHECKS = (_check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_holes, _check_loads,
                  _check_mesh, _check_mesh_sizes, _check_crank_support)
+
+
+def _check_material(case: Case) -> None:
+    """σ_W < R_m and R_p0.2 ≤ R_m (the fatigue check's Goodman line, docs/theory.md "Mass and strength")."""
+    m = case.material
+    if m.yield_strength > m.ultimate_strength:
+        raise _error(case, "material.yield_strength", f"{m.yield_strength:g} MPa is above the ultimate strength "
+                     f"{m.ultimate_strength:g} MPa; give a yield strength ≤ 'material.ultimate_strength'")
+    if m.fatigue_limit >= m.ultimate_strength:
+        raise _error(case, "material.fatigue_limit", f"{m.fatigue_limit:g} MPa is not below the ultimate strength "
+                     f"{m.ultimate_strength:g} MPa; lower it")
+
+
+_CROSS_CHECKS = _CROSS_CHECKS + (_check_material,)
 
 
 # --------------------------------------------------------------------------------------------

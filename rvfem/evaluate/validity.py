@@ -17,7 +17,10 @@ code                    warns when                                              
 ``load_ratio``          P/C = F_m/C of a bearing is above                        0.5
 ``life_under_1h``       a bearing life (L10h, duty-cycle service life) is under  1 h
 ``hertz_pressure``      a roller–raceway Hertz peak pressure is above            4000 MPa (steel)
-``disc_stress_yield``   the disc's structural stress peak (von Mises) is above   1600 MPa
+``disc_stress_yield``   the disc's structural stress peak (von Mises) is above   the material's
+                        (``material.yield_strength``)                            R_p0.2
+``fatigue_safety``      a hot spot's fatigue safety factor (FKM signed von        1
+                        Mises on the Goodman line) is below
 ``large_displacement``  the largest disc deformation is above, of the element    10 %
                         size at the contacts
 ======================  =======================================================  ================
@@ -30,6 +33,8 @@ from dataclasses import asdict, dataclass
 from typing import Iterable
 
 import numpy as np
+
+from rvfem.evaluate.strength import FATIGUE_CRITERION, hot_spot_fatigue
 
 __all__ = [
     "LOAD_RATIO_LIMIT",
@@ -46,7 +51,11 @@ __all__ = [
     "rigid_warnings",
     "KAPPA_RANGE",
     "roller_depth_warnings",
+    "FATIGUE_SAFETY_LIMIT",
 ]
+
+FATIGUE_SAFETY_LIMIT = 1.0
+"""Smallest fatigue safety factor of a hot spot reported without a warning."""
 
 LOAD_RATIO_LIMIT = 0.5
 """Largest P/C (equivalent load over the dynamic load rating) for which the ISO 281 rating life is
@@ -116,7 +125,7 @@ class ResultWarning:
     ----------
     code : str
         What is checked, a stable key: ``load_ratio``, ``life_under_1h``, ``hertz_pressure``,
-        ``disc_stress_yield``, ``large_displacement``.
+        ``disc_stress_yield``, ``large_displacement``, ``fatigue_safety``.
     message : str
         One line for the user: the value, where it occurs, the limit and what it means.
     value : float
@@ -246,7 +255,7 @@ def _yield_warning(disc_stress_MPa: float | None, yield_strength_MPa: float) -> 
     if not (disc_stress_MPa is not None and math.isfinite(disc_stress_MPa) and disc_stress_MPa > yield_strength_MPa):
         return None
     source = ("placeholder for through-hardened bearing steel"
-              if yield_strength_MPa == PLACEHOLDER_YIELD_STRENGTH_MPA else "given")
+              if yield_strength_MPa == PLACEHOLDER_YIELD_STRENGTH_MPA else "material.yield_strength")
     return ResultWarning(
         "disc_stress_yield",
         f"structural stress peak {disc_stress_MPa:.0f} MPa von Mises > yield strength "
@@ -319,10 +328,29 @@ def analysis_warnings(analysis) -> tuple[ResultWarning, ...]:
     snapshots = analysis.stress.snapshots
     deformation = max((float(np.max(np.hypot(*s.deformation.T), initial=0.0)) for s in snapshots), default=None)
     ms, mat = analysis.case.mesh, analysis.case.material
-    return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
-                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio),
-                        disc_stress_MPa=None if structural is None else structural.von_mises_MPa,
-                        deformation_mm=deformation, element_size_mm=min(ms.size_flank, ms.size_bore))
+    found = check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
+                         hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio),
+                         disc_stress_MPa=None if structural is None else structural.von_mises_MPa,
+                         yield_strength_MPa=mat.yield_strength,
+                         deformation_mm=deformation, element_size_mm=min(ms.size_flank, ms.size_bore))
+    return found + _fatigue_warnings(analysis)
+
+
+def _fatigue_warnings(analysis) -> tuple[ResultWarning, ...]:
+    """The ``fatigue_safety`` warning of the hot spot with the smallest fatigue safety factor, if
+    it is below 1 (:mod:`rvfem.evaluate.strength`)."""
+    history = getattr(analysis.stress, "history", None)
+    if history is None:
+        return ()
+    worst = min(hot_spot_fatigue(history, analysis.case.material), key=lambda f: f.safety_factor, default=None)
+    if worst is None or not worst.safety_factor < FATIGUE_SAFETY_LIMIT:
+        return ()
+    where = f"{worst.name} hot spot at ({worst.peak.x_mm:.2f}, {worst.peak.y_mm:.2f}) mm"
+    return (ResultWarning(
+        "fatigue_safety",
+        f"fatigue safety factor {_sig(worst.safety_factor)} < 1 ({where}; σ_a = {worst.amplitude_MPa:.0f} MPa, "
+        f"σ_m = {worst.mean_MPa:.0f} MPa, {FATIGUE_CRITERION}): the disc does not have infinite life there",
+        float(worst.safety_factor), FATIGUE_SAFETY_LIMIT, ""),)
 
 
 def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:

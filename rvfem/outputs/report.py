@@ -29,6 +29,7 @@ from rvfem.case.definition import Case
 from rvfem.case.schema import toml_literal
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
+from rvfem.outputs.design_summary import mass_strength_report
 from rvfem.solve.models import bearing_model, pin_model
 
 __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "report_context", "toml_text",
@@ -555,6 +556,7 @@ def report_context(summary: dict, case: Case, root: str | os.PathLike) -> dict:
         "depends_on": _depends_on(summary, case),
         "hertz": _hertz(summary),
         "roller_depth": _roller_depth(summary),
+        "mass_strength": mass_strength_report(summary),
         "duty_cycle": _duty_cycle(summary),
         "plots": _plots(summary, root),
         "images": _images(summary, case, root),

@@ -53,6 +53,7 @@ from rvfem.evaluate.postprocess import user_feature_name
 from rvfem.evaluate.rigid import references
 from rvfem.geometry import crank_centres
 from rvfem.outputs import plots, render, tables, vtkio
+from rvfem.outputs.design_summary import fatigue_point_data, piece_mass_strength
 from rvfem.outputs.plots import mesh_plot
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
@@ -675,6 +676,7 @@ SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_bearings,
     _piece_cycle,
     _piece_stress,
+    piece_mass_strength,
     _piece_hertz,
     _piece_duty_cycle,
     _piece_reducer_stage,
@@ -790,7 +792,8 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
         out.append(vtkio.write_envelope_vtu(
             vtk / vtkio.ENVELOPE_FILE, points, triangles, cy.von_mises_envelope, cy.von_mises_envelope_theta,
             element_order=model.order, structural_peak_MPa=None if structural is None else structural.von_mises_MPa,
-            structural_peak_order=2 if recovered is not None else model.order, mesh=mesh))
+            structural_peak_order=2 if recovered is not None else model.order, mesh=mesh,
+            extra_point_data=fatigue_point_data(analysis)))
     return out
 
 

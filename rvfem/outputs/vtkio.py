@@ -276,7 +276,7 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
                        von_mises: np.ndarray, theta: np.ndarray, *, element_order: int = 1,
                        structural_peak_MPa: float | None = None, structural_peak_order: int | None = None,
                        mesh: VtuMesh | None = None, level: int = ZLIB_LEVEL,
-                       strategy: int = ZLIB_STRATEGY) -> Path:
+                       strategy: int = ZLIB_STRATEGY, extra_point_data: dict | None = None) -> Path:
     """Write the cycle's stress envelope as a ``.vtu``: point data :func:`envelope_field`
     (``von_mises_envelope_P1_MPa``: the largest vertex von Mises stress of every vertex over every
     solved crank angle, of the cycle's element order) and ``envelope_theta_deg`` (the crank angle at
@@ -303,6 +303,8 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
         ``vtu_mesh(points, triangles)`` (see :func:`write_vtu`).
     level, strategy : int
         zlib level and strategy of the arrays.
+    extra_point_data : dict, optional
+        More point arrays (name → (n_vertices,)), e.g. ``fatigue_safety_factor_P1``.
 
     Returns
     -------
@@ -312,6 +314,7 @@ def write_envelope_vtu(path: str | os.PathLike, points: np.ndarray, triangles: n
         mesh = vtu_mesh(points, triangles)
     point_data = {envelope_field(element_order): np.asarray(von_mises, dtype=float),
                   "envelope_theta_deg": np.round(np.degrees(np.asarray(theta, dtype=float)), ANGLE_DECIMALS)}
+    point_data.update({k: np.asarray(v, dtype=float) for k, v in (extra_point_data or {}).items()})
     field_data = {"element_order": np.array([element_order], dtype=np.int64)}
     if structural_peak_MPa is not None:
         field_data["structural_peak_von_mises_MPa"] = np.array([structural_peak_MPa], dtype=float)

@@ -916,6 +916,10 @@ class CycleResult:
         ``stress_envelope=True``); the same vertex stresses as :func:`rvfem.fem.stress_fields`.
     von_mises_envelope_theta : ndarray (n_vertices,) or None
         Crank angle at which each vertex reaches it, rad.
+    signed_von_mises_max, signed_von_mises_min : ndarray (n_vertices,) or None
+        Largest and smallest vertex von Mises stress with the sign of σxx + σyy over all solved
+        angles, MPa (with ``stress_envelope=True``): the fatigue check's amplitude and mean
+        (:func:`rvfem.evaluate.strength.fatigue_field`).
     solutions : tuple of AngleResult
         The full solution of every angle (any displacement field can be rebuilt exactly from it
         with :func:`displacement`).
@@ -945,6 +949,8 @@ class CycleResult:
     timings: dict
     von_mises_envelope: np.ndarray | None = None
     von_mises_envelope_theta: np.ndarray | None = None
+    signed_von_mises_max: np.ndarray | None = None
+    signed_von_mises_min: np.ndarray | None = None
     solutions: tuple = field(default=(), repr=False)
     stage: str = "one disc carrying T/discs (the handbook's equal share); crank support rigid: upper bound of the flexibility effect"
     disc_torque_Nmm: np.ndarray | None = None
@@ -1411,9 +1417,9 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, op: Oper
         t_prefetch = extras.pop("prefetch_seconds")
         t_cycle = time.perf_counter() - t0
         t1 = time.perf_counter()
-        envelope = envelope_theta = None
+        envelope = envelope_theta = sv_max = sv_min = None
         if stress_envelope:
-            envelope, envelope_theta = _von_mises_envelope(system, results)
+            envelope, envelope_theta, sv_max, sv_min = _von_mises_envelope(system, results)
         t_envelope = time.perf_counter() - t1
 
     bf = np.stack([r.bearing_forces for r in results])
@@ -1443,35 +1449,43 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, op: Oper
                  "pair_solves": extras.pop("pair_solves", len(thetas))},
         von_mises_envelope=envelope,
         von_mises_envelope_theta=envelope_theta,
+        signed_von_mises_max=sv_max,
+        signed_von_mises_min=sv_min,
         solutions=tuple(results),
         **extras,
     )
 
 
-def _von_mises_envelope(system: DiscSystem, results: list[AngleResult]) -> tuple[np.ndarray, np.ndarray]:
-    """Largest vertex von Mises stress of every vertex over the solved angles (MPa) and the angle
-    at which it occurs (rad)."""
+def _von_mises_envelope(system: DiscSystem, results: list[AngleResult]) -> tuple[np.ndarray, ...]:
+    """Largest vertex von Mises stress of every vertex over the solved angles (MPa), the angle
+    at which it occurs (rad), and the largest and smallest signed von Mises stress (the von Mises
+    stress with the sign of σxx + σyy, for the fatigue check of :mod:`rvfem.evaluate.strength`), MPa."""
 
     stress_op = nodal_stress_operator(system.model)
     nv = system.model.n_vertices
     envelope = np.full(nv, -np.inf)
     envelope_theta = np.zeros(nv)
+    sv_max, sv_min = np.full(nv, -np.inf), np.full(nv, np.inf)
     origins, roots = _origins(system, results)
     solved = {}
     for batch, fields in _root_fields(system, roots):      # vertex von Mises of the solved angles
         sxx, syy, sxy = (stress_op @ fields).reshape(3, nv, len(batch))
         vm = np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
-        solved.update({id(r): vm[:, j].copy() for j, r in enumerate(batch)})
+        sign = np.where(sxx + syy >= 0.0, 1.0, -1.0)
+        solved.update({id(r): (vm[:, j].copy(), sign[:, j].copy()) for j, r in enumerate(batch)})
     turns = {}
     for r, (root, k) in zip(results, origins):
-        vm = solved[id(root)]
+        vm, sign = solved[id(root)]
         if k:                              # von Mises is invariant: the values move with the disc
             if k not in turns:
                 turns[k] = turned_nodes(system, k)[:nv]
-            turned = np.empty(nv)
+            turned, turned_sign = np.empty(nv), np.empty(nv)
             turned[turns[k]] = vm
-            vm = turned
+            turned_sign[turns[k]] = sign
+            vm, sign = turned, turned_sign
         higher = vm > envelope
         envelope[higher] = vm[higher]
         envelope_theta[higher] = r.theta
-    return envelope, envelope_theta
+        np.maximum(sv_max, sign * vm, out=sv_max)
+        np.minimum(sv_min, sign * vm, out=sv_min)
+    return envelope, envelope_theta, sv_max, sv_min

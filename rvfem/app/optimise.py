@@ -1,0 +1,756 @@
+"""The lightest disc within budgets: a constrained optimisation over the hole parameters, each
+design a full analysis on the same Dask machinery as studies (:mod:`rvfem.app.study`).
+
+An **optimisation file** (TOML) names a base case, what to minimise, the parameters and the
+budgets::
+
+    name = "rv40e_fanholes_lightest"
+    base_case = "../cases/rv40e_fanholes.toml"  # relative to the file
+    objective = "disc_mass_kg"                  # or "disc_polar_inertia_kg_mm2"
+    trials = 32                                 # designs evaluated (the base is not one of them)
+    seed = 29                                   # the sampler's seed: same file, same designs
+    batch = 2                                   # designs proposed and run at once (default: workers)
+
+    [overrides]                                 # applied to the base and to every design
+    "analysis.angle_step_deg" = 2.0
+
+    [[parameter]]                               # a case key and its range (step: a grid of values)
+    key = "fan_holes.outer_radius"
+    low = 45.0
+    high = 52.0
+    step = 0.1
+
+    [budget]                                    # each optional
+    max_load_delta_percent = 12.0               # largest bearing load vs the case's reference, %
+    life_ratio = 0.75                           # shortest L10h / the reference's, at least
+    fatigue_safety_factor = 1.5                 # at least
+    static_safety_factor = 2.0                  # at least
+
+The responses of a design come from its ``summary.json`` (:func:`design_responses`): the
+objective keys, the safety factors and, per bearing, the deltas of the flexible loads against the
+case's rigid reference (``bearings[].delta_max_percent``, ``bearings[].life_ratio``; the
+handbook for the shipped cases). Manufacturability is the case validation and the geometry check
+(walls ≥ ``mesh.min_wall``, fillets that fit): a design they reject is recorded as infeasible
+with its message, never fatal.
+
+The optimiser is Optuna's TPE sampler with constraints (Watanabe, "Tree-structured Parzen
+estimator: understanding its algorithm components and their roles for better empirical
+performance", 2023; the constrained variant of Watanabe and Hutter, "c-TPE", 2023): a seeded
+sampler that proposes ``batch`` designs at a time (ask), which run in parallel on Dask and are
+told back in proposal order (tell), so the same file gives the same designs. A rerun into the same
+folder replays the same proposals and takes every design already in ``trials.csv`` from there
+(same parameters and case digest) instead of running it again: it resumes where the last run
+stopped, and a finished optimisation with more ``trials`` goes on from its end.
+
+Outputs in DIR: ``trials.csv`` (one row per design: parameters, responses, feasibility, status),
+``best.toml`` (the best feasible design as a complete case file), ``trials/<id>/`` (every design's
+result folder), ``pareto.png`` (mass against life ratio coloured by the fatigue safety factor, the
+feasible Pareto front drawn), ``optimisation.json`` and ``report.html``.
+
+``analytic`` problems (``problem = "analytic"``, no base case) evaluate :func:`analytic_responses`
+instead of a case, through the same loop and the same Dask client: the check that the optimiser
+finds a known optimum.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import csv
+import html
+import io
+import json
+import logging
+import math
+import os
+import time
+import tomllib
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+from rvfem._files import write_text_atomic
+from rvfem.app.study import (
+    SingleThreadedBlas,
+    VariantTask,
+    _acquire_lock,
+    _connect,
+    _one_line,
+    _remove_partials,
+    local_cluster,
+    run_variant,
+)
+from rvfem.case.definition import case_to_dict, load_case, parse_override
+from rvfem.case.schema import toml_literal
+from rvfem.errors import CaseError, RvfemError
+
+log = logging.getLogger(__name__)
+
+__all__ = [
+    "OBJECTIVES",
+    "BUDGETS",
+    "OptParameter",
+    "Problem",
+    "DesignTask",
+    "OptimisationResult",
+    "load_problem",
+    "design_responses",
+    "analytic_responses",
+    "evaluate_design",
+    "read_trials",
+    "run_optimisation",
+    "case_file_text",
+    "pareto_front",
+]
+
+OBJECTIVES = ("disc_mass_kg", "disc_polar_inertia_kg_mm2", "objective")
+"""What can be minimised (``objective`` is the analytic problem's)."""
+
+BUDGETS = {
+    "max_load_delta_percent": ("max_load_delta_percent", "max"),
+    "life_ratio": ("life_ratio", "min"),
+    "fatigue_safety_factor": ("fatigue_safety_factor", "min"),
+    "static_safety_factor": ("static_safety_factor", "min"),
+    "g": ("g", "max"),
+}
+"""Budget name → (response, ``"max"``: the response may not exceed the limit, ``"min"``: may not
+fall below it). ``g`` is the analytic problem's constraint."""
+
+INFEASIBLE_VIOLATION = 1.0e3
+"""Constraint violation told to the sampler for a design that failed (rejected geometry)."""
+
+
+@dataclass(frozen=True)
+class OptParameter:
+    """A varied case key over [low, high] (on a grid of ``step`` if given)."""
+
+    key: str
+    low: float
+    high: float
+    step: float | None = None
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A validated optimisation file (module docstring)."""
+
+    name: str
+    description: str
+    path: Path | None
+    kind: str                       # "case" or "analytic"
+    base_case: Path | None
+    overrides: tuple[str, ...]
+    objective: str
+    parameters: tuple[OptParameter, ...]
+    budgets: tuple[tuple[str, float], ...]
+    trials: int
+    seed: int
+    batch: int | None = None
+
+
+@dataclass(frozen=True)
+class DesignTask:
+    """What a worker needs for one design: the parameters and, for a case, its variant task."""
+
+    trial_id: str
+    params: tuple[tuple[str, float], ...]
+    variant: VariantTask | None = None
+
+
+@dataclass(frozen=True)
+class OptimisationResult:
+    """Outcome of :func:`run_optimisation`: the rows of ``trials.csv``, the best feasible row
+    (None if none), the files, this run's wall time, the designs computed in this run."""
+
+    out_dir: Path
+    problem: Problem
+    rows: tuple[dict, ...]
+    best: dict | None
+    files: dict
+    wall_time_s: float
+    computed: int
+    base: dict | None = field(default=None)
+
+
+# --------------------------------------------------------------------------------------------
+# The file
+# --------------------------------------------------------------------------------------------
+
+
+def _fail(where: str, key: str, message: str) -> CaseError:
+    return CaseError(f"{where}: {key}: {message}")
+
+
+def _number(where: str, key: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise _fail(where, key, f"expected a number, got {value!r}")
+    return float(value)
+
+
+def _read_parameters(where: str, raw: Any) -> tuple[OptParameter, ...]:
+    if not isinstance(raw, list) or not raw:
+        raise _fail(where, "parameter", "give at least one [[parameter]] table with key, low and high")
+    out = []
+    for i, p in enumerate(raw, start=1):
+        w = f"parameter {i}"
+        if not isinstance(p, dict) or set(p) - {"key", "low", "high", "step", "label"} or "key" not in p:
+            raise _fail(where, w, "expected a table of key, low, high and optionally step")
+        low, high = _number(where, f"{w}.low", p.get("low")), _number(where, f"{w}.high", p.get("high"))
+        if not low < high:
+            raise _fail(where, f"{w}.high", f"must exceed low ({low:g}), got {high:g}")
+        step = None if p.get("step") is None else _number(where, f"{w}.step", p["step"])
+        out.append(OptParameter(str(p["key"]), low, high, step))
+    return tuple(out)
+
+
+def _read_budgets(where: str, raw: Any) -> tuple[tuple[str, float], ...]:
+    if not isinstance(raw, dict):
+        raise _fail(where, "budget", "expected a table, e.g. life_ratio = 0.75")
+    for name in raw:
+        if name not in BUDGETS:
+            raise _fail(where, f"budget.{name}", f"unknown budget; known: {', '.join(BUDGETS)}")
+    return tuple((name, _number(where, f"budget.{name}", v)) for name, v in raw.items())
+
+
+_TOP_KEYS = {"name", "description", "problem", "base_case", "objective", "trials", "seed", "batch", "overrides",
+             "parameter", "budget"}
+
+
+def load_problem(path: str | os.PathLike, extra_overrides: Sequence[str] = (), trials: int | None = None) -> Problem:
+    """Read and check an optimisation file; the base case and one design at the middle of the
+    ranges are loaded (unknown case keys get their one-line error here).
+
+    Raises
+    ------
+    CaseError
+        One line naming the file and the key.
+    """
+    path = Path(path)
+    where = str(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise CaseError(f"{where}: cannot read the optimisation file ({exc.strerror or exc})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CaseError(f"{where}: not a valid TOML file ({exc})") from None
+    unknown = set(data) - _TOP_KEYS
+    if unknown:
+        raise _fail(where, sorted(unknown)[0], f"unknown key; known: {', '.join(sorted(_TOP_KEYS))}")
+    kind = data.get("problem", "case")
+    if kind not in ("case", "analytic"):
+        raise _fail(where, "problem", f"expected \"case\" or \"analytic\", got {kind!r}")
+    objective = data.get("objective", "disc_mass_kg" if kind == "case" else "objective")
+    if objective not in OBJECTIVES:
+        raise _fail(where, "objective", f"expected one of {', '.join(OBJECTIVES)}, got {objective!r}")
+    overrides = tuple(f"{k}={toml_literal(v)}" for k, v in (data.get("overrides") or {}).items())
+    overrides += tuple(extra_overrides)
+    for text in overrides:
+        parse_override(text)
+    base = None
+    if kind == "case":
+        if "base_case" not in data:
+            raise _fail(where, "base_case", "missing: the case file the designs vary")
+        base = (path.parent / str(data["base_case"])).resolve()
+    n = int(trials if trials is not None else data.get("trials", 30))
+    problem = Problem(name=str(data.get("name", path.stem)), description=str(data.get("description", "")),
+                      path=path.resolve(), kind=kind, base_case=base, overrides=overrides, objective=objective,
+                      parameters=_read_parameters(where, data.get("parameter")),
+                      budgets=_read_budgets(where, data.get("budget", {})), trials=max(1, n),
+                      seed=int(data.get("seed", 0)), batch=None if data.get("batch") is None else int(data["batch"]))
+    if base is not None:
+        middle = tuple((p.key, 0.5 * (p.low + p.high)) for p in problem.parameters)
+        _load_design(problem, middle)
+    return problem
+
+
+def _design_overrides(problem: Problem, params: Sequence[tuple[str, float]]) -> tuple[str, ...]:
+    return problem.overrides + tuple(f"{k}={toml_literal(float(v))}" for k, v in params)
+
+
+def _load_design(problem: Problem, params: Sequence[tuple[str, float]]):
+    return load_case(problem.base_case, _design_overrides(problem, params))
+
+
+# --------------------------------------------------------------------------------------------
+# One design (runs in a Dask worker)
+# --------------------------------------------------------------------------------------------
+
+
+def analytic_responses(params: dict[str, float]) -> dict[str, float]:
+    """The analytic check problem: minimise f = (x − 1)² + (y − 2)² subject to g = x + y ≤ 2.
+    Known optimum: the projection of (1, 2) onto the line x + y = 2, (0.5, 1.5), f* = 0.5."""
+    x, y = float(params["x"]), float(params["y"])
+    return {"objective": (x - 1.0) ** 2 + (y - 2.0) ** 2, "g": x + y}
+
+
+def design_responses(summary: dict) -> dict[str, float | None]:
+    """The responses of a design from its ``summary.json``: mass, inertia, safety factors, the
+    largest bearing-load delta and the smallest life ratio against the case's reference, the
+    shortest flexible L10h and the structural stress peak."""
+    bearings = summary.get("bearings") or []
+    deltas = [b.get("delta_max_percent") for b in bearings if b.get("delta_max_percent") is not None]
+    ratios = [b.get("life_ratio") for b in bearings if b.get("life_ratio") is not None]
+    lives = [b["flexible"]["L10h_h"] for b in bearings if b.get("flexible")]
+    loads = [b["flexible"]["max_load_N"] for b in bearings if b.get("flexible")]
+    return {
+        "disc_mass_kg": summary.get("disc_mass_kg"),
+        "disc_polar_inertia_kg_mm2": summary.get("disc_polar_inertia_kg_mm2"),
+        "static_safety_factor": summary.get("static_safety_factor"),
+        "fatigue_safety_factor": summary.get("fatigue_safety_factor"),
+        "max_load_delta_percent": max(deltas, default=None),
+        "life_ratio": min(ratios, default=None),
+        "max_load_N": max(loads, default=None),
+        "L10h_h": min(lives, default=None),
+        "peak_von_mises_MPa": summary.get("peak_von_mises_MPa"),
+    }
+
+
+def evaluate_design(task: DesignTask) -> dict:
+    """Evaluate one design (in a worker): the analytic responses, or the case run by
+    :func:`rvfem.app.study.run_variant` into its trial folder. Never raises: a failure is a record
+    with ``status`` ``"failed"`` or ``"error"`` and its message."""
+    started = time.perf_counter()
+    if task.variant is None:
+        record = {"status": "ok", "error": "", "computed": True, "responses": analytic_responses(dict(task.params))}
+    else:
+        record = run_variant(task.variant)
+        summary = record.pop("summary", None)
+        record["responses"] = design_responses(summary) if summary else {}
+    record.update(id=task.trial_id, wall_time_s=time.perf_counter() - started)
+    return record
+
+
+# --------------------------------------------------------------------------------------------
+# Budgets and rows
+# --------------------------------------------------------------------------------------------
+
+
+def _violations(problem: Problem, responses: dict) -> list[float]:
+    """Per budget the violation relative to its limit, > 0 when broken ((r − limit)/|limit| for an
+    upper, (limit − r)/|limit| for a lower bound); a missing response is broken by
+    :data:`INFEASIBLE_VIOLATION`."""
+    out = []
+    for name, limit in problem.budgets:
+        key, sense = BUDGETS[name]
+        r = responses.get(key)
+        if r is None or math.isnan(float(r)):
+            out.append(INFEASIBLE_VIOLATION)
+            continue
+        if math.isinf(float(r)):
+            out.append(-1.0 if (sense == "min") == (float(r) > 0) else INFEASIBLE_VIOLATION)
+            continue
+        scale = abs(limit) or 1.0
+        out.append((float(r) - limit) / scale if sense == "max" else (limit - float(r)) / scale)
+    return out
+
+
+def _row(problem: Problem, number: int, params: Sequence[tuple[str, float]], record: dict, digest: str) -> dict:
+    responses = record.get("responses") or {}
+    ok = record.get("status") == "ok" and responses.get(problem.objective) is not None
+    violations = _violations(problem, responses) if ok else [INFEASIBLE_VIOLATION] * len(problem.budgets)
+    row = {"number": number, "id": record.get("id", f"t{number:03d}"), "status": record.get("status", "failed"),
+           "feasible": ok and all(v <= 0 for v in violations),
+           "objective": responses.get(problem.objective) if ok else None,
+           "violation": math.fsum(max(v, 0.0) for v in violations)}
+    row.update({k: float(v) for k, v in params})
+    row.update({k: responses.get(k) for k in _response_keys(problem)})
+    row.update(error=record.get("error", ""), computed=bool(record.get("computed", False)),
+               wall_time_s=record.get("wall_time_s"), digest=digest)
+    return row
+
+
+def _response_keys(problem: Problem) -> tuple[str, ...]:
+    if problem.kind == "analytic":
+        return ("g",)
+    return ("disc_mass_kg", "disc_polar_inertia_kg_mm2", "max_load_delta_percent", "life_ratio", "L10h_h",
+            "max_load_N", "fatigue_safety_factor", "static_safety_factor", "peak_von_mises_MPa")
+
+
+def _columns(problem: Problem) -> list[str]:
+    return (["number", "id", "status", "feasible", "objective", "violation"] + [p.key for p in problem.parameters]
+            + list(_response_keys(problem)) + ["error", "computed", "wall_time_s", "digest"])
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return "" if math.isnan(value) else repr(value)
+    return str(value)
+
+
+def _csv_text(problem: Problem, rows: Sequence[dict]) -> str:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=_columns(problem), lineterminator="\n", extrasaction="ignore")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: _cell(r.get(k)) for k in _columns(problem)})
+    return buf.getvalue()
+
+
+def _parse_cell(text: str) -> Any:
+    if text == "":
+        return None
+    if text in ("yes", "no"):
+        return text == "yes"
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def read_trials(path: str | os.PathLike) -> list[dict]:
+    """The rows of a ``trials.csv`` (numbers as floats, empty cells None); [] if there is none."""
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = [{k: _parse_cell(v) for k, v in r.items()} for r in csv.DictReader(f)]
+    except OSError:
+        return []
+    for r in rows:
+        for k in ("id", "status", "error", "digest"):
+            r[k] = "" if r.get(k) is None else str(r[k])
+    return rows
+
+
+def _tidy(value: float, p: OptParameter) -> float:
+    """A stepped value without the float noise of low + k·step (3.4000000000000004 → 3.4): the
+    case files and tables show what the grid means."""
+    return float(round(value, 10)) if p.step is not None else float(value)
+
+
+def _key(params: Sequence[tuple[str, float]]) -> str:
+    return json.dumps([[k, round(float(v), 10)] for k, v in params])
+
+
+def _earlier(problem: Problem, rows: Sequence[dict]) -> dict[str, dict]:
+    """Designs of an earlier run by parameters (ok or rejected, not interrupted ones)."""
+    out = {}
+    for r in rows:
+        if r.get("status") not in ("ok", "failed") or any(r.get(p.key) is None for p in problem.parameters):
+            continue
+        out[_key([(p.key, r[p.key]) for p in problem.parameters])] = r
+    return out
+
+
+
+# --------------------------------------------------------------------------------------------
+# The loop
+# --------------------------------------------------------------------------------------------
+
+
+ProgressCallback = Callable[[int, int, dict], None]
+"""``progress(done, total, row)`` after every design."""
+
+
+@contextlib.contextmanager
+def _dask_client(scheduler: str | None, workers: int | None, client, connect_timeout_s: float = 30.0):
+    """The client of :func:`rvfem.app.study.run_study`: the given one (not closed), one connected to
+    ``scheduler``, or one of a new :func:`~rvfem.app.study.local_cluster`."""
+    if client is not None:
+        yield client
+        return
+    cluster = None
+    if scheduler:
+        own = _connect(scheduler, connect_timeout_s)
+    else:
+        from distributed import (
+            Client,  # optimisation only: Dask's scheduler is a heavy import
+        )
+
+        cluster = local_cluster(workers)
+        own = Client(cluster, set_as_default=False)
+    try:
+        try:
+            own.register_plugin(SingleThreadedBlas())
+        except Exception:
+            log.debug("could not register the single-threaded BLAS plugin", exc_info=True)
+        yield own
+    finally:
+        own.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _task(problem: Problem, trial_id: str, params: tuple, trials_dir: Path, cache: Path) -> tuple[DesignTask | None, str, dict | None]:
+    """(task, case digest, record of a design the case validation rejects)."""
+    if problem.kind == "analytic":
+        return DesignTask(trial_id, params), "", None
+    try:
+        case = _load_design(problem, params)
+    except RvfemError as exc:
+        return None, "", {"id": trial_id, "status": "failed", "error": _one_line(f"{type(exc).__name__}: {exc}"),
+                          "computed": True, "responses": {}, "wall_time_s": 0.0}
+    digest = case.digest()
+    variant = VariantTask(trial_id, str(problem.base_case), _design_overrides(problem, params), digest,
+                          str(trials_dir / trial_id), str(cache))
+    return DesignTask(trial_id, params, variant), digest, None
+
+
+def _run_batch(problem: Problem, client, batch: Sequence[tuple[str, tuple]], earlier: dict, trials_dir: Path,
+               cache: Path) -> list[tuple[dict, str]]:
+    """(record, digest) of every design of a batch, in order: taken from an earlier run where
+    its parameters and case digest match, else run on the client."""
+    out: list = [None] * len(batch)
+    futures = {}
+    for i, (trial_id, params) in enumerate(batch):
+        task, digest, rejected = _task(problem, trial_id, params, trials_dir, cache)
+        old = earlier.get(_key(params))
+        if old is not None and (old.get("digest") or "") == digest:
+            responses = {k: old.get(k) for k in (*_response_keys(problem), problem.objective)}
+            out[i] = ({"id": trial_id, "status": old["status"], "error": old.get("error", ""), "computed": False,
+                       "responses": responses if old["status"] == "ok" else {},
+                       "wall_time_s": old.get("wall_time_s")}, digest)
+        elif rejected is not None:
+            out[i] = (rejected, digest)
+        else:
+            futures[i] = (client.submit(evaluate_design, task, key=f"rvfem-design-{trial_id}-{os.urandom(4).hex()}",
+                                        pure=False), digest)
+    for i, (fut, digest) in futures.items():
+        try:
+            out[i] = (fut.result(), digest)
+        except Exception as exc:   # the task itself raised (a worker lost): recorded, never fatal
+            out[i] = ({"id": batch[i][0], "status": "failed", "computed": True, "responses": {},
+                       "error": _one_line(f"{type(exc).__name__}: {exc}"), "wall_time_s": float("nan")}, digest)
+    return out
+
+
+def _sampler(problem: Problem):
+    import optuna  # optimisation only: an optional dependency (the "optimise" extra)
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    warnings.filterwarnings("ignore", category=optuna.exceptions.ExperimentalWarning)
+    # constraints: Trial.set_constraint since Optuna 5, the sampler's constraints_func before
+    legacy = {} if _modern_constraints() else {"constraints_func": lambda t: t.user_attrs["constraints"]}
+    sampler = optuna.samplers.TPESampler(seed=problem.seed, multivariate=True,
+                                         n_startup_trials=max(8, 3 * len(problem.parameters)), **legacy)
+    return optuna.create_study(direction="minimize", sampler=sampler)
+
+
+def _modern_constraints() -> bool:
+    import optuna  # optimisation only: an optional dependency (the "optimise" extra)
+
+    return hasattr(optuna.trial.Trial, "set_constraint")
+
+
+def _tell_constraints(problem: Problem, trial, violations: Sequence[float]) -> None:
+    trial.set_user_attr("constraints", list(violations))
+    if _modern_constraints():
+        for (name, _), v in zip(problem.budgets, violations):
+            trial.set_constraint(name, float(v))
+
+
+def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, fallback: float,
+          progress: ProgressCallback | None, head: Sequence[dict] = ()) -> list[dict]:
+    """Ask a batch, run it, tell it in order; ``trials.csv`` after every batch."""
+    study = _sampler(problem)
+    rows: list[dict] = []
+    batch = problem.batch or max(1, len(client.scheduler_info().get("workers", {})) or 1)
+    while len(rows) < problem.trials:
+        trials = [study.ask() for _ in range(min(batch, problem.trials - len(rows)))]
+        params = [tuple((p.key, _tidy(t.suggest_float(p.key, p.low, p.high, step=p.step), p)) for p in problem.parameters)
+                  for t in trials]
+        done = _run_batch(problem, client, [(f"t{t.number:03d}", prm) for t, prm in zip(trials, params)], earlier,
+                          out_dir / "trials", cache)
+        for t, prm, (record, digest) in zip(trials, params, done):
+            row = _row(problem, t.number, prm, record, digest)
+            _tell_constraints(problem, t, _violations(problem, record.get("responses") or {})
+                              if row["objective"] is not None else [INFEASIBLE_VIOLATION] * len(problem.budgets))
+            study.tell(t, row["objective"] if row["objective"] is not None else fallback)
+            rows.append(row)
+            if progress is not None:
+                progress(len(rows), problem.trials, row)
+        write_text_atomic(out_dir / "trials.csv", _csv_text(problem, [*head, *rows]))
+    return rows
+
+
+def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows: Sequence[dict]) -> dict | None:
+    """The base case itself (``trials/base``), the reference of the report and the value told
+    for failed designs; None for an analytic problem."""
+    if problem.kind == "analytic":
+        return None
+    case = load_case(problem.base_case, problem.overrides)
+    old = next((r for r in earlier_rows if r.get("id") == "base" and r.get("digest") == case.digest()
+                and r.get("status") == "ok"), None)
+    if old is not None:
+        return {**old, "computed": False}
+    task = DesignTask("base", (), VariantTask("base", str(problem.base_case), problem.overrides, case.digest(),
+                                              str(out_dir / "trials" / "base"), str(cache)))
+    record = client.submit(evaluate_design, task, key=f"rvfem-design-base-{os.urandom(4).hex()}", pure=False).result()
+    return _row(problem, -1, (), record, case.digest())
+
+
+def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.PathLike, *,
+                     scheduler: str | None = None, workers: int | None = None, client=None,
+                     cache_dir: str | os.PathLike = "meshes", progress: ProgressCallback | None = None,
+                     plots: bool = True) -> OptimisationResult:
+    """Run an optimisation (module docstring) and write its folder.
+
+    Parameters
+    ----------
+    problem : Problem or path
+    out_dir : path
+        Folder; a rerun into it resumes (designs already in ``trials.csv`` are not run again).
+    scheduler, workers, client, cache_dir, progress, plots
+        As :func:`rvfem.app.study.run_study`.
+
+    Raises
+    ------
+    CaseError, OutputError, ClusterError
+        A bad file, a locked folder, no cluster. Failing designs are recorded, never raised.
+    """
+    started = time.perf_counter()
+    if not isinstance(problem, Problem):
+        problem = load_problem(problem)
+    out_dir = Path(out_dir).resolve()
+    cache = Path(cache_dir).resolve()
+    (out_dir / "trials").mkdir(parents=True, exist_ok=True)
+    lock = _acquire_lock(out_dir)
+    try:
+        _remove_partials(out_dir / "trials")
+        earlier_rows = read_trials(out_dir / "trials.csv")
+        with _dask_client(scheduler, workers, client) as c:
+            base = _base_row(problem, c, out_dir, cache, earlier_rows)
+            fallback = base["objective"] if base and base.get("objective") is not None else 0.0
+            rows = _loop(problem, c, out_dir, cache, _earlier(problem, earlier_rows), fallback, progress,
+                         head=[base] if base else [])
+        all_rows = ([base] if base else []) + rows
+        write_text_atomic(out_dir / "trials.csv", _csv_text(problem, all_rows))
+        best = min((r for r in rows if r["feasible"]), key=lambda r: r["objective"], default=None)
+        files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started)
+    finally:
+        lock.unlink(missing_ok=True)
+    return OptimisationResult(out_dir=out_dir, problem=problem, rows=tuple(rows), best=best, files=files,
+                              wall_time_s=time.perf_counter() - started,
+                              computed=sum(1 for r in rows if r["computed"]), base=base)
+
+
+# --------------------------------------------------------------------------------------------
+# Outputs
+# --------------------------------------------------------------------------------------------
+
+
+def case_file_text(case, comment: str = "") -> str:
+    """A complete case file (TOML) of ``case``: every key, top-level keys first, then one table
+    each (sub-tables and arrays of tables inline). Reading it back gives the same case digest."""
+    data = case_to_dict(case)
+    lines = [f"# {line}" for line in comment.splitlines()]
+    tables = {k: v for k, v in data.items() if isinstance(v, dict)}
+    lines += [f"{k} = {toml_literal(v, bare_keys=True)}" for k, v in data.items() if k not in tables]
+    for name, table in tables.items():
+        lines += ["", f"[{name}]"]
+        lines += [f"{k} = {toml_literal(v, bare_keys=True)}" for k, v in table.items() if v is not None]
+    return "\n".join(lines) + "\n"
+
+
+def pareto_front(rows: Sequence[dict], x: str = "disc_mass_kg", y: str = "life_ratio") -> list[dict]:
+    """The rows not dominated in (smallest ``x``, largest ``y``) among those that have both, by ``x``."""
+    pts = sorted((r for r in rows if r.get(x) is not None and r.get(y) is not None), key=lambda r: (r[x], -r[y]))
+    front, best_y = [], -math.inf
+    for r in pts:
+        if r[y] > best_y:
+            front.append(r)
+            best_y = r[y]
+    return front
+
+
+def _pareto_png(problem: Problem, rows: Sequence[dict], base: dict | None, best: dict | None, path: Path) -> Path:
+    from matplotlib.backends.backend_agg import (
+        FigureCanvasAgg,  # drawing only: matplotlib is a heavy import the solver never needs
+    )
+    from matplotlib.figure import (
+        Figure,  # drawing only: matplotlib is a heavy import the solver never needs
+    )
+
+    fig = Figure(figsize=(8, 5.5))
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    ok = [r for r in rows if r.get("disc_mass_kg") is not None and r.get("life_ratio") is not None]
+    sf = [min(r.get("fatigue_safety_factor") or 0.0, 50.0) for r in ok]
+    for feasible, marker in ((True, "o"), (False, "x")):
+        pick = [i for i, r in enumerate(ok) if bool(r["feasible"]) == feasible]
+        if pick:
+            sc = ax.scatter([ok[i]["disc_mass_kg"] for i in pick], [ok[i]["life_ratio"] for i in pick],
+                            c=[sf[i] for i in pick], cmap="viridis", vmin=min(sf), vmax=max(sf), marker=marker, s=40,
+                            label="feasible" if feasible else "outside a budget")
+    if ok:
+        fig.colorbar(sc, ax=ax, label="fatigue safety factor")
+    front = pareto_front(ok)
+    ax.step([r["disc_mass_kg"] for r in front], [r["life_ratio"] for r in front], where="post", color="0.4", lw=1,
+            label="Pareto front (all designs)")
+    if base is not None and base.get("disc_mass_kg") is not None:
+        ax.plot(base["disc_mass_kg"], base["life_ratio"], "r*", ms=14, label="base case")
+    if best is not None:
+        ax.plot(best["disc_mass_kg"], best["life_ratio"], "o", mfc="none", mec="r", ms=16, mew=2,
+                label=f"best feasible ({best['id']})")
+    for name, limit in problem.budgets:
+        if name == "life_ratio":
+            ax.axhline(limit, color="r", ls=":", lw=1, label=f"life-ratio budget {limit:g}")
+    ax.set_xlabel("disc mass, kg")
+    ax.set_ylabel("life ratio (shortest L10h / reference)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(f"{problem.name}: {len(rows)} designs", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def _fmt(v: Any, spec: str) -> str:
+    return "–" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
+
+
+def _report(problem: Problem, rows: Sequence[dict], base: dict | None, best: dict | None, png: Path | None,
+            wall_s: float) -> str:
+    e = html.escape
+    keys = [p.key for p in problem.parameters] + list(_response_keys(problem))
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>", f"<title>rvfem optimise {e(problem.name)}</title>",
+             "<style>body{font-family:sans-serif;margin:2em;max-width:1300px}table{border-collapse:collapse}"
+             "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right;font-size:90%}.no{color:#999}</style>"
+             "</head><body>", f"<h1>{e(problem.name)}</h1><p>{e(problem.description)}</p>",
+             f"<p>Minimise <b>{e(problem.objective)}</b> over {', '.join(e(p.key) for p in problem.parameters)}; "
+             "budgets: " + (", ".join(f"{e(n)} {'≤' if BUDGETS[n][1] == 'max' else '≥'} {v:g}"
+                                      for n, v in problem.budgets) or "none")
+             + f". {len(rows)} designs (seed {problem.seed}), wall time {wall_s:.0f} s.</p>"]
+    for title, r in (("Base case", base), ("Best feasible design", best)):
+        if r is not None:
+            parts.append(f"<h2>{title}</h2><p>" + ", ".join(f"{e(k)} = {_fmt(r.get(k), '.4g')}" for k in keys) + "</p>")
+    if png is not None:
+        data = base64.b64encode(png.read_bytes()).decode()
+        parts.append(f"<h2>Mass against life ratio</h2><img src='data:image/png;base64,{data}' alt='Pareto'>")
+    parts.append("<h2>Designs</h2><table><tr><th>id</th><th>status</th><th>feasible</th><th>objective</th>"
+                 + "".join(f"<th>{e(k)}</th>" for k in keys) + "<th>error</th></tr>")
+    for r in rows:
+        cls = "" if r["feasible"] else " class='no'"
+        parts.append(f"<tr{cls}><td>{e(r['id'])}</td><td>{e(r['status'])}</td><td>{'yes' if r['feasible'] else 'no'}</td>"
+                     f"<td>{_fmt(r['objective'], '.5g')}</td>" + "".join(f"<td>{_fmt(r.get(k), '.4g')}</td>" for k in keys)
+                     + f"<td style='text-align:left'>{e(r.get('error') or '')}</td></tr>")
+    parts.append("</table></body></html>")
+    return "\n".join(parts)
+
+
+def _write_outputs(problem: Problem, out_dir: Path, rows: list[dict], base: dict | None, best: dict | None,
+                   plots: bool, wall_s: float) -> dict:
+    files = {"csv": out_dir / "trials.csv"}
+    if best is not None and problem.kind == "case":
+        params = tuple((p.key, best[p.key]) for p in problem.parameters)
+        case = _load_design(problem, params)
+        files["best"] = out_dir / "best.toml"
+        write_text_atomic(files["best"], case_file_text(case, (
+            f"The lightest feasible design of {problem.name} ({best['id']}): {problem.objective} = "
+            f"{best['objective']:.6g}\nbudgets: " + ", ".join(f"{n} {v:g}" for n, v in problem.budgets)
+            + "\n" + ", ".join(f"{k} = {v:g}" for k, v in params))))
+    png = None
+    if plots and problem.kind == "case":
+        png = files["pareto"] = _pareto_png(problem, rows, base, best, out_dir / "pareto.png")
+    files["json"] = out_dir / "optimisation.json"
+    doc = {"name": problem.name, "objective": problem.objective, "seed": problem.seed, "trials": problem.trials,
+           "parameters": [vars(p) for p in problem.parameters], "budgets": dict(problem.budgets),
+           "overrides": list(problem.overrides), "base": base, "best": best,
+           "designs": len(rows), "feasible": sum(1 for r in rows if r["feasible"]), "wall_time_s": wall_s}
+    write_text_atomic(files["json"], json.dumps(doc, indent=2, default=str) + "\n")
+    files["report"] = out_dir / "report.html"
+    write_text_atomic(files["report"], _report(problem, rows, base, best, png, wall_s))
+    return files

@@ -1,0 +1,115 @@
+"""The mass-and-strength piece of ``summary.json`` (:data:`rvfem.outputs.summary.SUMMARY_PIECES`).
+
+Top-level keys scripts can rely on: ``disc_mass_kg``, ``disc_polar_inertia_kg_mm2``,
+``static_safety_factor``, ``fatigue_safety_factor`` and ``fatigue_safety_factor_at`` (the hot spot
+with the smallest factor), and the details under ``mass_strength`` (docs/outputs.md).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
+from rvfem.evaluate.postprocess import user_feature_name
+from rvfem.evaluate.strength import FATIGUE_CRITERION, fatigue_field
+
+__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
+           "fatigue_point_data"]
+
+
+def _where(peak) -> dict | None:
+    if peak is None:
+        return None
+    return {"x_mm": peak.x_mm, "y_mm": peak.y_mm, "theta_deg": peak.theta_deg,
+            "feature": None if peak.feature is None else user_feature_name(peak.feature)}
+
+
+def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
+    """The keys of the piece from a :class:`~rvfem.evaluate.design_checks.DesignChecks`."""
+    m = checks.mass
+    gov = checks.fatigue_governing
+    return {
+        "disc_mass_kg": m.mass_kg,
+        "disc_polar_inertia_kg_mm2": m.polar_inertia_kg_mm2,
+        "static_safety_factor": finite_or_none(checks.static_safety_factor),
+        "fatigue_safety_factor": None if gov is None else finite_or_none(gov.safety_factor),
+        "fatigue_safety_factor_at": None if gov is None else {"hot_spot": gov.name, **_where(gov.peak)},
+        "mass_strength": {
+            "disc_area_mm2": m.area_mm2,
+            "disc_polar_moment_mm4": m.polar_mm4,
+            "solid_disc_mass_kg": m.solid_mass_kg,
+            "solid_disc_polar_inertia_kg_mm2": m.solid_polar_inertia_kg_mm2,
+            "mass_saving_percent": m.mass_saving_percent,
+            "inertia_saving_percent": m.inertia_saving_percent,
+            "density_kg_m3": m.density_kg_m3,
+            "thickness_mm": m.thickness_mm,
+            "yield_strength_MPa": material.yield_strength,
+            "ultimate_strength_MPa": material.ultimate_strength,
+            "fatigue_limit_MPa": material.fatigue_limit,
+            "static_peak_von_mises_MPa": checks.static_peak_MPa,
+            "static_peak_at": _where(checks.static_peak),
+            "fatigue_criterion": FATIGUE_CRITERION,
+            "fatigue_hot_spots": [{
+                "name": f.name, "at": _where(f.peak), "amplitude_MPa": f.amplitude_MPa, "mean_MPa": f.mean_MPa,
+                "signed_von_mises_max_MPa": f.max_MPa, "signed_von_mises_min_MPa": f.min_MPa,
+                "p2_factor": f.p2_factor, "safety_factor": finite_or_none(f.safety_factor),
+            } for f in checks.fatigue],
+        },
+    }
+
+
+def piece_mass_strength(a, ctx) -> dict[str, Any]:
+    """Summary piece: mass, inertia and safety factors of an analysis."""
+    return mass_strength_dict(design_checks(a), a.case.material)
+
+
+def _factor(x: float | None) -> str:
+    return "–" if x is None else f"{x:.3g}"
+
+
+def mass_strength_lines(summary: dict) -> list[str]:
+    """The screen lines of the mass-and-strength keys of a ``summary.json`` (none where absent)."""
+    ms = summary.get("mass_strength")
+    if not ms:
+        return []
+    lines = [f"  disc mass {summary['disc_mass_kg']:.4g} kg, polar inertia {summary['disc_polar_inertia_kg_mm2']:.4g} "
+             f"kg·mm² about its centre; the lightening holes save {ms['mass_saving_percent']:.1f} % of the mass and "
+             f"{ms['inertia_saving_percent']:.1f} % of the inertia of the solid disc "
+             f"({ms['solid_disc_mass_kg']:.4g} kg, {ms['solid_disc_polar_inertia_kg_mm2']:.4g} kg·mm²)"]
+    where = summary.get("fatigue_safety_factor_at") or {}
+    fat = ""
+    if where:
+        fat = (f"; fatigue safety {_factor(summary.get('fatigue_safety_factor'))} ({where['hot_spot']} hot spot, "
+               f"{where.get('feature') or '?'} at ({where['x_mm']:.1f}, {where['y_mm']:.1f}) mm; "
+               f"{ms['fatigue_criterion']}, σ_W = {ms['fatigue_limit_MPa']:g} MPa)")
+    lines.append(f"  static safety against yield {_factor(summary.get('static_safety_factor'))} "
+                 f"(R_p0.2 = {ms['yield_strength_MPa']:g} MPa at the structural peak){fat}")
+    return lines
+
+
+def mass_strength_report(summary: dict) -> list[str]:
+    """The paragraphs of the report's "Mass, inertia and strength" section (none where absent):
+    the screen lines and one line per hot spot."""
+    ms = summary.get("mass_strength")
+    if not ms:
+        return []
+    lines = [line.strip() for line in mass_strength_lines(summary)]
+    for f in ms["fatigue_hot_spots"]:
+        at = f["at"] or {}
+        lines.append(f"Hot spot {f['name']} ({at.get('feature') or '?'} at ({at.get('x_mm', 0.0):.1f}, "
+                     f"{at.get('y_mm', 0.0):.1f}) mm): signed von Mises {f['signed_von_mises_min_MPa']:.1f} … "
+                     f"{f['signed_von_mises_max_MPa']:.1f} MPa (P1 history × {f['p2_factor']:.3f}), σ_a = "
+                     f"{f['amplitude_MPa']:.1f} MPa, σ_m = {f['mean_MPa']:.1f} MPa, fatigue safety factor "
+                     f"{_factor(f['safety_factor'])}.")
+    return lines
+
+
+def fatigue_point_data(analysis) -> dict:
+    """The envelope's fatigue field: ``fatigue_safety_factor_P<order>`` (the Goodman safety factor
+    of every vertex from the cycle's own vertex stresses, not scaled to P2; capped at 1000 for
+    the colour scale), empty where the cycle has no signed von Mises envelope."""
+    cy = analysis.cycle
+    if getattr(cy, "signed_von_mises_max", None) is None:
+        return {}
+    return {f"fatigue_safety_factor_P{analysis.system.model.order}":
+            fatigue_field(cy.signed_von_mises_max, cy.signed_von_mises_min, analysis.case.material)}

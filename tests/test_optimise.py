@@ -1,0 +1,158 @@
+"""rvfem optimise: the loop finds a known optimum on an analytic problem through the same Dask
+client as the case designs, reproducibly and resumably; the case path records rejected designs."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import pytest
+
+from conftest import CASES_DIR, coarse_case
+from rvfem.app import cli
+from rvfem.app.optimise import (
+    case_file_text,
+    load_problem,
+    pareto_front,
+    read_trials,
+    run_optimisation,
+)
+from rvfem.case.definition import load_case
+from rvfem.errors import CaseError
+
+pytest.importorskip("optuna")
+
+ANALYTIC = """
+name = "analytic"
+problem = "analytic"
+trials = {trials}
+seed = 3
+batch = 2
+
+[[parameter]]
+key = "x"
+low = -2.0
+high = 3.0
+
+[[parameter]]
+key = "y"
+low = -2.0
+high = 3.0
+
+[budget]
+g = 2.0
+"""
+
+
+@pytest.fixture(scope="module")
+def client():
+    """Two single-threaded worker processes of rvfem's own local cluster (the studies' one)."""
+    from distributed import Client
+
+    from rvfem.app.study import local_cluster
+
+    cluster = local_cluster(2)
+    c = Client(cluster, set_as_default=False)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def _problem(tmp_path: Path, trials: int):
+    path = tmp_path / f"analytic{trials}.toml"
+    path.write_text(ANALYTIC.format(trials=trials), encoding="utf-8")
+    return load_problem(path)
+
+
+def test_finds_the_known_optimum_of_an_analytic_problem(client, tmp_path):
+    """min (x − 1)² + (y − 2)² subject to x + y ≤ 2: the optimum is the projection of (1, 2) onto
+    the line, (0.5, 1.5), f* = 0.5. TPE in 150 designs comes within 0.03 of f* (seeded: this seed
+    gives 0.504) and within 0.1 of the point."""
+    r = run_optimisation(_problem(tmp_path, 150), tmp_path / "out", client=client)
+    best = r.best
+    assert best is not None and best["feasible"] and best["g"] <= 2.0
+    assert best["objective"] == pytest.approx(0.5, abs=0.03)
+    assert math.hypot(best["x"] - 0.5, best["y"] - 1.5) < 0.1
+    assert r.computed == 150 and len(read_trials(tmp_path / "out" / "trials.csv")) == 150
+    # every design that breaks the budget is marked infeasible
+    assert all(row["feasible"] == (row["g"] <= 2.0) for row in r.rows)
+
+
+def test_reproducible_and_resumed(client, tmp_path):
+    """The same file gives the same designs; a run stopped after 20 designs and resumed with 40
+    takes the 20 from trials.csv and ends with exactly the designs of an uninterrupted run."""
+    full = run_optimisation(_problem(tmp_path, 40), tmp_path / "full", client=client)
+    again = run_optimisation(_problem(tmp_path, 40), tmp_path / "again", client=client)
+    assert [(r["x"], r["y"]) for r in full.rows] == [(r["x"], r["y"]) for r in again.rows]
+    run_optimisation(_problem(tmp_path, 20), tmp_path / "resumed", client=client)
+    resumed = run_optimisation(_problem(tmp_path, 40), tmp_path / "resumed", client=client)
+    assert resumed.computed == 20
+    assert [(r["x"], r["y"], r["objective"]) for r in resumed.rows] == [(r["x"], r["y"], r["objective"])
+                                                                         for r in full.rows]
+
+
+def test_pareto_front():
+    rows = [{"m": 1.0, "l": 0.5}, {"m": 0.8, "l": 0.4}, {"m": 0.9, "l": 0.3}, {"m": 1.2, "l": 0.9},
+            {"m": 1.1, "l": 0.45}]
+    assert [(r["m"], r["l"]) for r in pareto_front(rows, "m", "l")] == [(0.8, 0.4), (1.0, 0.5), (1.2, 0.9)]
+
+
+def test_best_design_case_file_reads_back_to_the_same_case(tmp_path):
+    case = load_case(CASES_DIR / "rv40e_fanholes.toml", ("fan_holes.outer_radius=51.3", "loads.torque_Nm=300.0"))
+    path = tmp_path / "best.toml"
+    path.write_text(case_file_text(case, "a comment\nof two lines"), encoding="utf-8")
+    assert load_case(path).digest() == case.digest()
+
+
+def test_bad_files_give_one_line_errors(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(ANALYTIC.format(trials=5).replace("g = 2.0", "mass = 2.0"), encoding="utf-8")
+    with pytest.raises(CaseError, match="budget.mass: unknown budget"):
+        load_problem(path)
+    path.write_text(ANALYTIC.format(trials=5).replace("high = 3.0", "high = -3.0", 1), encoding="utf-8")
+    with pytest.raises(CaseError, match="parameter 1.high: must exceed low"):
+        load_problem(path)
+
+
+@pytest.mark.slow
+def test_case_designs_through_the_command_line(tmp_path, capsys):
+    """Six coarse designs of the fan-hole disc through ``rvfem optimise``: the inner radius ranges
+    down to a 0.5 mm wall to the central hole, which the geometry check rejects (recorded, not
+    fatal); every design's mass is the one its own summary.json has; best.toml runs again."""
+    base = tmp_path / "coarse.toml"
+    base.write_text(case_file_text(coarse_case("rv40e_fanholes")), encoding="utf-8")
+    problem = tmp_path / "p.toml"
+    problem.write_text(f"""
+name = "p"
+base_case = "{base.name}"
+trials = 6
+seed = 1
+batch = 2
+[overrides]
+"analysis.angle_step_deg" = 30.0
+[[parameter]]
+key = "fan_holes.inner_radius"
+low = 12.5
+high = 17.5
+step = 1.0
+[budget]
+max_load_delta_percent = 30.0
+life_ratio = 0.5
+fatigue_safety_factor = 1.5
+""", encoding="utf-8")
+    out = tmp_path / "out"
+    assert cli.main(["optimise", str(problem), "-o", str(out), "--workers", "2",
+                     "--cache-dir", str(tmp_path / "meshes")]) == 0
+    rows = read_trials(out / "trials.csv")
+    assert rows[0]["id"] == "base" and len(rows) == 7
+    assert any(r["status"] == "failed" for r in rows[1:]) and any(r["status"] == "ok" for r in rows[1:])
+    for r in rows[1:]:
+        if r["fan_holes.inner_radius"] < 14.0:        # wall to the central hole (12 mm) under 2 mm
+            assert r["status"] == "failed" and not r["feasible"] and "central hole" in r["error"]
+        else:
+            assert r["status"] == "ok"
+    assert (out / "pareto.png").stat().st_size > 10_000 and (out / "report.html").is_file()
+    best = load_case(out / "best.toml")
+    assert best.fan_holes.inner_radius == min(r["fan_holes.inner_radius"] for r in rows[1:]
+                                              if r["status"] == "ok" and r["feasible"])
