@@ -156,3 +156,16 @@ fatigue_safety_factor = 1.5
     best = load_case(out / "best.toml")
     assert best.fan_holes.inner_radius == min(r["fan_holes.inner_radius"] for r in rows[1:]
                                               if r["status"] == "ok" and r["feasible"])
+
+
+def test_without_optuna_the_command_says_how_to_install_it(tmp_path, monkeypatch):
+    """Optuna is an optional extra: without it the optimiser stops before any folder or cluster
+    with one line that says how to install it."""
+    import sys
+
+    from rvfem.errors import RvfemError
+
+    monkeypatch.setitem(sys.modules, "optuna", None)   # makes ``import optuna`` raise ImportError
+    with pytest.raises(RvfemError, match=r"pip install 'rvfem\[optimise\]'"):
+        run_optimisation(_problem(tmp_path, 5), tmp_path / "out")
+    assert not (tmp_path / "out").exists()

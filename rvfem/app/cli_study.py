@@ -149,14 +149,19 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def _add_study_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("study", help="study file (TOML; see docs/studies.md)")
-    parser.add_argument("-o", "--output", metavar="DIR", help="study folder (default: results/<study name>); "
-                        "a rerun into the same folder skips the variants already done")
+def _add_cluster_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--scheduler`` and ``--workers``: where a study's or an optimisation's designs run."""
     parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                         help="address of a running Dask scheduler (default: a local cluster)")
     parser.add_argument("--workers", type=_positive_int, metavar="N",
                         help="workers of the local cluster (default: one per core)")
+
+
+def _add_study_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("study", help="study file (TOML; see docs/studies.md)")
+    parser.add_argument("-o", "--output", metavar="DIR", help="study folder (default: results/<study name>); "
+                        "a rerun into the same folder skips the variants already done")
+    _add_cluster_arguments(parser)
     _add_set_argument(parser, "of the base case and every variant")
     parser.add_argument("--cache-dir", default="meshes", help="mesh cache shared by the workers (default: meshes)")
     parser.add_argument("--check", action="store_true", help="validate the study and list its variants; run nothing")
@@ -270,10 +275,7 @@ def _add_optimise_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("problem", help="optimisation file (TOML; see docs/studies.md, \"Optimisation\")")
     parser.add_argument("-o", "--output", metavar="DIR", help="folder (default: results/<name>); a rerun into "
                         "the same folder takes the designs already in its trials.csv from there")
-    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
-                        help="address of a running Dask scheduler (default: a local cluster)")
-    parser.add_argument("--workers", type=_positive_int, metavar="N",
-                        help="workers of the local cluster (default: one per core)")
+    _add_cluster_arguments(parser)
     parser.add_argument("--trials", type=_positive_int, metavar="N", help="designs to evaluate (default: the file's)")
     _add_set_argument(parser, "of the base case and every design")
     parser.add_argument("--cache-dir", default="meshes", help="mesh cache shared by the workers (default: meshes)")

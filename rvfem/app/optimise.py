@@ -517,9 +517,24 @@ def _run_batch(problem: Problem, client, batch: Sequence[tuple[str, tuple]], ear
     return out
 
 
-def _sampler(problem: Problem):
-    import optuna  # optimisation only: an optional dependency (the "optimise" extra)
+def _optuna():
+    """Optuna, the optional dependency of the optimiser (the ``optimise`` extra).
 
+    Raises
+    ------
+    RvfemError
+        Optuna is not installed: the message says how to install it.
+    """
+    try:
+        import optuna  # optimisation only: an optional dependency (the "optimise" extra)
+    except ImportError:
+        raise RvfemError("rvfem optimise needs Optuna, an optional dependency: install it with "
+                         "pip install 'rvfem[optimise]' (make test installs it with the dev extra)") from None
+    return optuna
+
+
+def _sampler(problem: Problem):
+    optuna = _optuna()
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     warnings.filterwarnings("ignore", category=optuna.exceptions.ExperimentalWarning)
     # constraints: Trial.set_constraint since Optuna 5, the sampler's constraints_func before
@@ -530,9 +545,7 @@ def _sampler(problem: Problem):
 
 
 def _modern_constraints() -> bool:
-    import optuna  # optimisation only: an optional dependency (the "optimise" extra)
-
-    return hasattr(optuna.trial.Trial, "set_constraint")
+    return hasattr(_optuna().trial.Trial, "set_constraint")
 
 
 def _tell_constraints(problem: Problem, trial, violations: Sequence[float]) -> None:
@@ -604,6 +617,7 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
     started = time.perf_counter()
     if not isinstance(problem, Problem):
         problem = load_problem(problem)
+    _optuna()  # before any folder or cluster: a missing optional dependency is said first
     out_dir = Path(out_dir).resolve()
     cache = Path(cache_dir).resolve()
     (out_dir / "trials").mkdir(parents=True, exist_ok=True)
