@@ -50,3 +50,21 @@ def test_warning_lines():
     assert warning_lines([]) == []
     lines = warning_lines([{"code": "load_ratio", "message": "P/C = 6.09 (bearing 1, flexible) > 0.5: …"}])
     assert lines == ["", "  warning: P/C = 6.09 (bearing 1, flexible) > 0.5: …"]
+
+
+def test_roller_depth_lines_merge_bearings_with_equal_results():
+    """With N-fold symmetry the bearings carry equal loads: one set of lines names them together;
+    a bearing that differs keeps its own lines."""
+    from rvfem.app.screen import roller_depth_lines
+
+    entry = {"roller_peak_pressure_MPa": 1911.0, "roller_edge_factor": 1.22, "peak_raceway": "eccentric",
+             "film_thickness_min_um": 0.053, "kappa": 0.72, "a_iso": 3.47, "L10h_h": 27768.0,
+             "L_nm_h": 96367.0, "L10r_h": 58061.0}
+    bearing = {"rigid": entry, "flexible": entry, "L10h_ratio": 1.0, "L_nm_ratio": 1.0, "L10r_ratio": 1.0}
+    depth = {"profile": "straight", "slices": 30, "max_slope_mrad": 0.14,
+             "bearings": [dict(bearing, bearing=i) for i in (1, 2, 3)]}
+    text = "\n".join(roller_depth_lines(depth))
+    assert "bearings 1–3 rigid" in text and "bearing 1 " not in text
+    depth["bearings"][2] = dict(bearing, bearing=3, L10r_ratio=0.5)
+    text = "\n".join(roller_depth_lines(depth))
+    assert "bearings 1–2 flexible/rigid" in text and "bearing 3 flexible/rigid" in text

@@ -173,26 +173,42 @@ def summary_text(summary: dict) -> str:
     return "\n".join(lines)
 
 
-def roller_depth_lines(depth: dict | None) -> list[str]:
-    """The crank bearing in depth: per bearing the pressure along the roller, film, κ and the three
-    lives (basic L10h, modified L_nm, lamina L10r) rigid and flexible with the flexible/rigid ratio."""
-    if not depth:
-        return []
-    lines = [f"  crank bearing in depth ({depth['profile']} rollers, {depth['slices']} slices; crankshaft slope up to "
-             f"{_sig(depth['max_slope_mrad'], '.3f')} mrad):"]
-    for b in depth["bearings"]:
-        for model in ("rigid", "flexible"):
-            d = b[model]
-            if d is None:
-                continue
-            lines.append(f"    bearing {b['bearing']} {model:<8} p_max {_sig(d['roller_peak_pressure_MPa'], '.0f')} MPa "
+def _bearing_depth_lines(b: dict) -> list[str]:
+    """One bearing's lines of :func:`roller_depth_lines` without its name (``{name}`` in front)."""
+    lines = []
+    for model in ("rigid", "flexible"):
+        d = b[model]
+        if d is not None:
+            lines.append(f"{model:<8} p_max {_sig(d['roller_peak_pressure_MPa'], '.0f')} MPa "
                          f"(edge factor {_num(d['roller_edge_factor'], '.2f')}, {d['peak_raceway']}), h_min "
                          f"{_num(d['film_thickness_min_um'], '.3f')} µm, κ {_num(d['kappa'], '.2f')}, a_ISO "
                          f"{_num(d['a_iso'], '.2f')}; L10h {_life(d['L10h_h'])} h, L_nm {_life(d['L_nm_h'])} h, "
                          f"L10r {_life(d['L10r_h'])} h")
-        if b["rigid"] is not None:
-            lines.append(f"    bearing {b['bearing']} flexible/rigid: L10h {_num(b['L10h_ratio'], '.2f')}, L_nm "
-                         f"{_num(b['L_nm_ratio'], '.2f')}, L10r {_num(b['L10r_ratio'], '.2f')}")
+    if b["rigid"] is not None:
+        lines.append(f"flexible/rigid: L10h {_num(b['L10h_ratio'], '.2f')}, L_nm {_num(b['L_nm_ratio'], '.2f')}, "
+                     f"L10r {_num(b['L10r_ratio'], '.2f')}")
+    return lines
+
+
+def roller_depth_lines(depth: dict | None) -> list[str]:
+    """The crank bearing in depth: per bearing the pressure along the roller, film, κ and the three
+    lives (basic L10h, modified L_nm, lamina L10r) rigid and flexible with the flexible/rigid ratio.
+    Neighbouring bearings whose lines read the same (N-fold symmetry: every crank bearing carries the
+    same loads, 120° apart) share them: ``bearings 1–3``."""
+    if not depth:
+        return []
+    groups: list[tuple[list[int], list[str]]] = []
+    for b in depth["bearings"]:
+        body = _bearing_depth_lines(b)
+        if groups and groups[-1][1] == body:
+            groups[-1][0].append(b["bearing"])
+        else:
+            groups.append(([b["bearing"]], body))
+    lines = [f"  crank bearing in depth ({depth['profile']} rollers, {depth['slices']} slices; crankshaft slope up to "
+             f"{_sig(depth['max_slope_mrad'], '.3f')} mrad):"]
+    for numbers, body in groups:
+        name = f"bearings {numbers[0]}–{numbers[-1]}" if len(numbers) > 1 else f"bearing {numbers[0]}"
+        lines += [f"    {name} {line}" for line in body]
     return lines
 
 
