@@ -344,13 +344,25 @@ def _other_results(summary: dict) -> dict:
     rows = _stress_rows(summary["stress"]) + [
         ["largest bearing load", f"{mx['flexible_N']:.0f} N, bearing {mx['bearing']}, θ = {mx['theta_deg']:.1f}°"],
         ["pins in contact", f"{pins['min']}–{pins['max']} of {pins['of']} (mean {pins['mean']:.1f})"],
-        ["torsional stiffness (per disc)", f"{summary['torsional_stiffness_Nm_per_arcmin']:.2f} N·m/arcmin"],
+        ["disc torque / mean carrier rotation (per disc)",
+         f"{summary['torsional_stiffness_Nm_per_arcmin']:.2f} N·m/arcmin"],
         ["carrier rotation", f"{summary['carrier_rotation_arcmin']['mean']:.3f} arcmin (mean)"],
+        *_accuracy_rows(summary.get("accuracy")),
         ["equilibrium residual (max)", f"{summary['equilibrium_residual']:.2e}"],
         ["active-set iterations", f"max {summary['active_set_iterations']['max']}, mean "
                                   f"{summary['active_set_iterations']['mean']:.1f}"],
     ]
     return _table(["quantity", "value"], rows, left=2)
+
+
+def _accuracy_rows(acc: dict | None) -> list[list[str]]:
+    """Torsional rigidity and lost motion of the stage from the run's few points of the hysteresis
+    loop (docs/theory.md § 9b; ``rvfem hysteresis`` gives the whole loop)."""
+    if not acc:
+        return []
+    where = f"input locked at θ = {acc['crank_angle_deg']:g}°, ±{acc['torque_Nm']:g} N·m, stage only"
+    return [["torsional rigidity (b/a, 3–100 % T)", f"{acc['torsional_rigidity_Nm_per_arcmin']:.1f} N·m/arcmin ({where})"],
+            ["lost motion (±3 % T)", f"{acc['lost_motion_arcmin']:.3f} arcmin ({where})"]]
 
 
 def _attribution(summary: dict) -> dict:
