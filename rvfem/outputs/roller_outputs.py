@@ -45,7 +45,7 @@ def write_roller_pressure_csv(analysis, folder: str | os.PathLike) -> list[Path]
 
 def roller_pressure_plot(path: str | os.PathLike, depths, profile: str) -> Path:
     """Draw p(x) of the worst roller of every bearing and model (rigid dashed, flexible solid)."""
-    fig = _figure((7.0, 4.2))
+    fig = _figure((7.0, 5.0))
     ax = fig.add_subplot(1, 1, 1)
     for d in sorted(depths, key=lambda d: (d.bearing, d.model)):
         ax.plot(d.x_mm, d.pressure_MPa, ls="--" if d.model == "rigid" else "-", color=COLOURS[d.bearing % len(COLOURS)],
@@ -55,7 +55,7 @@ def roller_pressure_plot(path: str | os.PathLike, depths, profile: str) -> Path:
     ax.set_ylabel("contact pressure (MPa)")
     ax.set_title(f"Pressure along the most loaded roller ({profile} profile, slice model)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="lower center")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)  # below: the curves fill the axes
     fig.tight_layout()
     return _save(fig, path)
 
