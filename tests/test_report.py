@@ -33,6 +33,7 @@ BUILT_IN = ["tables", "roller_pressure_csv", "case_json", "vtk", "plots", "rolle
 SECTIONS = [
     "Crank-bearing loads and lives: rigid handbook vs flexible disc", "Other results",
     "What the flexibility delta is made of", "What this delta depends on", "Hertz pressure of the most loaded roller",
+    "The crank bearing in depth: pressure along the rollers, film and lives", "Mass, inertia and strength",
     "Plots", "Case parameters", "Assumptions", "Files and timings",
 ]
 """The headings (h2) of every report, in order."""
@@ -220,7 +221,7 @@ def test_the_report_of_a_run_renders_every_section(run_folder, summary, case):
     for f in summary["files"]:
         assert f in text
     raw = (run_folder / "report.html").read_text(encoding="utf-8")
-    assert raw.count('<img src="data:image/png;base64,') == len(summary["plots"]) == 4 and "<" not in text
+    assert raw.count('<img src="data:image/png;base64,') == len(summary["plots"]) == 5 and "<" not in text
     overrides = ", ".join(f"{k} = {report.toml_text(v)}" for k, v in summary["case"]["overrides"].items())
     assert f"overrides: {overrides}" in text
     assert "fan holes 3, r = 17…49 mm, ligament 4.5 mm, fillet 2 mm" in text

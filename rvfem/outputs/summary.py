@@ -1077,7 +1077,9 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
     return calls
 
 
-@register_writer("plots", order=40, stage="plots", options=("pending",), files=("plots/*.png",))
+@register_writer("plots", order=40, stage="plots", options=("pending",),
+                 files=tuple(f"plots/{name}.png" for name in ("bearing_loads", "roller_loads", "pin_forces",
+                                                            "pins_in_contact")))
 def write_plots(analysis, folder: str | os.PathLike, *, pending: PendingImages | None = None) -> list[Path]:
     """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
     the equal share where it is not defined), roller loads and pin forces at the angle of the
