@@ -194,7 +194,7 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     codes = [w["code"] for w in summary["warnings"]]
     assert codes == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield", "large_displacement",
-                     "fatigue_safety"]
+                     "fatigue_safety", "roller_pressure"]
     for w in summary["warnings"]:
         assert set(w) == {"code", "message", "value", "limit", "unit"}
         assert f"  warning: {w['message']}" in screen.splitlines()
@@ -225,7 +225,7 @@ def test_overload_cases_warn(changes, tmp_path):
 
     a = analyse(coarse_case("rv40e_fanholes", **changes), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
     assert _codes(a.warnings) == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield",
-                                  "large_displacement", "fatigue_safety"]
+                                  "large_displacement", "fatigue_safety", "roller_pressure"]
 
 
 def test_hertz_limit_scales_with_a_material_that_is_not_steel():
