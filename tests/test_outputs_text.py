@@ -58,8 +58,8 @@ def test_roller_depth_lines_merge_bearings_with_equal_results():
     from rvfem.app.screen import roller_depth_lines
 
     entry = {"roller_peak_pressure_MPa": 1911.0, "roller_edge_factor": 1.22, "peak_raceway": "eccentric",
-             "film_thickness_min_um": 0.053, "kappa": 0.72, "a_iso": 3.47, "L10h_h": 27768.0,
-             "L_nm_h": 96367.0, "L10r_h": 58061.0}
+             "film_thickness_min_um": 0.053, "kappa": 0.72, "a_iso": 0.92, "L10h_h": 27768.0,
+             "L_nm_h": 25630.0, "L10r_h": 58061.0}
     bearing = {"rigid": entry, "flexible": entry, "L10h_ratio": 1.0, "L_nm_ratio": 1.0, "L10r_ratio": 1.0}
     depth = {"profile": "straight", "slices": 30, "max_slope_mrad": 0.14,
              "bearings": [dict(bearing, bearing=i) for i in (1, 2, 3)]}

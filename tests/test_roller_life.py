@@ -72,11 +72,23 @@ def test_reference_viscosity_by_hand():
     assert lb.reference_viscosity(3000.0, 31.0) == pytest.approx(4500 / math.sqrt(3000 * 31), rel=1e-12)
 
 
-@pytest.mark.parametrize("kappa, c1, e", [(0.3, 2.2649, 0.054381), (0.7, 1.9987, 0.19087), (2.0, 1.9987, 0.071739)])
-def test_a_iso_by_hand_in_each_kappa_branch(kappa, c1, e):
-    for x in (0.1, 0.55 * 2835.25 / 2763.46):  # and e_C·C_u/P of the shipped bearing (normal cleanliness)
-        hand = min(0.1 * (1 - (2.5671 - c1 / kappa**e) ** 1.1 * x**0.4) ** -9.185, 50.0)
-        assert lb.a_iso_roller(kappa, x) == pytest.approx(hand, rel=1e-12)
+@pytest.mark.parametrize("kappa, x, a_iso", [
+    (0.3, 0.1, 0.140834), (0.3, 0.564288, 0.200845),     # 0.1 ≤ κ < 0.4: 1.5859 − 1.3993/κ^0.054381
+    (0.7, 0.1, 0.277425), (0.7, 0.564288, 0.872362),     # 0.4 ≤ κ < 1:   1.5859 − 1.2348/κ^0.19087
+    (2.0, 0.1, 0.516097), (2.0, 0.564288, 3.794975),     # 1 ≤ κ ≤ 4:     1.5859 − 1.2348/κ^0.071739
+])
+def test_a_iso_by_hand_in_each_kappa_branch(kappa, x, a_iso):
+    """ISO 281:2007 eqs. (34)–(36), radial roller bearings, 0.1·[1 − (…)·x^0.4]^−9.185, worked by
+    hand to six digits; x = 0.564288 is e_C·C_u/P of the shipped bearing (normal cleanliness)."""
+    assert lb.a_iso_roller(kappa, x) == pytest.approx(a_iso, rel=2e-6)
+
+
+@pytest.mark.parametrize("kappa", [0.4, 1.0])
+def test_a_iso_branches_meet(kappa):
+    """The standard's constants make a_ISO continuous where its κ branches meet (a mistyped
+    constant or a ball-bearing constant would not)."""
+    for x in (0.05, 0.3, 1.0):
+        assert lb.a_iso_roller(kappa * (1 - 1e-9), x) == pytest.approx(lb.a_iso_roller(kappa, x), rel=1e-4)
 
 
 def test_a_iso_limits():

@@ -173,23 +173,25 @@ def reference_viscosity(speed_rpm: float, pitch_diameter_mm: float) -> float:
 
 
 def a_iso_roller(kappa: float, ec_cu_over_p: float) -> float:
-    """Life modification factor a_ISO of radial roller bearings (ISO 281:2007, 9.3.2, eqs. for
-    radial roller bearings).
+    """Life modification factor a_ISO of radial roller bearings (ISO 281:2007, 9.3.3.2, eqs. (34)
+    to (36)).
 
-    a_ISO = 0.1·[1 − (2.5671 − c1/κ^e)^1.1 · (e_C·C_u/P)^0.4]^−9.185 with
-    (c1, e) = (2.2649, 0.054381) for 0.1 ≤ κ < 0.4, (1.9987, 0.19087) for 0.4 ≤ κ < 1 and
-    (1.9987, 0.071739) for 1 ≤ κ ≤ 4; κ > 4 is taken as 4 and κ < 0.1 as 0.1 (outside the
-    standard's range, warned elsewhere); capped at 50 (also where the bracket is not positive).
+    a_ISO = 0.1·[1 − (1.5859 − c1/κ^e) · (e_C·C_u/P)^0.4]^−9.185 with
+    (c1, e) = (1.3993, 0.054381) for 0.1 ≤ κ < 0.4, (1.2348, 0.19087) for 0.4 ≤ κ < 1 and
+    (1.2348, 0.071739) for 1 ≤ κ ≤ 4 (the branches meet at κ = 0.4 and 1); κ > 4 is taken as 4
+    and κ < 0.1 as 0.1 (outside the standard's range, warned elsewhere); capped at 50 (also where
+    the bracket is not positive). The ball-bearing equations (31) to (33) have other constants
+    (2.5671, 2.2649, 1.9987) and exponents (0.83, 1/3, −9.3).
     """
     k = min(max(kappa, 0.1), 4.0)
     if k < 0.4:
-        c1, e = 2.2649, 0.054381
+        c1, e = 1.3993, 0.054381
     elif k < 1.0:
-        c1, e = 1.9987, 0.19087
+        c1, e = 1.2348, 0.19087
     else:
-        c1, e = 1.9987, 0.071739
+        c1, e = 1.2348, 0.071739
     x = max(ec_cu_over_p, 0.0)
-    bracket = 1.0 - (2.5671 - c1 / k**e) ** 1.1 * x**0.4
+    bracket = 1.0 - (1.5859 - c1 / k**e) * x**0.4
     if bracket <= 0.0:
         return A_ISO_MAX
     return min(0.1 * bracket**-9.185, A_ISO_MAX)
