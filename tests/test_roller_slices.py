@@ -136,13 +136,16 @@ def test_logarithmic_profile_is_flat_at_its_design_load():
     c = rs.roller_contact(q, LENGTH, R_INNER, E_STAR, RollerProfile(kind="logarithmic", design_load_N=q), slices=60)
     nominal, _ = rs.hertz_peak_from_line_load(q / LENGTH, R_INNER, E_STAR)
     core = np.abs(c.x_mm) < 0.4 * LENGTH                   # the inner 80 % of the length
-    flatness = c.pressure_MPa[core].max() / c.pressure_MPa[core].min() - 1.0
-    # Johns–Gohar's finite drop relieves the last tenths of the length a little: the pressure
-    # falls by about 5 % from the centre to 0.8·L/2 and stays within 2.5 % over the middle half
-    assert flatness < 0.06
-    middle = np.abs(c.x_mm) < 0.25 * LENGTH
-    assert c.pressure_MPa[middle].max() / c.pressure_MPa[middle].min() - 1.0 < 0.025
-    assert c.edge_factor < 1.05
+    # Johns–Gohar's drop is the sag of a uniform strip load on the half-space (Lundberg): at Q_d
+    # the pressure is uniform; only the last slices, where the finite drop ends, move at all
+    assert c.pressure_MPa[core].max() / c.pressure_MPa[core].min() - 1.0 < 1e-3
+    loaded = c.pressure_MPa[c.pressure_MPa > 0]
+    assert loaded.size == c.pressure_MPa.size and loaded.max() / loaded.min() - 1.0 < 0.02
+    assert c.edge_factor < 1.01
+    # above its design load the profile's drop is used up towards the ends: edge peaks return
+    over = rs.roller_contact(2 * q, LENGTH, R_INNER, E_STAR, RollerProfile(kind="logarithmic", design_load_N=q),
+                             slices=60)
+    assert over.edge_factor > 1.1
     # a straight roller at the same load is far from flat
     s = rs.roller_contact(q, LENGTH, R_INNER, E_STAR, RollerProfile(), slices=60)
     assert s.pressure_MPa.max() / s.pressure_MPa[core].min() - 1.0 > 0.25

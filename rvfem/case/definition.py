@@ -266,7 +266,8 @@ class RollerProfile:
       ISO 281's edge-stress factor λν meaningful);
     * ``"arc"``: z = R − √(R² − x²), R = ``crown_radius`` (their eq. 9);
     * ``"logarithmic"``: Johns–Gohar's drop for the design load Q_d = ``design_load_N``,
-      z = 2Q_d/(π·L·E*)·ln[1/(1 − (1 − b²/l²)(x/l)²)], l = L/2, b the Hertz half-width at Q_d;
+      z = 2Q_d/(π·L·E′)·ln[1/(1 − (1 − b²/l²)(x/l)²)], E′ = 2E*, l = L/2, b the Hertz half-width
+      at Q_d (uniform pressure along the roller at Q_d);
     * ``"combined"``: straight centre, then a circular segment of length a =
       ``modification_length`` dropping by b = ``modification_drop`` at the end of L_we (their
       eq. 10, R = (a² + b²)/(2b)).
@@ -560,7 +561,8 @@ class Material:
                                      doc="tensile strength R_m (the Goodman line of the fatigue check)")
     fatigue_limit: float = param(960.0, unit="MPa", low=1.0, high=1.0e4,
                                  doc="fully reversed (R = −1) fatigue limit σ_W of the material, "
-                                     "default 0.40·R_m (FKM guideline, wrought steel)")
+                                     "default 0.40·R_m, below the FKM guideline's 0.45·R_m by choice (docs/theory.md, "
+                                     "\"Mass and strength\")")
 
 
 @dataclass(frozen=True)

@@ -130,8 +130,11 @@ def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: floa
     * arc: z = R − √(R² − x²) (eq. 9);
     * combined: z = 0 for |x| ≤ l − a, else R − √(R² − (|x| − l + a)²) with l = L/2 and
       R = (a² + b²)/(2b), so that z(l) = b (eq. 10, its b = R − √(R² − a²));
-    * logarithmic (Johns–Gohar): z = 2Q_d/(π·L·E*)·ln[1/(1 − (1 − b_d²/l²)·(x/l)²)], b_d the Hertz
-      half-width at Q_d; Lundberg's profile (b_d → 0) with a finite drop at the ends.
+    * logarithmic (Johns–Gohar): z = 2Q_d/(π·L·E′)·ln[1/(1 − (1 − b_d²/l²)·(x/l)²)] with
+      E′ = 2E* (the plane-strain modulus E/(1 − ν²) of two equal steels), i.e.
+      Q_d/(π·L·E*)·ln[…]; b_d the Hertz half-width at Q_d; Lundberg's profile (b_d → 0) with a
+      finite drop at the ends. It is the sag of a uniformly loaded strip on the half-space, so
+      the pressure is uniform along the roller at Q_d.
     """
     x = np.abs(np.asarray(x_mm, dtype=float))
     half = 0.5 * length_mm
@@ -153,7 +156,7 @@ def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: floa
         b_d = math.sqrt(4.0 * q * reduced_radius_mm / (math.pi * length_mm * composite_modulus_MPa))
         frac = min(b_d / half, 1.0)
         arg = 1.0 - (1.0 - frac * frac) * np.minimum(x / half, 1.0) ** 2
-        return 2.0 * q / (math.pi * length_mm * composite_modulus_MPa) * np.log(1.0 / arg)
+        return q / (math.pi * length_mm * composite_modulus_MPa) * np.log(1.0 / arg)   # 2Q/(π·L·E′), E′ = 2E*
     raise ValueError(f"unknown roller profile kind {kind!r}; expected one of {PROFILE_KINDS}")
 
 

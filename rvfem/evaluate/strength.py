@@ -8,7 +8,7 @@ Static
 Fatigue: the FKM guideline's signed von Mises approach on a Goodman (Haigh) diagram
     At a hot spot the in-plane principal stresses σ1(θ), σ2(θ) over the crank angle θ give the
     signed von Mises stress (FKM guideline "Analytical strength assessment of components", 6th
-    ed. 2012, section 4.6, the equivalent stress for proportional multiaxial stress states:
+    ed. 2012, the equivalent stress for proportional multiaxial stress states:
     the von Mises stress with the sign of the first stress invariant)
 
         σ_sv(θ) = sign(σ1 + σ2) · sqrt(σ1² − σ1 σ2 + σ2²)                       (plane stress)
@@ -54,7 +54,7 @@ FATIGUE_CRITERION = "FKM signed von Mises, Goodman line (σ_W, R_m)"
 
 
 def signed_von_mises(s1: np.ndarray, s2: np.ndarray) -> np.ndarray:
-    """σ_sv = sign(σ1 + σ2)·sqrt(σ1² − σ1σ2 + σ2²) of plane stress (FKM guideline, 4.6), MPa.
+    """σ_sv = sign(σ1 + σ2)·sqrt(σ1² − σ1σ2 + σ2²) of plane stress (FKM guideline), MPa.
     A zero first invariant counts as positive."""
     s1, s2 = np.asarray(s1, dtype=float), np.asarray(s2, dtype=float)
     vm = np.sqrt(np.maximum(s1 * s1 - s1 * s2 + s2 * s2, 0.0))
