@@ -212,6 +212,20 @@ def test_profile_kind_is_settable_and_checked():
     assert base.crank_bearing.profile.kind == "straight" and base.lubricant.iso_vg == 68
 
 
+@pytest.mark.parametrize("overrides, key, cause", [
+    (("crank_bearing.profile.kind=combined", "crank_bearing.profile.modification_length=5"),
+     "crank_bearing.profile.modification_length", "shorter than half the roller length"),
+    (("lubricant.nu40=100",), "lubricant.nu100", "is missing"),
+    (("lubricant.nu100=10",), "lubricant.nu40", "is missing"),
+    (("lubricant.nu40=10", "lubricant.nu100=20"), "lubricant.nu100", "must be below 'lubricant.nu40'"),
+])
+def test_profile_and_oil_that_cannot_be_used_give_one_line_errors(overrides, key, cause):
+    """A modified segment longer than half the 9 mm roller, one viscosity without the other, an oil
+    that thickens as it warms: each is refused naming its key, never used silently."""
+    with pytest.raises(CaseError, match=f"'{key}'.*{cause}"):
+        load_case(CASES_DIR / "rv40e_fanholes.toml", overrides=overrides)
+
+
 def test_roller_depth_warnings_one_line_each():
     def depth(peak, kappa):
         d = SimpleNamespace(roller_peak_pressure_MPa=peak, bearing=0, model="flexible", raceway="eccentric",

@@ -1178,8 +1178,30 @@ def _positive_definite(matrix: tuple[tuple[float, ...], ...]) -> bool:
     return True
 
 
-_CROSS_CHECKS = (_check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_holes, _check_loads,
-                 _check_mesh, _check_mesh_sizes, _check_crank_support)
+def _check_roller_profile(case: Case) -> None:
+    """A crowned roller's drop has to fit its length: the combined profile's modified segment within
+    half the roller, the arc's radius beyond it (docs/theory.md § 12)."""
+    b, key = case.crank_bearing, "crank_bearing.profile."
+    half = 0.5 * b.roller_length
+    if b.profile.kind == "combined" and b.profile.modification_length >= half:
+        raise _error(case, key + "modification_length", f"({b.profile.modification_length:g} mm) must be shorter than "
+                     f"half the roller length ({half:g} mm): the modified segment runs from each end inwards")
+    if b.profile.kind == "arc" and b.profile.crown_radius <= half:
+        raise _error(case, key + "crown_radius", f"({b.profile.crown_radius:g} mm) must exceed half the roller "
+                     f"length ({half:g} mm)")
+
+
+def _check_lubricant(case: Case) -> None:
+    """Two viscosities or none (then ``iso_vg``), and the oil thinner when hot (Walther's line)."""
+    oil = case.lubricant
+    if (oil.nu40 is None) != (oil.nu100 is None):
+        given, missing = ("lubricant.nu40", "lubricant.nu100") if oil.nu100 is None else ("lubricant.nu100",
+                                                                                        "lubricant.nu40")
+        raise _error(case, missing, f"is missing: '{given}' alone does not fix the viscosity–temperature line; "
+                     "give both, or neither and 'lubricant.iso_vg'")
+    if oil.nu40 is not None and oil.nu100 >= oil.nu40:
+        raise _error(case, "lubricant.nu100", f"({oil.nu100:g} mm²/s) must be below 'lubricant.nu40' "
+                     f"({oil.nu40:g} mm²/s): an oil thins as it warms")
 
 
 def _check_material(case: Case) -> None:
@@ -1193,7 +1215,8 @@ def _check_material(case: Case) -> None:
                      f"{m.ultimate_strength:g} MPa; lower it")
 
 
-_CROSS_CHECKS = _CROSS_CHECKS + (_check_material,)
+_CROSS_CHECKS = (_check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_roller_profile, _check_holes,
+                 _check_loads, _check_mesh, _check_mesh_sizes, _check_crank_support, _check_lubricant, _check_material)
 
 
 # --------------------------------------------------------------------------------------------
