@@ -218,3 +218,19 @@ def test_hysteresis_command_writes_the_folder(tmp_path, capsys):
         assert (out / "plots" / f"{png}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "What the model leaves out" in (out / "accuracy.md").read_text(encoding="utf-8")
     assert "torsional rigidity" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("options, cause", [
+    (["--steps", "2"], "--steps must be a multiple of 4"), (["--steps", "42"], "--steps must be a multiple of 4"),
+    (["--friction", "0.9"], "--friction must be in"), (["--torque", "-5"], "--torque must be positive"),
+])
+def test_hysteresis_options_out_of_range_give_one_line_errors(options, cause, tmp_path, capsys):
+    """Options the loop cannot use end with exit 2 and one line naming the option, before any
+    folder is written."""
+    from rvfem.app import cli
+
+    out = tmp_path / "out"
+    assert cli.main(["hysteresis", str(CASES_DIR / "rv40e_fanholes.toml"), "-o", str(out), *options]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and cause in err[0]
+    assert not out.exists()

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rvfem.app.analysis import default_cache_dir
-from rvfem.case.definition import Case
+from rvfem.case.definition import MAX_FRICTION, Case
 from rvfem.errors import CaseError
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures, mean_loop
 from rvfem.geometry import disc_geometry
@@ -73,12 +73,17 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
     of one mesh period (:func:`mesh_period_angles`).
     """
     t_start = time.perf_counter()
-    out = Path(out_dir)
-    (out / "plots").mkdir(parents=True, exist_ok=True)
     T = float(case.loads.torque_Nm if torque_Nm is None else torque_Nm)
     if not T > 0:
         raise CaseError(f"--torque must be positive (the loop goes to +T and −T), got {T:g}")
+    if steps < 8 or steps % 4:
+        raise CaseError(f"--steps must be a multiple of 4 and at least 8 (0 → +T → 0 → −T → 0 in equal "
+                        f"steps), got {steps}")
     mu = float(case.analysis.friction if friction is None else friction)
+    if not 0.0 <= mu <= MAX_FRICTION:
+        raise CaseError(f"--friction must be in [0, {MAX_FRICTION:g}] (the range of analysis.friction), got {mu:g}")
+    out = Path(out_dir)
+    (out / "plots").mkdir(parents=True, exist_ok=True)
     thetas = (np.radians(angles_deg) if angles_deg else mesh_period_angles(case, angle_count))
     timings = {}
     t0 = time.perf_counter()
