@@ -153,3 +153,15 @@ def test_holes_against_solid_from_case_files(tmp_path, monkeypatch, capsys):
                  "--set", "crank_bearing.rolers=14"], monkeypatch)
     err = capsys.readouterr().err.strip()
     assert bad == 2 and "crank_bearing.rolers" in err and "did you mean" in err and len(err.splitlines()) == 1
+
+
+def test_headline_leads_with_mass_and_inertia_and_ends_with_the_lamina_life():
+    """The comparison's first line: mass and inertia first, then loads and lives, B against A; the
+    L10r ratio only where both results have the crank bearing in depth."""
+    from rvfem.app.result_compare import headline
+
+    ratio = {"disc_mass_kg": 0.713, "disc_polar_inertia_kg_mm2": 0.818, "max_load_N": 1.023,
+             "equivalent_load_N": 1.034, "L10h_h": 0.895, "L10r_h": 0.591}
+    assert headline({"overall": {"ratio": ratio}}) == ("B against A: mass −28.7 %, inertia −18.2 %, largest load "
+                                                      "+2.3 %, equivalent load +3.4 %, L10h × 0.90, L10r × 0.59")
+    assert "L10r" not in headline({"overall": {"ratio": dict(ratio, L10r_h=None)}})

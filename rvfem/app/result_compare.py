@@ -133,7 +133,16 @@ def _overall(r: ResultFolder) -> dict:
         "disc_polar_inertia_kg_mm2": s.get("disc_polar_inertia_kg_mm2"),
         "static_safety_factor": s.get("static_safety_factor"),
         "fatigue_safety_factor": s.get("fatigue_safety_factor"),
+        "L10r_h": _shortest_lamina_life(s),
     }
+
+
+def _shortest_lamina_life(summary: dict) -> float | None:
+    """The shortest flexible ISO/TS 16281 lamina life L10r of the crank bearings, h (None for a
+    result without the crank bearing in depth)."""
+    depth = summary.get("crank_bearing_depth") or {}
+    lives = [b["flexible"]["L10r_h"] for b in depth.get("bearings", ()) if (b.get("flexible") or {}).get("L10r_h")]
+    return min(lives, default=None)
 
 
 def _describe(r: ResultFolder) -> dict:
@@ -173,12 +182,14 @@ def overall_titles(comparison: dict) -> dict:
             "peak_away_from_contacts_MPa":
                 f"structural peak, {_orders(a, b, 'cycle_element_order')} cycle (away from contacts), MPa",
             "disc_mass_kg": "disc mass, kg", "disc_polar_inertia_kg_mm2": "disc polar inertia, kg·mm²",
-            "static_safety_factor": "static safety factor (yield)", "fatigue_safety_factor": "fatigue safety factor"}
+            "static_safety_factor": "static safety factor (yield)", "fatigue_safety_factor": "fatigue safety factor",
+            "L10r_h": "shortest L10r (ISO/TS 16281 lamina life), h"}
 
 
 def headline(comparison: dict) -> str | None:
     """The line a comparison leads with: "mass −x %, inertia −y %" (where both results have them),
-    then the largest load, the equivalent load and the L10h ratio, B against A."""
+    then the largest load, the equivalent load, the L10h ratio and the L10r ratio (where both
+    results have the crank bearing in depth), B against A."""
     r = comparison["overall"]["ratio"]
     parts = [f"{name} {100 * (r[key] - 1):+.1f} %".replace("+-", "−").replace("-", "−")
              for key, name in (("disc_mass_kg", "mass"), ("disc_polar_inertia_kg_mm2", "inertia"))
@@ -186,6 +197,8 @@ def headline(comparison: dict) -> str | None:
     if r["max_load_N"] is not None and r["equivalent_load_N"] is not None and r["L10h_h"] is not None:
         parts += [f"largest load {100 * (r['max_load_N'] - 1):+.1f} %",
                   f"equivalent load {100 * (r['equivalent_load_N'] - 1):+.1f} %", f"L10h × {r['L10h_h']:.2f}"]
+    if r.get("L10r_h") is not None:
+        parts.append(f"L10r × {r['L10r_h']:.2f}")
     return ("B against A: " + ", ".join(parts)) if parts else None
 
 
