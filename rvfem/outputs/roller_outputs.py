@@ -14,7 +14,7 @@ from pathlib import Path
 from rvfem.outputs.plots import COLOURS, _figure, _save
 from rvfem.outputs.registry import register_writer
 
-__all__ = ["write_roller_pressure_csv", "write_roller_pressure_plot", "roller_pressure_plot"]
+__all__ = ["write_roller_pressure_csv", "roller_pressure_calls", "roller_pressure_plot"]
 
 _COLUMNS = ("bearing", "model", "raceway", "theta_deg", "roller", "roller_load_N", "tilt_mrad", "x_mm",
             "pressure_MPa")
@@ -60,12 +60,12 @@ def roller_pressure_plot(path: str | os.PathLike, depths, profile: str) -> Path:
     return _save(fig, path)
 
 
-@register_writer("roller_pressure_plot", order=45, stage="plots", files=("plots/roller_pressure.png",))
-def write_roller_pressure_plot(analysis, folder: str | os.PathLike) -> list[Path]:
-    """Draw ``plots/roller_pressure.png`` (:func:`roller_pressure_plot`); nothing without FE rollers."""
+def roller_pressure_calls(analysis, plots_folder: str | os.PathLike) -> list[tuple]:
+    """The drawing of ``plots/roller_pressure.png`` as a call (:func:`roller_pressure_plot`, keyword
+    arguments) for :func:`rvfem.outputs.summary.plot_calls`, so that a render worker's child process
+    draws it beside the other plots; none without FE rollers."""
     depths = _depths(analysis)
     if not depths:
         return []
-    out = Path(folder) / "plots"
-    out.mkdir(parents=True, exist_ok=True)
-    return [roller_pressure_plot(out / "roller_pressure.png", depths, analysis.case.crank_bearing.profile.kind)]
+    return [(roller_pressure_plot, dict(path=Path(plots_folder) / "roller_pressure.png", depths=depths,
+                                        profile=analysis.case.crank_bearing.profile.kind))]

@@ -57,8 +57,8 @@ from rvfem.outputs.design_summary import fatigue_point_data, piece_mass_strength
 from rvfem.outputs.plots import mesh_plot
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
+from rvfem.outputs.roller_outputs import roller_pressure_calls  # also registers roller_pressure.csv
 from rvfem.outputs.vtkio import vtu_name
-from rvfem.outputs import roller_outputs  # noqa: F401  (registers roller_pressure.csv and its plot)
 
 log = logging.getLogger(__name__)
 
@@ -1074,12 +1074,12 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
     calls.append((plots.pins_in_contact_plot, dict(
         path=folder / "pins_in_contact.png", theta=th, count=cy.pins_in_contact, total=case.pins.count,
         classical=None if classical is None else np.count_nonzero(classical > 0, axis=0))))
-    return calls
+    return calls + roller_pressure_calls(analysis, folder)
 
 
 @register_writer("plots", order=40, stage="plots", options=("pending",),
                  files=tuple(f"plots/{name}.png" for name in ("bearing_loads", "roller_loads", "pin_forces",
-                                                            "pins_in_contact")))
+                                                            "pins_in_contact", "roller_pressure")))
 def write_plots(analysis, folder: str | os.PathLike, *, pending: PendingImages | None = None) -> list[Path]:
     """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
     the equal share where it is not defined), roller loads and pin forces at the angle of the
