@@ -28,6 +28,7 @@ import numpy as np
 from rvfem.evaluate import lubrication, roller_slices
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
 from rvfem.evaluate.iso281 import ROLLER_LIFE_EXPONENT
+from rvfem.fem.crankshaft import crankshaft_beam
 
 __all__ = [
     "beam_slope_influence",
@@ -92,12 +93,7 @@ def crankshaft_slope_influence(case) -> np.ndarray | None:
     cs = case.crank_support
     if cs is None or cs.influence_mm_per_N is not None:
         return None
-    if cs.bending_stiffness_Nmm2 is not None:
-        ei = float(cs.bending_stiffness_Nmm2)
-    else:
-        ei = cs.youngs_modulus * math.pi * cs.journal_diameter**4 / 64.0
-    ks, kc = cs.support_stiffness_pair, cs.carrier_stiffness_pair
-    compliance = tuple((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    ei, _, compliance = crankshaft_beam(cs)   # shear turns no cross-section
     return beam_slope_influence(cs.span, cs.eccentric_positions, ei, compliance)
 
 
@@ -172,7 +168,7 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
     if loaded.size == 0:
         return out.reshape(shape + (x.size,))
     q_bin = np.maximum(flat_q[loaded], light_fraction * q_max)
-    b = np.sqrt(4.0 * q_bin * r_red / (math.pi * length_mm * e_star))
+    _, b = roller_slices.hertz_peak_from_line_load(q_bin / length_mm, r_red, e_star)   # Hertz half-width of Q/L
     group = np.floor(np.log(b) / math.log(bin_ratio)).astype(int)
     cache = {} if cache is None else cache
     for key in np.unique(group):

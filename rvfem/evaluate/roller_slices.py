@@ -46,6 +46,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem.evaluate.hertz import hertz_half_width
+
 __all__ = [
     "PROFILE_KINDS",
     "SHEAR_FACTOR",
@@ -153,7 +155,7 @@ def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: floa
         return r - np.sqrt(r * r - np.minimum(u, r) ** 2)
     if kind == "logarithmic":
         q = profile.design_load_N
-        b_d = math.sqrt(4.0 * q * reduced_radius_mm / (math.pi * length_mm * composite_modulus_MPa))
+        b_d = hertz_half_width(q, length_mm, reduced_radius_mm, composite_modulus_MPa)
         frac = min(b_d / half, 1.0)
         arg = 1.0 - (1.0 - frac * frac) * np.minimum(x / half, 1.0) ** 2
         return q / (math.pi * length_mm * composite_modulus_MPa) * np.log(1.0 / arg)   # 2Q/(π·L·E′), E′ = 2E*
@@ -379,7 +381,7 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
     """
     n = profile.slices if slices is None else slices
     x, dx = slice_centres(length_mm, n)
-    b_nom = math.sqrt(4.0 * load_N * reduced_radius_mm / (math.pi * length_mm * composite_modulus_MPa))
+    b_nom = hertz_half_width(load_N, length_mm, reduced_radius_mm, composite_modulus_MPa)
     drop = profile_drop(profile, length_mm, x, composite_modulus_MPa=composite_modulus_MPa,
                         reduced_radius_mm=reduced_radius_mm)
     g = (tilt_rad * x - drop)[None, :]

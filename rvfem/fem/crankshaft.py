@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-__all__ = ["beam_influence", "crankshaft_influence"]
+__all__ = ["beam_influence", "crankshaft_beam", "crankshaft_influence"]
 
 
 def beam_influence(span: float, positions, bending_stiffness: float, shear_stiffness: float | None = None,
@@ -74,6 +74,27 @@ def beam_influence(span: float, positions, bending_stiffness: float, shear_stiff
     return f
 
 
+def crankshaft_beam(cs) -> tuple[float, float | None, tuple[float, float]]:
+    """The beam of a ``[crank_support]`` table: bending stiffness EI (N·mm²) from
+    ``bending_stiffness_Nmm2`` or from ``journal_diameter`` (E·π·d⁴/64), shear stiffness κGA (N;
+    G = E/(2(1 + ν)), A = π·d²/4, κ = 6(1 + ν)/(7 + 6ν)) when ``shear`` is on and the journal is
+    given (else None), and the compliance 1/k_support + 1/k_carrier of each support (mm/N)."""
+    E, nu = cs.youngs_modulus, cs.poissons_ratio
+    shear = None
+    if cs.bending_stiffness_Nmm2 is not None:
+        EI = float(cs.bending_stiffness_Nmm2)
+    else:
+        d = cs.journal_diameter
+        EI = E * math.pi * d**4 / 64.0
+        if cs.shear:
+            kappa = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
+            shear = kappa * E / (2.0 * (1.0 + nu)) * math.pi * d * d / 4.0
+    ks = cs.support_stiffness_pair
+    kc = cs.carrier_stiffness_pair
+    compliance = tuple((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    return EI, shear, compliance
+
+
 def crankshaft_influence(case) -> np.ndarray | None:
     """The crankshaft influence matrix of a case (mm/N, one row per disc), None for rigid support.
 
@@ -88,17 +109,5 @@ def crankshaft_influence(case) -> np.ndarray | None:
         return None
     if cs.influence_mm_per_N is not None:
         return np.asarray(cs.influence_mm_per_N, dtype=float)
-    E, nu = cs.youngs_modulus, cs.poissons_ratio
-    shear = None
-    if cs.bending_stiffness_Nmm2 is not None:
-        EI = float(cs.bending_stiffness_Nmm2)
-    else:
-        d = cs.journal_diameter
-        EI = E * math.pi * d**4 / 64.0
-        if cs.shear:
-            kappa = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu)
-            shear = kappa * E / (2.0 * (1.0 + nu)) * math.pi * d * d / 4.0
-    ks = cs.support_stiffness_pair
-    kc = cs.carrier_stiffness_pair
-    compliance = tuple((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    EI, shear, compliance = crankshaft_beam(cs)
     return beam_influence(cs.span, cs.eccentric_positions, EI, shear, compliance)
