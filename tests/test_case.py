@@ -67,6 +67,40 @@ def test_name_defaults_to_the_file_stem(case_text, tmp_path):
     assert load_case(case_text.write(tmp_path, "my_reducer.toml")).name == "my_reducer"
 
 
+def test_a_default_name_from_an_unportable_file_name_is_made_one_component(case_text, tmp_path):
+    """The file "-my reducer (v2).toml" gives the name "_my_reducer__v2_": each character outside
+    letters, digits and ._+- and a leading '-' become '_', so the default never fails the check."""
+    case_text.drop("", "name")
+    assert load_case(case_text.write(tmp_path, "-my reducer (v2).toml")).name == "_my_reducer__v2_"
+
+
+@pytest.mark.parametrize("name, fragment", [
+    ("", "got an empty name"),
+    (".", "it starts with '.'"),
+    ("..", "it starts with '.'"),
+    (".hidden", "it starts with '.'"),
+    ("-rf", "it starts with '-'"),
+    ("a/b", "it holds '/'"),
+    ("a\\\\b", "it holds '\\\\'"),
+    ("my disc / v2", "it holds ' ', '/'"),
+    ("disc:v2", "it holds ':'"),
+    ("x" * 101, "at most 100 characters"),
+])
+def test_a_name_that_is_not_one_portable_file_name_component_is_refused(case_text, tmp_path, name, fragment):
+    """The name is the result folder results/<name>: "" would be results/ itself, ".." its parent,
+    "a/b" a nested folder."""
+    case_text.set("", "name", '"' + name + '"')
+    message = expect_error(tmp_path, case_text, "name", fragment)
+    if "at most" not in fragment:
+        assert "letters A–Z a–z, digits and . _ + -, not starting with '.' or '-'" in message
+
+
+@pytest.mark.parametrize("name", ["rv40e", "RV-40E_v2.1", "a+b", "_x", "9", "x" * 100])
+def test_portable_names_are_taken(case_text, tmp_path, name):
+    case_text.set("", "name", '"' + name + '"')
+    assert load_case(case_text.write(tmp_path)).name == name
+
+
 def test_case_error_is_an_rvfem_error():
     assert issubclass(CaseError, RvfemError)
 
@@ -446,7 +480,7 @@ def test_every_number_rejects_non_finite_and_huge_values(dotted, value, pattern)
     ("analysis", "angle_step_deg", "1e-9", "must be at least 0.05°"),
     ("loads", "torque_Nm", "1e9", "must be at most 1e+06 N·m"),
     ("cycloid", "eccentricity", "5e-324", "must be at least 0.01 mm"),
-    ("", "name", '"' + "x" * 201 + '"', "at most 200 characters"),
+    ("", "name", '"' + "x" * 101 + '"', "at most 100 characters"),
     ("crank_bearing", "b_m", "0.0", "must be positive"),
     ("crank_bearing", "b_m", "0.9", "must be at least 1"),
     ("crank_bearing", "b_m", "2.0", "must be at most 1.3"),

@@ -43,6 +43,7 @@ import copy
 import dataclasses
 import hashlib
 import math
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -61,6 +62,7 @@ from rvfem.errors import CaseError
 
 __all__ = [
     "Case",
+    "name_problem",
     "Cycloid",
     "ProfileModification",
     "PitchError",
@@ -719,6 +721,10 @@ class CrankSupport:
     influence_mm_per_N : tuple of tuple of float or None
         discs × discs symmetric positive-definite matrix: displacement of eccentric i per unit
         force on eccentric j, mm/N.
+    support_bearing_C_N : float or None
+        Basic dynamic load rating C of one support bearing, N (None: loads only, no life).
+    support_bearing_life_exponent : float
+        Its life exponent p (10/3 roller, 3 ball bearings).
     """
 
     span: float | None = param(None, unit="mm", low=1.0, high=5000.0,
@@ -743,6 +749,13 @@ class CrankSupport:
         None, unit="mm/N", low=-1.0, high=1.0, max_length=4,
         doc="instead of the beam keys: discs × discs symmetric positive-definite matrix, displacement of "
             "eccentric i per unit force on eccentric j")
+    support_bearing_C_N: float | None = param(
+        None, unit="N", low=1.0, high=1.0e8, default_doc="none (support-bearing loads only, no life)",
+        doc="basic dynamic load rating C of one support bearing (from its maker's catalogue): gives the support "
+            "bearings' ISO 281 L10h from their loads over the cycle")
+    support_bearing_life_exponent: float = param(
+        10.0 / 3.0, low=1.0, high=10.0, default_doc="10/3 (roller bearings)",
+        doc="life exponent p of the support bearings, L10 = (C/P)^p: 10/3 roller, 3 ball bearings")
 
     @staticmethod
     def _pair(value: float | tuple[float, ...] | None) -> tuple[float | None, float | None]:
@@ -763,9 +776,43 @@ class CrankSupport:
         return self._pair(self.carrier_stiffness_N_per_mm)
 
 
+MAX_NAME_LENGTH = 100
+"""Longest case name, characters (it names result folders, with suffixes such as ``-accuracy``)."""
+
+NAME_CHARACTERS = "letters A–Z a–z, digits and . _ + -"
+"""What a case name may hold, in words (:data:`_NAME_PATTERN`)."""
+
+_NAME_PATTERN = re.compile(r"[A-Za-z0-9_+][A-Za-z0-9._+-]*")
+"""A case name is one portable file-name component: the POSIX portable file-name characters and
+``+``, not starting with ``.`` (a hidden file; ``.`` and ``..``) or ``-`` (read as an option)."""
+
+
+def name_problem(name: str) -> str | None:
+    """Why ``name`` cannot be a case name (it names the result folder ``results/<name>``), or
+    None if it can: 1 to :data:`MAX_NAME_LENGTH` characters of :data:`NAME_CHARACTERS`, not
+    starting with ``.`` or ``-`` (so no path separator, no ``.`` or ``..``, nothing hidden)."""
+    rule = (f"one file-name component (it names the result folder): 1–{MAX_NAME_LENGTH} {NAME_CHARACTERS}, "
+            "not starting with '.' or '-'")
+    if not isinstance(name, str) or not name:
+        return f"must be {rule}; got an empty name"
+    if len(name) > MAX_NAME_LENGTH:
+        return f"must be {rule}; got {len(name)} characters"
+    if _NAME_PATTERN.fullmatch(name) is None:
+        bad = sorted({c for c in name if not re.fullmatch(r"[A-Za-z0-9._+-]", c)})
+        what = (f"it holds {', '.join(repr(c) for c in bad)}" if bad else f"it starts with {name[0]!r}")
+        return f"must be {rule}; {what} in {name!r}"
+    return None
+
+
 def _file_stem(values: Mapping[str, Any]) -> str:
+    """The default case name: the file name without ``.toml``, each character outside
+    :data:`NAME_CHARACTERS` replaced by ``_`` (and a leading ``.`` or ``-`` too)."""
     source = values.get("<source>", "")
-    return Path(source).stem if source.endswith(".toml") else "case"
+    if not source.endswith(".toml"):
+        return "case"
+    stem = re.sub(r"[^A-Za-z0-9._+-]", "_", Path(source).stem)[:MAX_NAME_LENGTH]
+    stem = re.sub(r"^[.-]", "_", stem)
+    return stem or "case"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -779,8 +826,10 @@ class Case:
     :meth:`hole_tables` lists every hole table of the case.
     """
 
-    name: str = param(max_length=200, default_from=_file_stem, default_doc="file name without `.toml`",
-                      doc="case name used in reports and result folders")
+    name: str = param(max_length=MAX_NAME_LENGTH, default_from=_file_stem,
+                      default_doc="file name without `.toml` (other characters replaced by `_`)",
+                      doc="case name used in reports and as the result folder `results/<name>`: one file-name "
+                          "component of letters, digits and `._+-`, not starting with `.` or `-`")
     cycloid: Cycloid = param()
     pins: Pins = param()
     cranks: Cranks = param()
@@ -858,6 +907,12 @@ class Case:
 
 def _error(case: Case, key: str, message: str) -> CaseError:
     return table_error(case.source, key, message)
+
+
+def _check_name(case: Case) -> None:
+    problem = name_problem(case.name)
+    if problem is not None:
+        raise _error(case, "name", problem)
 
 
 def _check_cycloid_and_pins(case: Case) -> None:
@@ -1215,7 +1270,7 @@ def _check_material(case: Case) -> None:
                      f"{m.ultimate_strength:g} MPa; lower it")
 
 
-_CROSS_CHECKS = (_check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_roller_profile, _check_holes,
+_CROSS_CHECKS = (_check_name, _check_cycloid_and_pins, _check_cranks, _check_crank_bearing, _check_roller_profile, _check_holes,
                  _check_loads, _check_mesh, _check_mesh_sizes, _check_crank_support, _check_lubricant, _check_material)
 
 
