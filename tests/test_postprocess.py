@@ -247,9 +247,21 @@ def test_max_load_index_takes_the_first_of_equal_loads_and_the_largest_otherwise
 
 def test_feature_names_are_numbered_from_one_for_users():
     assert [postprocess.feature_label(n) for n in ("profile", "central_hole", "bore_0", "hole_2", "slot_1")] == [
-        "tooth profile", "central hole", "bore of bearing 1", "lightening hole 3", "slot_1"]
+        "tooth profile", "central hole", "bore 1", "hole 3", "slot_1"]
     names = [postprocess.user_feature_name(n) for n in ("bore_0", "hole_2", "profile")]
     assert names == ["bore_1", "hole_3", "profile"]
+
+
+def test_one_naming_of_features_on_screen_in_reports_and_messages():
+    """What is printed names a feature as the check's messages do ("bore 1", the README's promise),
+    from the mesh's name (from 0) and from the files' identifier (from 1) alike."""
+    from rvfem.geometry.features import feature_text
+
+    for mesh_name in ("bore_0", "bore_2", "hole_0", "hole_4", "central_hole", "profile"):
+        words = postprocess.feature_label(mesh_name)
+        assert words == feature_text(mesh_name).removeprefix("the ")
+        assert postprocess.user_feature_label(postprocess.user_feature_name(mesh_name)) == words
+        assert "_" not in words
 
 
 # --------------------------------------------------------------------------------------------

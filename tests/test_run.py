@@ -690,10 +690,8 @@ def test_p2_model_in_its_child_process_gives_what_it_gives_here(coarse_case_file
 def test_features_are_numbered_from_one(summary):
     for at in (summary["stress"]["structural_peak"]["at"], summary["stress"]["contact_zone"]["at"]):
         stem, _, number = at["feature"].rpartition("_")
-        if stem == "bore":
-            assert at["feature_label"] == f"bore of bearing {number}"
-        elif stem == "hole":
-            assert at["feature_label"] == f"lightening hole {number}"
+        if stem in ("bore", "hole"):
+            assert at["feature_label"] == f"{stem} {number}"
         assert at["feature"] not in ("bore_0", "hole_0")
     from rvfem.evaluate.postprocess import feature_label, user_feature_name
 

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Callable, TextIO
 
 from rvfem import __version__
-from rvfem.app.analysis import analyse_rigid, default_cache_dir
+from rvfem.app.analysis import analyse_rigid, default_cache_dir, resolve_case
 from rvfem.app.cli_hysteresis import HYSTERESIS
 from rvfem.app.cli_study import COMPARE, OPTIMISE, STUDY
 from rvfem.app.commands import (
@@ -40,7 +40,7 @@ from rvfem.app.screen import rigid_text
 from rvfem.case.definition import Case, load_case
 from rvfem.case.registry import bearing_model_names
 from rvfem.errors import OutputError, RvfemError
-from rvfem.evaluate.postprocess import user_feature_name
+from rvfem.evaluate.postprocess import feature_label
 from rvfem.geometry import disc_geometry
 from rvfem.geometry.features import feature_text
 from rvfem.mesh import mesh_case
@@ -73,9 +73,33 @@ def _add_check_arguments(parser: argparse.ArgumentParser) -> None:
     _add_case_argument(parser)
 
 
+def _log_check(case: Case, args: argparse.Namespace, walls) -> None:
+    """What ``rvfem -v check`` adds (INFO): where the case comes from, the reducer it describes and
+    how many keys take their default; with ``-vv`` (DEBUG) every default used and every wall."""
+    if not logger.isEnabledFor(logging.INFO):
+        return
+    _, provenance = resolve_case(args.case, overrides=tuple(args.set))
+    c, p, k = case.cycloid, case.pins, case.cranks
+    logger.info("case file %s, sha256 %s%s", provenance.file, provenance.sha256,
+                f", overrides {', '.join(case.overrides)}" if case.overrides else "")
+    logger.info("disc of %d teeth on %d pins (pin circle radius %g mm, eccentricity %g mm, %d discs of %g mm), "
+                "%d crank bearings at %s° (circle radius %g mm); crank-bearing model '%s'",
+                c.teeth, p.count, p.circle_radius, c.eccentricity, case.loads.discs, c.thickness, k.count,
+                ", ".join(f"{a:g}" for a in k.angles_deg), k.circle_radius, case.crank_bearing.model)
+    logger.info("%d keys take their default (-vv lists them); %d walls between features measured",
+                len(provenance.defaults_used), len(walls))
+    for key, value in provenance.defaults_used:
+        logger.debug("default used: %s = %s", key, value)
+    for w in walls:
+        logger.debug("wall %.3f mm between %s and %s at (%.2f, %.2f) mm", w.thickness, feature_text(w.first),
+                     feature_text(w.second), *w.location)
+
+
 def _run_check(args: argparse.Namespace) -> int:
     case = _load(args)
-    wall = disc_geometry(case).walls[0]   # the geometry checks meshing does first (cheap, no Gmsh)
+    walls = disc_geometry(case).walls   # the geometry checks meshing does first (cheap, no Gmsh)
+    _log_check(case, args, walls)
+    wall = walls[0]
     given = f" with {', '.join(case.overrides)}" if case.overrides else ""
     print(f"OK: case '{case.name}' ({args.case}){given} is valid; thinnest wall {wall.thickness:.3f} mm "
           f"between {feature_text(wall.first)} and {feature_text(wall.second)}")
@@ -131,7 +155,7 @@ def _run_mesh(args: argparse.Namespace) -> int:
     print(f"  {mesh.n_nodes} nodes, {mesh.n_elements} linear triangles, "
           f"min element quality ({mesh.quality_measure}) {mesh.min_quality:.3f}")
     print(f"  mesh cache: {Path(cache).resolve()}" + (" (default)" if args.cache_dir is None else ""))
-    print(f"  boundaries: {', '.join(f'{user_feature_name(n)} ({len(e)} edges)' for n, e in mesh.boundaries.items())}")
+    print(f"  boundaries: {', '.join(f'{feature_label(n)} ({len(e)} edges)' for n, e in mesh.boundaries.items())}")
     print(f"  thinnest wall {thinnest.thickness:.2f} mm between {feature_text(thinnest.first)} and "
           f"{feature_text(thinnest.second)}")
     print(f"  preview: {png}")
@@ -276,12 +300,30 @@ SUBCOMMANDS: tuple[Subcommand, ...] = (
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are one line on stderr, like every other error of
+    rvfem: ``rvfem: error: MESSAGE (see rvfem COMMAND --help)``, exit code 2. (Sub-parsers are of
+    the same class: argparse makes them of the main parser's.)"""
+
+    def error(self, message: str):  # noqa: D102 - argparse's hook
+        self.exit(EXIT_USER_ERROR, f"rvfem: error: {message} (see {self.prog} --help)\n")
+
+    def parse_args(self, args=None, namespace=None):  # noqa: D102
+        # argparse gives arguments a sub-parser does not know back to the main parser: blame the
+        # subcommand's, whose --help lists the arguments it takes
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            parser = getattr(self, "subcommand_parsers", {}).get(getattr(parsed, "command", None), self)
+            parser.error(f"unrecognized arguments: {' '.join(extras)}")
+        return parsed
+
+
 def build_parser(subcommands: tuple[Subcommand, ...] | None = None) -> argparse.ArgumentParser:
     """The argument parser with one sub-parser per entry of ``subcommands`` (default
     :data:`SUBCOMMANDS`)."""
     if subcommands is None:
         subcommands = SUBCOMMANDS
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="rvfem",
         description="Crank-bearing loads of RV reducers with a flexible cycloid disc.",
     )
@@ -289,8 +331,10 @@ def build_parser(subcommands: tuple[Subcommand, ...] | None = None) -> argparse.
     parser.add_argument("-v", "--verbose", action="count", default=0,
                         help="more log output on stderr (-v info, -vv debug); also after the subcommand")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    parser.subcommand_parsers = {}
     for command in subcommands:
         p = sub.add_parser(command.name, help=command.help, description=command.help)
+        parser.subcommand_parsers[command.name] = p
         command.add_arguments(p)
         # -v after the subcommand too (its own dest: a subparser's value would replace the main one's)
         p.add_argument("-v", "--verbose", action="count", default=0, dest="verbose_after",

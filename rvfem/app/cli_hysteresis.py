@@ -50,8 +50,10 @@ def _run(args: argparse.Namespace) -> int:
           f"{s['hysteresis_loss_arcmin']:.4f} arcmin; backlash {s['backlash_arcmin']:.4f} arcmin")
     if "compliance_shares" in s:
         cs = s["compliance_shares"]
-        print("  where the compliance sits: " + ", ".join(f"{k} {100 * v:.0f} %" for k, v in cs["shares"].items())
-              + f" (sum {100 * cs['total']:.0f} %)")
+        print("  where the compliance sits: " + ", ".join(f"{k} {100 * v:.0f} %" for k, v in cs["shares"].items()))
+        print(f"    each: the part of the rotation that goes when that part alone is made 1000× stiffer; sum "
+              f"{100 * cs['total']:.0f} %, {100 * (cs['total'] - 1):+.0f} % from 100 % because the parts interact (stiffening "
+              "one shifts load between parallel paths and changes which contacts carry)")
     if "transmission_error" in s:
         te = s["transmission_error"]
         print(f"  transmission error p-p: no load {te['no_load_peak_to_peak_arcsec']:.3f} arcsec, loaded "

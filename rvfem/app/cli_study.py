@@ -91,10 +91,7 @@ def _format_compare(c: dict, out) -> None:
         a, b, r = o["a"].get(key), o["b"].get(key), o["ratio"].get(key)
         fmt = (lambda v, k=key: "–" if v is None else f"{v:10.4g}" if k in _SMALL_KEYS else f"{v:10.1f}")
         w(f"{title:<{width}} {fmt(a):>10} {fmt(b):>10} {'–' if r is None else format(r, '8.4f'):>8}\n")
-    r = o["ratio"]
-    if r["max_load_N"] is not None and r["equivalent_load_N"] is not None and r["L10h_h"] is not None:
-        w(f"\nB against A: largest load {100 * (r['max_load_N'] - 1):+.1f} %, equivalent load "
-          f"{100 * (r['equivalent_load_N'] - 1):+.1f} %, L10h × {r['L10h_h']:.2f}\n")
+    # the ratios in words are the headline above the tables, said once
     for warning in c["warnings"]:
         w(f"note: {warning}\n")
 

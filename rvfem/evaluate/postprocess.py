@@ -26,6 +26,7 @@ from scipy.spatial import cKDTree
 from rvfem import fem
 from rvfem._arrays import TIE_RTOL, first_max, max_load_index, near_max
 from rvfem.fem import StressState, nodal_stress_operator
+from rvfem.geometry.features import feature_text
 from rvfem.solve.cycle import displacement, displacements
 
 __all__ = [
@@ -35,6 +36,7 @@ __all__ = [
     "FEATURE_LABELS",
     "feature_label",
     "user_feature_name",
+    "user_feature_label",
     "max_load_index",
     "nearest_index",
     "field_snapshots",
@@ -105,7 +107,7 @@ class PeakStress:
     feature : str
         Mesh boundary nearest to the point (``profile``, ``bore_0``, ``hole_1``, ``central_hole``…).
     feature_label : str
-        The same in words (``tooth profile``, ``bore of bearing 1``, ``lightening hole 2``…).
+        The same in words, numbered from 1 (``tooth profile``, ``bore 1``, ``hole 2``…).
     distance_to_feature_mm : float
         Distance from the point to the nearest vertex of that boundary, mm (0 on the boundary).
     """
@@ -128,16 +130,23 @@ FEATURE_LABELS = {
 
 
 def feature_label(name: str) -> str:
-    """Readable name of a mesh boundary: ``bore_0`` → ``bore of bearing 1``, ``hole_2`` →
-    ``lightening hole 3``, ``profile`` → ``tooth profile``."""
+    """Readable name of a mesh boundary, numbered from 1 as everything rvfem prints names it (the
+    words of the check's messages, :func:`rvfem.geometry.features.feature_text`, without the
+    article): ``bore_0`` → ``bore 1`` (the bore of bearing 1), ``hole_2`` → ``hole 3`` (lightening
+    hole 3), ``profile`` → ``tooth profile``, ``central_hole`` → ``central hole``."""
+    if name in FEATURE_LABELS:
+        return FEATURE_LABELS[name]
+    return feature_text(name)
+
+
+def user_feature_label(name: str) -> str:
+    """:func:`feature_label` of a name numbered from 1 already (the ``feature`` of ``summary.json``,
+    :func:`user_feature_name`): ``bore_1`` → ``bore 1``, ``central_hole`` → ``central hole``."""
     if name in FEATURE_LABELS:
         return FEATURE_LABELS[name]
     stem, _, number = name.rpartition("_")
-    if number.isdigit():
-        if stem == "bore":
-            return f"bore of bearing {int(number) + 1}"
-        if stem == "hole":
-            return f"lightening hole {int(number) + 1}"
+    if stem in ("bore", "hole") and number.isdigit():
+        return f"{stem} {number}"
     return name
 
 

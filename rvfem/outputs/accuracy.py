@@ -149,8 +149,9 @@ def accuracy_report(summary: dict) -> str:
                   "Each component stiffened ×1000 in turn; its share is the part of that rotation that goes.", "",
                   "| component | share |", "|---|---|"]
         lines += [f"| {k} | {100 * v:.1f} % |" for k, v in shares["shares"].items()]
-        lines += [f"| sum | {100 * shares['total']:.1f} % (100 % for compliances in series; the rest is the "
-                  "load redistribution between parallel paths) |", "", "![shares](plots/compliance_shares.png)"]
+        lines += [f"| sum | {100 * shares['total']:.1f} % (100 % for compliances in series; the rest, "
+                  f"{100 * (shares['total'] - 1):+.1f} %, is the interaction of the parts: stiffening one moves load "
+                  "between parallel paths and changes which contacts carry) |", "", "![shares](plots/compliance_shares.png)"]
     te = s.get("transmission_error")
     if te:
         lines += ["", "## Transmission error over one crank revolution", "",

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
-from rvfem.evaluate.postprocess import user_feature_name
+from rvfem.evaluate.postprocess import feature_label, user_feature_label, user_feature_name
 from rvfem.evaluate.strength import FATIGUE_CRITERION, fatigue_field
 
 __all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
@@ -21,7 +21,8 @@ def _where(peak) -> dict | None:
     if peak is None:
         return None
     return {"x_mm": peak.x_mm, "y_mm": peak.y_mm, "theta_deg": peak.theta_deg,
-            "feature": None if peak.feature is None else user_feature_name(peak.feature)}
+            "feature": None if peak.feature is None else user_feature_name(peak.feature),
+            "feature_label": None if peak.feature is None else feature_label(peak.feature)}
 
 
 def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
@@ -63,6 +64,14 @@ def piece_mass_strength(a, ctx) -> dict[str, Any]:
     return mass_strength_dict(design_checks(a), a.case.material)
 
 
+def _words(at: dict) -> str:
+    """The feature of a location in words (``bore 1``; from its ``feature`` in a summary written
+    before ``feature_label`` was), or ``?``."""
+    if at.get("feature_label"):
+        return at["feature_label"]
+    return user_feature_label(at["feature"]) if at.get("feature") else "?"
+
+
 def _factor(x: float | None) -> str:
     return "–" if x is None else f"{x:.3g}"
 
@@ -72,15 +81,19 @@ def mass_strength_lines(summary: dict) -> list[str]:
     ms = summary.get("mass_strength")
     if not ms:
         return []
-    lines = [f"  disc mass {summary['disc_mass_kg']:.4g} kg, polar inertia {summary['disc_polar_inertia_kg_mm2']:.4g} "
-             f"kg·mm² about its centre; the lightening holes save {ms['mass_saving_percent']:.1f} % of the mass and "
-             f"{ms['inertia_saving_percent']:.1f} % of the inertia of the solid disc "
-             f"({ms['solid_disc_mass_kg']:.4g} kg, {ms['solid_disc_polar_inertia_kg_mm2']:.4g} kg·mm²)"]
+    head = (f"  disc mass {summary['disc_mass_kg']:.4g} kg, polar inertia {summary['disc_polar_inertia_kg_mm2']:.4g} "
+            "kg·mm² about its centre; ")
+    if ms["mass_saving_percent"] == 0.0 and ms["inertia_saving_percent"] == 0.0:   # the same outlines: no holes
+        lines = [head + "no lightening holes (a solid disc)"]
+    else:
+        lines = [head + f"the lightening holes save {ms['mass_saving_percent']:.1f} % of the mass and "
+                 f"{ms['inertia_saving_percent']:.1f} % of the inertia of the solid disc "
+                 f"({ms['solid_disc_mass_kg']:.4g} kg, {ms['solid_disc_polar_inertia_kg_mm2']:.4g} kg·mm²)"]
     where = summary.get("fatigue_safety_factor_at") or {}
     fat = ""
     if where:
         fat = (f"; fatigue safety {_factor(summary.get('fatigue_safety_factor'))} ({where['hot_spot']} hot spot, "
-               f"{where.get('feature') or '?'} at ({where['x_mm']:.1f}, {where['y_mm']:.1f}) mm; "
+               f"{_words(where)} at ({where['x_mm']:.1f}, {where['y_mm']:.1f}) mm; "
                f"{ms['fatigue_criterion']}, σ_W = {ms['fatigue_limit_MPa']:g} MPa)")
     lines.append(f"  static safety against yield {_factor(summary.get('static_safety_factor'))} "
                  f"(R_p0.2 = {ms['yield_strength_MPa']:g} MPa at the structural peak){fat}")
@@ -96,7 +109,7 @@ def mass_strength_report(summary: dict) -> list[str]:
     lines = [line.strip() for line in mass_strength_lines(summary)]
     for f in ms["fatigue_hot_spots"]:
         at = f["at"] or {}
-        lines.append(f"Hot spot {f['name']} ({at.get('feature') or '?'} at ({at.get('x_mm', 0.0):.1f}, "
+        lines.append(f"Hot spot {f['name']} ({_words(at)} at ({at.get('x_mm', 0.0):.1f}, "
                      f"{at.get('y_mm', 0.0):.1f}) mm): signed von Mises {f['signed_von_mises_min_MPa']:.1f} … "
                      f"{f['signed_von_mises_max_MPa']:.1f} MPa (P1 history × {f['p2_factor']:.3f}), σ_a = "
                      f"{f['amplitude_MPa']:.1f} MPa, σ_m = {f['mean_MPa']:.1f} MPa, fatigue safety factor "

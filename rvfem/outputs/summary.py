@@ -237,7 +237,8 @@ def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False) -> Ite
         tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=out_dir.parent))
     except OSError as exc:
         _remove_created(created)
-        raise OutputError(f"cannot write into {out_dir.parent}: {exc.strerror or exc}") from None
+        # the results are first written to a new folder beside out_dir: that is what failed
+        raise OutputError(f"cannot create the folder {out_dir}: {exc.strerror or exc} (in {out_dir.parent})") from None
     try:
         umask = os.umask(0o022)
         os.umask(umask)
