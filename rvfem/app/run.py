@@ -376,9 +376,11 @@ def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[out
     submitted = time.perf_counter() - t_submit
 
     written: list[Path] = []
+    drawn = t_submit   # when the last writer waiting for the worker's drawings had them
     for stage, group in itertools.groupby(registered, key=lambda w: w.stage):
         group = list(group)
-        if meanwhile is not None and any("pending" in w.options for w in group):
+        waits = any("pending" in w.options for w in group)
+        if meanwhile is not None and waits:
             meanwhile()
             meanwhile = None
         total = next((w.ticks(result) for w in group if w.ticks is not None), 1)
@@ -387,8 +389,12 @@ def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[out
             options = {"tick": lambda done, n, stage=stage: stages.tick(stage, done, n), "pending": pending}
             written += w.write(result, tmp, **{k: options[k] for k in w.options})
         stages.end(stage, t, total)
+        if waits:
+            drawn = time.perf_counter()
     if meanwhile is not None:   # no writer waited for the worker
         meanwhile()
     if pending is not None:
         stages.seconds["images"] += submitted   # handing the drawings over counts as drawing
+        # the child process draws while this one writes: the stages above are only the waits for it
+        stages.seconds["drawing_background"] = drawn - t_submit
     return written

@@ -166,11 +166,25 @@ def summary_text(summary: dict) -> str:
     lines += mass_strength_lines(summary)
     lines.append(_hertz_line(summary["hertz"]))
     lines += roller_depth_lines(summary.get("crank_bearing_depth"))
+    lines += bearing_check_lines(summary.get("bearing_checks"))
     lines += _duty_lines(summary.get("duty_cycle"))
-    lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, images {t.get('images', 0.0):.1f} s); "
+    lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, {_drawing_text(t, summary['files'])}); "
                  f"{len(summary['files'])} files")
     lines += warning_lines(summary.get("warnings", []))
     return "\n".join(lines)
+
+
+def _drawing_text(t: dict, files) -> str:
+    """The drawing's part of the wall-time line: with a render worker (``drawing_background`` in
+    the timings) the plots and images are drawn by a child process while the tables and VTK files
+    are written, so its time is the span from handing them over to having them all, of which this
+    process only waited for ``plots`` + ``images``; without, the time the images took here."""
+    images = sum(1 for f in files if f.startswith("images/") and f.endswith(".png"))
+    wait = t.get("plots", 0.0) + t.get("images", 0.0)
+    if "drawing_background" in t:
+        return (f"{images} images and the plots drawn in a background process within "
+                f"{t['drawing_background']:.1f} s, {wait:.1f} s of it waited for")
+    return f"{images} images {t.get('images', 0.0):.1f} s" if images else "no images"
 
 
 def _bearing_depth_lines(b: dict) -> list[str]:

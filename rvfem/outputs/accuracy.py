@@ -108,13 +108,14 @@ def te_plot(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndar
     arcsec = ARCMIN_PER_RAD * 60.0
     for te, label in ((no_load_rad, "no load (kinematic)"), (loaded_rad, f"at {torque_Nm:g} N·m")):
         te = np.asarray(te) * arcsec
-        ax.plot(theta_deg, te - te.mean(), label=f"{label}: p-p {np.ptp(te):.3f} arcsec, mean {te.mean():.2f}")
+        ax.plot(theta_deg, te - te.mean(), label=f"{label}: p-p {np.ptp(te):.3f} arcsec, mean {te.mean():.2f} arcsec "
+                                                 "(subtracted)")
     ax.set_xlabel("crank angle, ° (one revolution = one output pin pitch)")
     ax.set_ylabel("TE − its mean, arcsec")
     ax.set_xlim(0, 360)
     ax.set_xticks(np.arange(0, 361, 60))
     ax.set_title(title or "transmission error θ_out − θ_in/i")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # below: not over the curves
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     return _save(fig, path)

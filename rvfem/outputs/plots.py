@@ -15,7 +15,7 @@ import numpy as np
 
 from rvfem.evaluate.postprocess import feature_label
 
-__all__ = ["mesh_plot", "mesh_preview", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
+__all__ = ["mesh_plot", "mesh_preview", "rim_closeup", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
 
 DPI = 120
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
@@ -188,7 +188,8 @@ def pins_in_contact_plot(path: str | os.PathLike, theta: np.ndarray, count: np.n
     hi = max(int(count.max()), int(classical.max()) if classical is not None else 0)
     ax.set_ylim(lo - 1.5, hi + 1.5)
     ax.set_title(title or "Pins in contact over one crank revolution")
-    ax.legend(fontsize=9)
+    # below the axes: inside it would hide the curves (the count spans the whole height)
+    ax.legend(fontsize=9, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     fig.tight_layout()
     return _save(fig, path)
 
@@ -264,9 +265,43 @@ def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
     return path
 
 
+def rim_closeup(points: np.ndarray, boundaries: dict, bore: str = "bore_0",
+                min_half_height: float = 8.0) -> tuple[tuple[float, float], float]:
+    """Where the mesh pictures look closely: the rim between the bore ``bore`` and the teeth.
+
+    The window is centred between the bore's vertex farthest from the disc centre and the tooth
+    profile's vertex nearest to it, and is large enough to hold both with a margin (at least
+    ``min_half_height``), so that the teeth are in view however thick the rim is.
+
+    Parameters
+    ----------
+    points : ndarray (n, 2)
+        Mesh vertices, mm.
+    boundaries : dict
+        Boundary name → edges (vertex index pairs); ``bore`` and ``profile`` are used.
+    bore : str
+        The bore's boundary name (mesh numbering, from 0).
+    min_half_height : float
+        Smallest half height of the window, mm.
+
+    Returns
+    -------
+    ((float, float), float)
+        Centre of the window and its half height, mm.
+    """
+    pts = np.asarray(points, dtype=float)
+    b = np.unique(np.asarray(boundaries[bore]).ravel())
+    outer = pts[b[np.argmax(np.hypot(pts[b, 0], pts[b, 1]))]]
+    prof = pts[np.unique(np.asarray(boundaries["profile"]).ravel())]
+    tooth = prof[np.argmin(np.hypot(*(prof - outer).T))]
+    centre = 0.5 * (outer + tooth)
+    half = max(min_half_height, 0.5 * float(np.hypot(*(tooth - outer))) + 3.0)
+    return (float(centre[0]), float(centre[1])), half
+
+
 def mesh_preview(mesh, path: str | os.PathLike, *, title: str = "", dpi: int = 150) -> Path:
     """The preview ``rvfem mesh`` writes next to a cached mesh: :func:`mesh_plot` of the whole disc
-    and of the rim under the bore of bearing 1 with the teeth next to it.
+    and of the rim under bore 1 with the teeth next to it (:func:`rim_closeup`).
 
     Parameters
     ----------
@@ -278,15 +313,15 @@ def mesh_preview(mesh, path: str | os.PathLike, *, title: str = "", dpi: int = 1
     dpi : int
     """
     pts = np.asarray(mesh.points, dtype=float)
+    half = 8.0
     if "bore_0" in mesh.boundaries:
-        b = np.unique(np.asarray(mesh.boundaries["bore_0"]).ravel())
-        c = pts[b[np.argmax(np.hypot(pts[b, 0], pts[b, 1]))]]
-        c = c * (1 + 3.0 / np.hypot(*c))
-        where = "close-up: rim under the bore of bearing 1 and teeth"
+        c, half = rim_closeup(pts, mesh.boundaries)
+        where = "close-up: the rim under bore 1 and the teeth next to it"
     else:
         c = pts[np.asarray(mesh.boundaries["profile"])[0, 0]]
         where = "close-up: tooth profile"
     return mesh_plot(path, pts, mesh.triangles, mesh.boundaries, closeup_centre=(float(c[0]), float(c[1])),
+                     closeup_half_height=half,
                      title=title or mesh.path.stem,
                      subtitle=f"{mesh.n_nodes} nodes, {mesh.n_elements} triangles (P1), "
                               f"min {mesh.quality_measure} = {mesh.min_quality:.3f}",

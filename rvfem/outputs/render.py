@@ -63,6 +63,11 @@ COLORMAP = "turbo"
 ABOVE_COLOUR = "magenta"
 """Colour of stresses above the colour range (the contact spots when the range is clipped)."""
 BACKGROUND = "white"
+TITLE_FONT_SIZE = 16
+"""Font size of an image's title (upper left; VTK points on the 1500 × 1100 window: the close-ups'
+two-line titles read at the size of the colour bar's labels)."""
+BAR_TITLE_SEPARATION_PX = 16
+"""Pixels between the colour bar's title and the bar (its top label sticks out above the bar)."""
 PNG_COMPRESS_LEVEL = 4
 """zlib level of the stress images' PNG files (0-9): 4 writes them in about 60 % of the time of
 the default 6, 4 % larger."""
@@ -511,14 +516,16 @@ class StressRenderer:
             actor = pl.add_mesh(disc, scalars=_FIELD, cmap=COLORMAP, clim=[0.0, 1.0], show_edges=False,
                                 edge_color="#303030", line_width=0.5, lighting=False, render=False,
                                 scalar_bar_args=dict(title=_FIELD, vertical=True, color="black", fmt="%.0f",
-                                                     n_labels=6, position_x=0.87, position_y=0.25, width=0.06,
-                                                     height=0.65, title_font_size=20, label_font_size=18))
+                                                     n_labels=6, position_x=0.87, position_y=0.2, width=0.06,
+                                                     height=0.62, title_font_size=22, label_font_size=18))
         finally:
             pl.suppress_rendering = False
         actor.mapper.lookup_table.above_range_color = ABOVE_COLOUR
         actor.mapper.lookup_table.SetUseAboveRangeColor(False)
         bar = pl.scalar_bars[_FIELD]
         bar.SetAboveRangeAnnotation("above")
+        # the title clear above the top label (which is centred on the bar's end), not over it
+        bar.SetVerticalTitleSeparation(BAR_TITLE_SEPARATION_PX)
         pl.add_mesh(_outline(pv, pts, scene.boundaries, 0.2), color="#7f7f7f", line_width=1.0, lighting=False,
                     render=False)
         self._disc, self._disc_actor = actor.mapper.dataset, actor
@@ -618,8 +625,8 @@ class StressRenderer:
             if marker is not None:
                 ring = self._shapes.discs([marker], 3.0, 0.35, 0.5, 32)
                 pl.add_mesh(ring, color="black", lighting=False, render=False)
-            title = pl.add_text(scene.title, position="upper_left", font_size=12 if not closeup else 11,
-                                color="black", render=False)
+            title = pl.add_text(scene.title, position="upper_left", font_size=TITLE_FONT_SIZE, color="black",
+                                render=False)
             _text_background(title)
 
             if focus is None:

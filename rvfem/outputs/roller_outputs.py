@@ -11,10 +11,12 @@ import csv
 import os
 from pathlib import Path
 
+import numpy as np
+
 from rvfem.outputs.plots import COLOURS, _figure, _save
 from rvfem.outputs.registry import register_writer
 
-__all__ = ["write_roller_pressure_csv", "roller_pressure_calls", "roller_pressure_plot"]
+__all__ = ["write_roller_pressure_csv", "roller_pressure_calls", "roller_pressure_curves", "roller_pressure_plot"]
 
 _COLUMNS = ("bearing", "model", "raceway", "theta_deg", "roller", "roller_load_N", "tilt_mrad", "x_mm",
             "pressure_MPa")
@@ -43,19 +45,53 @@ def write_roller_pressure_csv(analysis, folder: str | os.PathLike) -> list[Path]
     return [path]
 
 
+def _same_curve(a, b) -> bool:
+    """Whether two pressure curves draw as one: the same raceway, slices and pressures to 1e-6 of
+    the peak (bearings that carry the same loads 360°/N apart, N-fold symmetry)."""
+    if a.raceway != b.raceway or len(a.x_mm) != len(b.x_mm):
+        return False
+    scale = 1e-6 * max(float(np.max(np.abs(a.pressure_MPa))), 1e-300)
+    return bool(np.allclose(a.x_mm, b.x_mm, rtol=0, atol=1e-9) and
+                np.allclose(a.pressure_MPa, b.pressure_MPa, rtol=0, atol=scale) and
+                abs(a.roller_load_N - b.roller_load_N) <= 1e-6 * max(abs(a.roller_load_N), 1e-300))
+
+
+def roller_pressure_curves(depths) -> list[tuple[str, object]]:
+    """The curves of ``roller_pressure.png``: (legend label, depth drawn) per model and run of
+    bearings whose curves are the same (:func:`_same_curve`), which would be drawn over each
+    other: one curve labelled ``bearings 1–3 (identical) …`` with the crank angle of each."""
+    curves: list[tuple[list, object]] = []
+    for d in sorted(depths, key=lambda d: (d.model, d.bearing)):
+        if curves and curves[-1][1].model == d.model and _same_curve(curves[-1][1], d):
+            curves[-1][0].append(d)
+        else:
+            curves.append(([d], d))
+    out = []
+    for group, d in sorted(curves, key=lambda c: (c[1].bearing, c[1].model)):
+        if len(group) > 1:
+            who = f"bearings {group[0].bearing + 1}–{group[-1].bearing + 1} (identical)"
+            when = "θ = " + ", ".join(f"{g.theta_deg:.0f}" for g in group) + "°"
+        else:
+            who, when = f"bearing {d.bearing + 1}", f"θ = {d.theta_deg:.0f}°"
+        out.append((f"{who} {d.model}: {d.raceway}, {when}, Q = {d.roller_load_N:.0f} N", d))
+    return out
+
+
 def roller_pressure_plot(path: str | os.PathLike, depths, profile: str) -> Path:
-    """Draw p(x) of the worst roller of every bearing and model (rigid dashed, flexible solid)."""
-    fig = _figure((7.0, 5.0))
+    """Draw p(x) of the worst roller of every bearing and model (rigid dashed, flexible solid);
+    bearings with the same curve share one, labelled so (:func:`roller_pressure_curves`)."""
+    curves = roller_pressure_curves(depths)
+    fig = _figure((7.0, 4.6 + 0.22 * len(curves)))
     ax = fig.add_subplot(1, 1, 1)
-    for d in sorted(depths, key=lambda d: (d.bearing, d.model)):
+    for label, d in curves:
         ax.plot(d.x_mm, d.pressure_MPa, ls="--" if d.model == "rigid" else "-", color=COLOURS[d.bearing % len(COLOURS)],
-                label=f"bearing {d.bearing + 1} {d.model}: {d.raceway}, θ = {d.theta_deg:.0f}°, "
-                      f"Q = {d.roller_load_N:.0f} N")
+                label=label)
     ax.set_xlabel("x along the roller (mm)")
     ax.set_ylabel("contact pressure (MPa)")
     ax.set_title(f"Pressure along the most loaded roller ({profile} profile, slice model)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)  # below: the curves fill the axes
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=1,   # below: the curves fill the axes
+              title="dashed: rigid loads, solid: flexible (FE) loads", title_fontsize=7)
     fig.tight_layout()
     return _save(fig, path)
 

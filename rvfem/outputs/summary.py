@@ -54,7 +54,7 @@ from rvfem.evaluate.rigid import references
 from rvfem.geometry import crank_centres
 from rvfem.outputs import plots, render, tables, vtkio
 from rvfem.outputs.design_summary import fatigue_point_data, piece_mass_strength
-from rvfem.outputs.plots import mesh_plot
+from rvfem.outputs.plots import mesh_plot, rim_closeup
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
 from rvfem.outputs.roller_outputs import roller_pressure_calls  # also registers roller_pressure.csv
@@ -883,13 +883,13 @@ def mesh_picture(system, images: str | os.PathLike) -> dict:
     so a run can have it drawn while the load cycle is solved (:func:`start_mesh_picture`)."""
 
     case, mesh = system.case, system.mesh
-    bore = crank_centres(case)[0]
-    b0 = bore * (1.0 + (case.crank_bearing.bore_radius + 3.0) / np.hypot(*bore))
-    return dict(path=Path(images) / "mesh.png", points=system.model.mesh.p.T, triangles=system.model.mesh.t.T,
-                boundaries=mesh.boundaries, closeup_centre=(float(b0[0]), float(b0[1])),
+    points = system.model.mesh.p.T
+    centre, half = rim_closeup(points, mesh.boundaries)
+    return dict(path=Path(images) / "mesh.png", points=points, triangles=system.model.mesh.t.T,
+                boundaries=mesh.boundaries, closeup_centre=centre, closeup_half_height=half,
                 title=f"{case.name}: {mesh.n_nodes} vertices, {mesh.n_elements} triangles "
                       f"(min quality {mesh.min_quality:.2f})",
-                closeup_title="close-up: the rim under the bore of bearing 1")
+                closeup_title="close-up: the rim under bore 1 and the teeth next to it")
 
 
 def start_mesh_picture(system, folder: str | os.PathLike, worker) -> int:
