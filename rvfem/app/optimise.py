@@ -683,12 +683,13 @@ def _pareto_png(problem: Problem, rows: Sequence[dict], base: dict | None, best:
     ax = fig.subplots()
     ok = [r for r in rows if r.get("disc_mass_kg") is not None and r.get("life_ratio") is not None]
     sf = [min(r.get("fatigue_safety_factor") or 0.0, 50.0) for r in ok]
+    budgets = ", ".join(f"{n} {'≤' if BUDGETS[n][1] == 'max' else '≥'} {v:g}" for n, v in problem.budgets) or "none"
     for feasible, marker in ((True, "o"), (False, "x")):
         pick = [i for i, r in enumerate(ok) if bool(r["feasible"]) == feasible]
         if pick:
             sc = ax.scatter([ok[i]["disc_mass_kg"] for i in pick], [ok[i]["life_ratio"] for i in pick],
                             c=[sf[i] for i in pick], cmap="viridis", vmin=min(sf), vmax=max(sf), marker=marker, s=40,
-                            label="feasible" if feasible else "outside a budget")
+                            label="within the budgets" if feasible else f"outside a budget ({budgets})")
     if ok:
         fig.colorbar(sc, ax=ax, label="fatigue safety factor")
     front = pareto_front(ok)
@@ -705,8 +706,8 @@ def _pareto_png(problem: Problem, rows: Sequence[dict], base: dict | None, best:
     ax.set_xlabel("disc mass, kg")
     ax.set_ylabel("life ratio (shortest L10h / reference)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(f"{problem.name}: {len(rows)} designs", fontsize=10)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
+    ax.set_title(f"{problem.name}: {len(rows)} designs; budgets: {budgets}", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path

@@ -1310,7 +1310,7 @@ def _tornado_figure(study: Study, ok: Sequence[dict], base: dict):
 
 def _variants_figure(study: Study, rows: Sequence[dict]):
     """Every variant: flexible largest load and F_m as bars, the handbook maximum as a tick."""
-    fig, ax = _figure((max(6.4, 0.45 * len(rows) + 2), 4.2))
+    fig, ax = _figure((max(6.4, 0.45 * len(rows) + 2) + 1.8, 4.2))   # + the legend's column
     x = range(len(rows))
     ax.bar([i - 0.2 for i in x], [r["max_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, largest load")
     ax.bar([i + 0.2 for i in x], [r["equivalent_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, F_m")
@@ -1318,7 +1318,8 @@ def _variants_figure(study: Study, rows: Sequence[dict]):
     ax.set_xticks(list(x), [r["id"] for r in rows], rotation=60, ha="right", fontsize=7)
     ax.set_ylabel("crank-bearing load, N")
     ax.set_title(f"{study.name}: all variants", fontsize=10)
-    ax.legend(fontsize=7)
+    # right of the axes: inside it would hide bars
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     ax.grid(axis="y", alpha=0.3)
     fig.tight_layout()
     return fig
@@ -1374,6 +1375,23 @@ def _fmt(value: Any, spec: str) -> str:
     return html.escape(str(value))
 
 
+STUDY_KEY_RESULTS = ("max_load_N", "max_vs_base_percent", "L10h_h", "life_ratio_vs_base", "peak_von_mises_MPa")
+"""The columns of the study report's table right after the id and the status: what a variant gives."""
+
+
+def study_table_columns(study: Study) -> list[tuple[str, str, str]]:
+    """The columns of the study report's table, (key, CSS class, format): the id and the status,
+    the key results (:data:`STUDY_KEY_RESULTS`), the other results, then the parameter values and
+    the run's wall time and error, so that the results are on screen with many parameters."""
+    results = [("max_load_N", "", ".1f"), ("max_vs_base_percent", "", "+.1f"), ("L10h_h", "", ".0f"),
+               ("life_ratio_vs_base", "", ".3f"), ("peak_von_mises_MPa", "", ".1f"),
+               ("handbook_max_load_N", "", ".1f"), ("max_vs_handbook_percent", "", "+.1f"),
+               ("equivalent_load_N", "", ".1f"), ("equivalent_vs_base_percent", "", "+.1f"),
+               ("life_ratio", "", ".3f")]
+    return [("id", "l id", "s"), ("status", "l", "s"), *results, *[(p.key, "l", "s") for p in study.parameters],
+            ("wall_time_s", "", ".1f"), ("error", "l", "s")]
+
+
 def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float, compute_s: float) -> str:
     e = html.escape
     parts = [
@@ -1381,7 +1399,9 @@ def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float, com
         f"<title>rvfem study {e(study.name)}</title>",
         "<style>body{font-family:sans-serif;margin:2em;max-width:1400px}table{border-collapse:collapse;"
         "font-size:12px}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}"
-        "td.l,th.l{text-align:left}.failed{background:#fdd}img{max-width:100%}</style></head><body>",
+        "td.l,th.l{text-align:left}.failed{background:#fdd}img{max-width:100%}"
+        "div.scroll{overflow-x:auto;max-width:100%}td.id,th.id{position:sticky;left:0;background:#fff}"
+        "tr.failed td.id{background:#fdd}</style></head><body>",
         f"<h1>Study {e(study.name)}</h1>",
         f"<p>{e(study.description)}</p>" if study.description else "",
         f"<p>Kind: <b>{e(study.kind)}</b>; base case <code>{e(study.base_case.name)}</code>"
@@ -1400,13 +1420,10 @@ def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float, com
     for name, path in plots.items():
         data = base64.b64encode(Path(path).read_bytes()).decode()
         parts.append(f"<h2>{e(name)}</h2><img src='data:image/png;base64,{data}' alt='{e(name)}'>")
-    cols = [("id", "l", "s"), *[(p.key, "l", "s") for p in study.parameters], ("status", "l", "s"),
-            ("max_load_N", "", ".1f"), ("handbook_max_load_N", "", ".1f"), ("max_vs_handbook_percent", "", "+.1f"),
-            ("max_vs_base_percent", "", "+.1f"), ("equivalent_load_N", "", ".1f"),
-            ("equivalent_vs_base_percent", "", "+.1f"), ("L10h_h", "", ".0f"), ("life_ratio", "", ".3f"),
-            ("life_ratio_vs_base", "", ".3f"), ("peak_von_mises_MPa", "", ".1f"),
-            ("wall_time_s", "", ".1f"), ("error", "l", "s")]
-    parts.append("<h2>Variants</h2><table><tr>" + "".join(f"<th class='{c}'>{e(n)}</th>" for n, c, _ in cols) + "</tr>")
+    cols = study_table_columns(study)
+    parts.append("<h2>Variants</h2><p>The results first, then the parameter values of each variant (the table "
+                 "scrolls sideways; the variant's id stays in view).</p><div class='scroll'><table><tr>"
+                 + "".join(f"<th class='{c}'>{e(n)}</th>" for n, c, _ in cols) + "</tr>")
     for r in rows:
         cls = "" if r["status"] == "ok" else " class='failed'"
         parts.append(f"<tr{cls}>" + "".join(
