@@ -51,12 +51,14 @@ from rvfem.case.registry import bearing_model_names
 from rvfem.errors import CaseError, ContactError
 from rvfem.evaluate import (
     attribution,
+    bearing_checks,
     compare,
     hertz,
     iso281,
     postprocess,
     rigid,
     roller_life,
+    roller_slices,
     validity,
 )
 from rvfem.evaluate import accuracy as accuracy_eval
@@ -393,9 +395,15 @@ class RigidBearing:
     crank_angle_deg : float
         Position α_i of the crank, degrees.
     max_roller_load_N : float
-        Stribeck's most loaded roller at the maximum bearing load, Q_max = 4.6·F_max/Z, N.
+        The most loaded roller: the largest roller load of rigid rings under the handbook forces
+        over the cycle (:data:`rvfem.evaluate.hertz.RIGID_ROLLER_MODEL`), N.
     hertz_inner, hertz_outer : rvfem.evaluate.hertz.HertzLineContact
         Hertz contact of that roller on the eccentric (convex) and in the disc bore (concave).
+    max_roller_theta_deg : float
+        Crank angle of that roller load, degrees.
+    depth : rvfem.evaluate.roller_life.BearingDepth or None
+        κ, a_ISO, L_nm and L10r of the bearing under the handbook forces (the run's rigid column);
+        None for a bearing model without discrete rollers.
     """
 
     loads: rigid.BearingLoadSummary
@@ -403,6 +411,8 @@ class RigidBearing:
     max_roller_load_N: float
     hertz_inner: hertz.HertzLineContact
     hertz_outer: hertz.HertzLineContact
+    max_roller_theta_deg: float = math.nan
+    depth: Any = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -428,7 +438,8 @@ class RigidAnalysis:
     exponent : float
         Equivalent-load exponent p.
     stribeck_factor : float
-        Factor of Stribeck's Q_max = factor·F/Z.
+        k of the most loaded roller Q_max = k·F_max/Z of the rigid rings (the largest over the
+        bearings; :func:`rvfem.evaluate.hertz.rigid_ring_factor` for a roller on the load line).
     duty_cycle : rvfem.evaluate.iso281.DutyCycleLife or None
         Service life of the case's duty cycle from the shortest bearing life (None without a duty
         cycle, or where the handbook is not defined).
@@ -439,6 +450,9 @@ class RigidAnalysis:
     warnings : tuple of rvfem.evaluate.validity.ResultWarning
         Results outside their model's range (:func:`rvfem.evaluate.validity.rigid_warnings`: P/C, lives
         under 1 h, Hertz pressures); empty when all hold.
+    checks : rvfem.evaluate.bearing_checks.BearingChecks or None
+        Static safety S0 and minimum load of the crank bearing under the handbook forces (no support
+        bearings: the rigid model has no crankshaft beam); None where the handbook is not defined.
     """
 
     case: Case
@@ -451,6 +465,7 @@ class RigidAnalysis:
     duty_cycle: iso281.DutyCycleLife | None
     references: rigid.References | None = None
     warnings: tuple = ()
+    checks: Any = None
 
     @property
     def angle_step_deg(self) -> float:
@@ -491,26 +506,44 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
     if not refs.handbook.defined and case.pins.count - case.cycloid.teeth != 1:
         log.info("%s: the handbook model is %s", case.name, refs.handbook.why)
         return RigidAnalysis(case=case, loads=rigid.undefined_loads(case, theta), bearings=(), rating_N=rating,
-                             bearing_speed_rpm=speed, exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR,
+                             bearing_speed_rpm=speed, exponent=exponent,
+                             stribeck_factor=hertz.rigid_ring_factor(case.crank_bearing.rollers),
                              duty_cycle=None, references=refs)
     loads = rigid.handbook_bearing_loads(case, theta)
     mat = case.material
-    bearings = []
-    for s in rigid.summarize_bearing_loads(loads, exponent):
-        inner, outer = hertz.crank_bearing_hertz(case.crank_bearing, s.max_N, youngs_modulus_MPa=mat.youngs_modulus,
-                                                 poissons_ratio=mat.poissons_ratio)
+    forces = np.stack([loads.fx.T, loads.fy.T], axis=2)                     # (n, N, 2)
+    rollers = roller_slices.case_rigid_roller_loads(case, loads.theta, forces)   # the one rigid roller model
+    summaries = rigid.summarize_bearing_loads(loads, exponent)
+    depths = {}
+    if case.crank_bearing.model == "rollers":
+        depths = {d.bearing: d for d in roller_life.rigid_bearing_depths(
+            case, loads.theta, forces, {s.bearing: s.equivalent_N for s in summaries}, rating, speed)}
+    bearings, factors = [], []
+    for s in summaries:
+        k, j = np.unravel_index(int(np.argmax(rollers[:, s.bearing])), rollers[:, s.bearing].shape)
+        q = float(rollers[k, s.bearing, j])
+        factors.append(case.crank_bearing.rollers * q / float(np.linalg.norm(forces[k, s.bearing])))
+        inner, outer = hertz.roller_raceway_contacts(case.crank_bearing, q, youngs_modulus_MPa=mat.youngs_modulus,
+                                                     poissons_ratio=mat.poissons_ratio)
         bearings.append(RigidBearing(
             loads=rigid.with_rating_life(s, rating, speed),
             crank_angle_deg=case.cranks.angles_deg[s.bearing],
-            max_roller_load_N=hertz.stribeck_max_roller_load(s.max_N, case.crank_bearing.rollers),
+            max_roller_load_N=q,
             hertz_inner=inner,
             hertz_outer=outer,
+            max_roller_theta_deg=math.degrees(float(loads.theta[k])),
+            depth=depths.get(s.bearing),
         ))
     duty = iso281.case_duty_cycle_life(case, [b.loads.L10h for b in bearings])
+    c0 = bearing_checks.crank_bearing_static_rating(case.crank_bearing)
+    checks = bearing_checks.BearingChecks(
+        static={"rigid": bearing_checks.static_safety(c0, max(s.max_N for s in summaries))},
+        minimum={"rigid": bearing_checks.minimum_load(min(s.min_N for s in summaries), rating)},
+        support=None, support_note="the handbook model has no crankshaft beam: support-bearing loads come with rvfem run")
     result = RigidAnalysis(case=case, loads=loads, bearings=tuple(bearings), rating_N=rating, bearing_speed_rpm=speed,
-                           exponent=exponent, stribeck_factor=hertz.STRIBECK_FACTOR, duty_cycle=duty,
-                           references=refs)
-    return dataclasses.replace(result, warnings=validity.rigid_warnings(result))
+                           exponent=exponent, stribeck_factor=max(factors), duty_cycle=duty,
+                           references=refs, checks=checks)
+    return dataclasses.replace(result, warnings=validity.rigid_warnings(result) + validity.bearing_check_warnings(checks))
 
 
 # --------------------------------------------------------------------------------------------
@@ -723,6 +756,9 @@ class Analysis:
         Torsional rigidity (N·m/arcmin) and lost motion (arcmin) of the stage at the case's torque
         from a few points of the hysteresis loop at crank angle 0 (:func:`run_accuracy`); None when
         they could not be solved.
+    bearing_checks : rvfem.evaluate.bearing_checks.BearingChecks or None
+        Static safety S0 and minimum load of the crank bearing (rigid and flexible) and the support
+        bearings' loads and lives.
     """
 
     case: Case
@@ -745,6 +781,7 @@ class Analysis:
     warnings: tuple = ()
     roller_depth: Any = None
     accuracy: dict | None = None
+    bearing_checks: Any = None
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -1216,12 +1253,29 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
 def _with_roller_depth(result: Analysis) -> Analysis:
     """The analysis with the crank bearing in depth (slices of every roller, film, a_ISO, L_nm and
     L10r, rigid and flexible; :func:`rvfem.evaluate.roller_life.crank_bearing_depth`) and all warnings."""
+    rigid_depths = tuple(b.depth for b in result.rigid.bearings if b.depth is not None)
     depth = roller_life.crank_bearing_depth(result.case, result.theta, result.cycle, result.rigid_forces,
-                                            result.comparison, result.rigid.rating_N, result.rigid.bearing_speed_rpm)
+                                            result.comparison, result.rigid.rating_N, result.rigid.bearing_speed_rpm,
+                                            rigid_depths=rigid_depths or None)
     if depth is not None:
         result.timings["roller_depth"] = depth.seconds
-    return dataclasses.replace(result, roller_depth=depth, warnings=validity.analysis_warnings(result)
-                               + validity.roller_depth_warnings(depth))
+    checks = _bearing_checks(result)
+    return dataclasses.replace(result, roller_depth=depth, bearing_checks=checks,
+                               warnings=validity.analysis_warnings(result) + validity.roller_depth_warnings(depth)
+                               + validity.bearing_check_warnings(checks))
+
+
+def _bearing_checks(result: Analysis) -> bearing_checks.BearingChecks:
+    """Static safety, minimum load and support bearings of a run
+    (:func:`rvfem.evaluate.bearing_checks.case_bearing_checks`)."""
+    bearings = result.comparison.bearings
+    models_ = {"flexible": [b.flexible for b in bearings]}
+    if result.rigid.defined and all(b.rigid is not None for b in bearings):
+        models_["rigid"] = [b.rigid for b in bearings]
+    return bearing_checks.case_bearing_checks(
+        result.case, result.theta, result.rigid.rating_N, result.rigid.bearing_speed_rpm,
+        {m: max(s.max_N for s in v) for m, v in models_.items()},
+        {m: min(s.min_N for s in v) for m, v in models_.items()}, result.cycle.disc_bearing_forces)
 
 
 def run_accuracy(system) -> dict | None:
@@ -1276,14 +1330,14 @@ def _evaluate(case, stages, system, mesh, cycle, comparison, rigid_analysis, pea
     history = postprocess.hot_spot_history(system, cycle, spots, factors)
     stress = StressResult(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
                           recovered=recovered, history=history)
+    rigid_forces = None
     if rigid_analysis.defined:
-        # the first bearing among equals (the handbook curves are exact shifts of each other)
-        rigid_max = max(comparison.bearings, key=lambda b: round(b.rigid.max_N, 6))
-        rigid_peak = (rigid_max.rigid.max_N, rigid_max.rigid.max_at_deg, rigid_max.bearing)
-    else:
-        rigid_peak = (None, None, None)
-    roller_hertz = hertz.most_loaded_roller_hertz(case, cycle.theta, cycle.bearing_forces, cycle.roller_loads,
-                                                  *rigid_peak)
+        hb = rigid_analysis.loads
+        rigid_forces = np.stack([hb.fx.T, hb.fy.T], axis=2)
+    roller_hertz = hertz.most_loaded_roller_hertz(
+        case, cycle.theta, cycle.bearing_forces, cycle.roller_loads, rigid_forces,
+        None if rigid_forces is None else roller_slices.case_rigid_roller_loads(case, cycle.theta, rigid_forces),
+        roller_slices.case_rigid_roller_loads(case, cycle.theta, cycle.bearing_forces))
     stiffness = cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm)
     duty = None
     if case.loads.duty_cycle:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 
 from rvfem.evaluate.rigid import REFERENCE_NAMES
-from rvfem.outputs.design_summary import mass_strength_lines
+from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_lines
 from rvfem.outputs.report import toml_text
 
 __all__ = ["SCREEN_DIGITS", "summary_text", "rigid_text", "warning_lines", "reference_lines", "stress_lines"]
@@ -117,15 +117,15 @@ def _hertz_line(h: dict) -> str:
     Stribeck with the FE bearing load where there are no FE roller loads)."""
     sr, fe = h["stribeck_rigid"], h.get("fe_rollers")
     line = ("  Hertz, most loaded roller: " + (
-        f"rigid Stribeck Q = {_sig(sr['roller_load_N'], '.0f')} N, p_in {_sig(sr['inner']['peak_pressure_MPa'], '.0f')}"
+        f"rigid rings Q = {_sig(sr['roller_load_N'], '.0f')} N, p_in {_sig(sr['inner']['peak_pressure_MPa'], '.0f')}"
         f" / p_out {_sig(sr['outer']['peak_pressure_MPa'], '.0f')} MPa" if sr else
-        "rigid Stribeck not defined for Zp − Zc ≠ 1"))
+        "rigid rings not defined for Zp − Zc ≠ 1"))
     if fe:
         return line + (f"; FE Q = {_sig(fe['roller_load_N'], '.0f')} N, p_in "
                        f"{_sig(fe['inner']['peak_pressure_MPa'], '.0f')} / p_out "
                        f"{_sig(fe['outer']['peak_pressure_MPa'], '.0f')} MPa")
     sf = h["stribeck_flexible"]
-    return line + (f"; FE bearing load with Stribeck Q = {_sig(sf['roller_load_N'], '.0f')} N, p_in "
+    return line + (f"; rigid rings under the FE bearing loads Q = {_sig(sf['roller_load_N'], '.0f')} N, p_in "
                    f"{_sig(sf['inner']['peak_pressure_MPa'], '.0f')} / p_out "
                    f"{_sig(sf['outer']['peak_pressure_MPa'], '.0f')} MPa")
 
@@ -298,7 +298,8 @@ def rigid_text(report: dict) -> str:
     if not defined:
         lines += reference_lines(report["references"])
     header = (f"{'bearing':>7} {'max N':>9} {'at °':>6} {'min N':>9} {'at °':>6} {'F_m N':>9} "
-              f"{'L10h h':>9} {'Q_max N':>8} {'p_in MPa':>9} {'p_out MPa':>9}")
+              f"{'L10h h':>9} {'Q_max N':>8} {'p_in MPa':>9} {'p_out MPa':>9} {'κ':>5} {'a_ISO':>5} "
+              f"{'L_nm h':>9} {'L10r h':>9}")
     lines += ["", header, "-" * len(header)]
     for b in report["bearings"]:
         if b["max_load_N"] is None and not defined:
@@ -309,13 +310,17 @@ def rigid_text(report: dict) -> str:
             f"{b['bearing']:>7d} {_sig(b['max_load_N'], '9.1f')} {b['max_at_deg']:6.1f} {_sig(b['min_load_N'], '9.1f')} "
             f"{b['min_at_deg']:6.1f} {_sig(b['equivalent_load_N'], '9.1f')} {_life(b['L10h_h'], 9)} "
             f"{_sig(b['max_roller_load_N'], '8.1f')} {_sig(b['hertz_inner']['peak_pressure_MPa'], '9.1f')} "
-            f"{_sig(b['hertz_outer']['peak_pressure_MPa'], '9.1f')}")
+            f"{_sig(b['hertz_outer']['peak_pressure_MPa'], '9.1f')}"
+            + (f" {_num(d['kappa'], '5.2f')} {_num(d['a_iso'], '5.2f')} {_life(d['L_nm_h'], 9)} {_life(d['L10r_h'], 9)}"
+               if (d := b.get("depth")) else ""))
     lines += [
         "",
         "  at °: crank angle θ of the eccentric relative to the carrier; F_m = (mean F^p)^(1/p) over a turn",
-        f"  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Hertz at Q_max = {report['stribeck_factor']:g}·F_max/Z "
-        "(p_in: eccentric, p_out: disc bore)",
+        f"  L10h = 1e6/(60·n_b)·(C/F_m)^(10/3); Q_max: the most loaded roller, rigid rings with the rollers at "
+        f"their cage positions (= {report['stribeck_factor']:.2f}·F_max/Z), Hertz at it (p_in: eccentric, p_out: "
+        "disc bore); κ, a_ISO, L_nm = a_ISO·L10h (ISO 281), L10r the lamina life (ISO/TS 16281)",
     ]
+    lines += bearing_check_lines(report.get("bearing_checks"))
     duty = report.get("duty_cycle")
     if "duty_cycle" in report and duty is None:
         lines.append("  duty cycle: service life not defined (no handbook bearing lives for Zp − Zc ≠ 1)")

@@ -41,6 +41,8 @@ __all__ = [
     "palmgren_approach",
     "hertz_line_contact",
     "stribeck_max_roller_load",
+    "rigid_ring_factor",
+    "RIGID_ROLLER_MODEL",
     "crank_bearing_hertz",
     "roller_raceway_contacts",
     "most_loaded_roller_hertz",
@@ -76,9 +78,9 @@ class RollerHertz:
     Attributes
     ----------
     source : str
-        ``"fe_rollers"`` (largest roller load of the FE cycle), ``"stribeck_rigid"`` (Q_max =
-        4.6·F_max/Z with the handbook F_max) or ``"stribeck_flexible"`` (the same with the FE
-        F_max).
+        ``"fe_rollers"`` (largest roller load of the FE cycle), ``"stribeck_rigid"`` (largest
+        roller load of rigid rings under the handbook forces, :data:`RIGID_ROLLER_MODEL`) or
+        ``"stribeck_flexible"`` (the same under the FE bearing forces).
     roller_load_N : float
         Q, N.
     inner : HertzLineContact
@@ -90,7 +92,9 @@ class RollerHertz:
     roller : int or None
         0-based roller index (FE only).
     theta_deg : float or None
-        Crank angle at which it carries Q (FE), or at which the bearing load is largest, degrees.
+        Crank angle at which it carries Q, degrees.
+    factor : float or None
+        Z·Q/|F| with F that bearing's force at that angle (the k of Stribeck's Q_max = k·F/Z).
     """
 
     source: str
@@ -100,6 +104,7 @@ class RollerHertz:
     bearing: int | None = None
     roller: int | None = None
     theta_deg: float | None = None
+    factor: float | None = None
 
 
 def composite_modulus(
@@ -306,12 +311,40 @@ def _case_contacts(case: Case, q: float) -> tuple[HertzLineContact, HertzLineCon
                                    poissons_ratio=case.material.poissons_ratio)
 
 
+def rigid_ring_factor(rollers: int) -> float:
+    """k of the rigid-ring most loaded roller Q_max = k·F_r/Z of a radially loaded line-contact
+    bearing without clearance, one roller on the load line (the largest over the cage positions):
+    k = Z/Σ_j cos(2πj/Z)₊^(19/9) (Stribeck's method with the line contact's load-deflection
+    exponent 10/9; Harris & Kotzalas). 4.086 for Z = 14, → 4.08 for many rollers (the classic
+    4.6 or 5 allow for a clearance, Gao et al.'s eq. 21 uses 4.6)."""
+    if rollers <= 0:
+        raise ValueError("rollers must be positive")
+    c = np.clip(np.cos(2.0 * np.pi * np.arange(rollers) / rollers), 0.0, None)
+    return float(rollers / np.sum(c ** (19.0 / 9.0)))
+
+
+#: What the rigid most loaded roller is, for reports and summary.json (one definition everywhere).
+RIGID_ROLLER_MODEL = ("rigid rings (Stribeck's method): the bearing force shared by the rollers at their cage "
+                      "positions, Palmgren line contact, the case's radial clearance")
+
+
+def _largest_roller(case: Case, theta: np.ndarray, forces: np.ndarray, loads: np.ndarray, source: str) -> RollerHertz:
+    """The largest of a cycle's roller loads (n, N, Z) as a RollerHertz, with its factor Z·Q/|F|."""
+    k, i, j = first_max(loads)
+    q = float(loads[k, i, j])
+    f = float(np.linalg.norm(forces[k, i]))
+    factor = case.crank_bearing.rollers * q / f if f > 0 else None
+    return RollerHertz(source, q, *_case_contacts(case, q), bearing=int(i), roller=int(j),
+                       theta_deg=math.degrees(float(theta[k])), factor=factor)
+
+
 def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.ndarray,
-                             roller_loads: np.ndarray | None, rigid_max_N: float | None,
-                             rigid_max_at_deg: float | None = None,
-                             rigid_max_bearing: int | None = None) -> dict[str, RollerHertz]:
-    """Hertz pressures of the most loaded roller of a load cycle, from the FE roller loads and from
-    Stribeck's estimate with the rigid and the FE bearing loads.
+                             roller_loads: np.ndarray | None, rigid_forces: np.ndarray | None,
+                             rigid_roller_loads: np.ndarray | None,
+                             flexible_ring_loads: np.ndarray) -> dict[str, RollerHertz]:
+    """Hertz pressures of the most loaded roller of a load cycle: the largest roller load over the
+    cycle's crank angles, bearings and rollers, from the FE rollers, from the rigid rings
+    (:data:`RIGID_ROLLER_MODEL`) under the handbook forces and under the FE bearing forces.
 
     Parameters
     ----------
@@ -323,33 +356,23 @@ def most_loaded_roller_hertz(case: Case, theta: np.ndarray, bearing_forces: np.n
         FE force of every bearing on the disc, N.
     roller_loads : ndarray (n, N, Z) or None
         FE roller loads, N (None for a bearing model without discrete rollers).
-    rigid_max_N : float or None
-        Largest handbook bearing load over the cycle, N; None where the handbook is not defined
-        (Zp − Zc ≠ 1).
-    rigid_max_at_deg : float, optional
-        Its crank angle, degrees.
-    rigid_max_bearing : int, optional
-        Its bearing (0-based).
+    rigid_forces : ndarray (n, N, 2) or None
+        Handbook bearing forces, N; None where the handbook is not defined (Zp − Zc ≠ 1).
+    rigid_roller_loads : ndarray (n, N, Z) or None
+        Their rigid-ring roller loads (:func:`rvfem.evaluate.roller_slices.case_rigid_roller_loads`), N.
+    flexible_ring_loads : ndarray (n, N, Z)
+        The rigid-ring roller loads under the FE bearing forces, N.
 
     Returns
     -------
     dict of str to RollerHertz
-        ``"stribeck_flexible"`` always and ``"stribeck_rigid"`` with a handbook load (Q_max =
-        4.6·F_max/Z, Gao et al.'s eq. 21), ``"fe_rollers"`` when ``roller_loads`` is given.
+        ``"stribeck_flexible"`` always, ``"stribeck_rigid"`` with a handbook load and ``"fe_rollers"``
+        when ``roller_loads`` is given.
     """
-    z = case.crank_bearing.rollers
     out = {}
     if roller_loads is not None:
-        k, i, j = first_max(roller_loads)
-        q = float(roller_loads[k, i, j])
-        out["fe_rollers"] = RollerHertz("fe_rollers", q, *_case_contacts(case, q), bearing=int(i), roller=int(j),
-                                        theta_deg=math.degrees(float(theta[k])))
-    if rigid_max_N is not None:
-        q = stribeck_max_roller_load(rigid_max_N, z)
-        out["stribeck_rigid"] = RollerHertz("stribeck_rigid", q, *_case_contacts(case, q),
-                                            bearing=rigid_max_bearing, theta_deg=rigid_max_at_deg)
-    k, i = max_load_index(bearing_forces)
-    q = stribeck_max_roller_load(float(np.linalg.norm(bearing_forces[k, i])), z)
-    out["stribeck_flexible"] = RollerHertz("stribeck_flexible", q, *_case_contacts(case, q), bearing=int(i),
-                                           theta_deg=math.degrees(float(theta[k])))
+        out["fe_rollers"] = _largest_roller(case, theta, bearing_forces, roller_loads, "fe_rollers")
+    if rigid_forces is not None and rigid_roller_loads is not None:
+        out["stribeck_rigid"] = _largest_roller(case, theta, rigid_forces, rigid_roller_loads, "stribeck_rigid")
+    out["stribeck_flexible"] = _largest_roller(case, theta, bearing_forces, flexible_ring_loads, "stribeck_flexible")
     return out

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rvfem.evaluate import lubrication, roller_slices
+from rvfem.evaluate.bearing_checks import crank_bearing_static_rating
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
 from rvfem.evaluate.iso281 import ROLLER_LIFE_EXPONENT
 from rvfem.fem.crankshaft import crankshaft_beam
@@ -44,6 +45,7 @@ __all__ = [
     "bearing_depth",
     "CrankBearingDepth",
     "crank_bearing_depth",
+    "rigid_bearing_depths",
 ]
 
 log = logging.getLogger(__name__)
@@ -271,6 +273,13 @@ class BearingDepth:
         a1·a_ISO·L10h (a1 = 1, 10 % failure probability), h.
     L10r_h : float
         ISO/TS 16281 reference rating life from the lamina loads (Palmgren–Miner over the cycle), h.
+    max_roller_load_N : float
+        The most loaded roller: the largest roller load over the cycle, N (the quantity of
+        ``hertz.fe_rollers`` / ``hertz.stribeck_rigid``, not the roller of the pressure peak).
+    max_roller_theta_deg : float
+        Its crank angle, degrees.
+    max_roller : int
+        Its 0-based roller.
     """
 
     bearing: int
@@ -294,6 +303,9 @@ class BearingDepth:
     L10h: float
     L_nm_h: float
     L10r_h: float
+    max_roller_load_N: float = math.nan
+    max_roller_theta_deg: float = math.nan
+    max_roller: int = -1
 
 
 def _peak(case, theta, loads, tilts, slice_loads, geoms):
@@ -353,8 +365,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
                                         geoms[0].composite_modulus_MPa, nu * lub.density * 1e-6, u,
                                         lub.pressure_viscosity_per_GPa)
     kappa = nu / lubrication.reference_viscosity(bearing_speed_rpm, b.pitch_diameter)
-    c0 = b.static_load_rating_N or lubrication.static_load_rating(b.rollers, b.roller_diameter, b.roller_length,
-                                                                  b.pitch_diameter)
+    c0 = crank_bearing_static_rating(b)
     cu = b.fatigue_load_limit_N or lubrication.fatigue_load_limit(c0, b.pitch_diameter)
     a_iso = lubrication.a_iso_roller(kappa, lubrication.contamination_factor(lub) * cu / equivalent_load_N)
     to_hours = 1.0e6 / (60.0 * bearing_speed_rpm)
@@ -364,6 +375,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     # frame but does not follow the crank); the bore stands relative to it
     per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
     damage = float(np.mean(1.0 / per_angle))
+    k_max, j_max = np.unravel_index(int(np.argmax(roller_loads)), roller_loads.shape)
     return BearingDepth(
         bearing=bearing, model=model, roller_peak_pressure_MPa=worst.peak_pressure_MPa,
         roller_edge_factor=worst.edge_factor, raceway=g.name, theta_deg=math.degrees(float(theta[k])), roller=j,
@@ -372,7 +384,8 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
         film_thickness_min_um=film.minimum_um, film_thickness_central_um=film.central_um,
         film_parameter=film.minimum_um / lubrication.composite_roughness_um(lub.roughness_Ra_um),
         kappa=kappa, a_iso=a_iso, L10h=l10h, L_nm_h=a_iso * l10h,
-        L10r_h=math.inf if damage == 0 else to_hours / damage)
+        L10r_h=math.inf if damage == 0 else to_hours / damage, max_roller_load_N=float(roller_loads[k_max, j_max]),
+        max_roller_theta_deg=math.degrees(float(theta[k_max])), max_roller=int(j_max))
 
 
 @dataclass(frozen=True)
@@ -399,7 +412,7 @@ class CrankBearingDepth:
 
 
 def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison, rating_N: float,
-                        speed_rpm: float) -> CrankBearingDepth | None:
+                        speed_rpm: float, rigid_depths: tuple | None = None) -> CrankBearingDepth | None:
     """The crank bearing in depth over a load cycle, rigid and flexible (None without FE rollers).
 
     Parameters
@@ -415,6 +428,9 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
         Equivalent loads P = F_m per bearing (rigid and flexible).
     rating_N, speed_rpm : float
         C and n_b.
+    rigid_depths : tuple of BearingDepth, optional
+        The rigid column already computed at the same angles (:func:`rigid_bearing_depths`, as the
+        rigid handbook evaluation has it); computed here when not given.
     """
     if cycle.roller_loads is None or cycle.roller_angles is None:
         return None
@@ -422,19 +438,47 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
     slopes = eccentric_slopes(case, cycle)
     misalignment = 1e-3 * case.crank_bearing.profile.misalignment_mrad
     tilts = roller_tilts(slopes, cycle.roller_angles, cycle.bearing_forces, misalignment)
-    flexible, rigid, cache = [], [], {}
+    flexible, cache = [], {}
     have_rigid = isinstance(rigid_forces, np.ndarray) and np.all(np.isfinite(rigid_forces))
-    rig_loads = roller_slices.rigid_ring_roller_loads(rigid_forces, cycle.roller_angles) if have_rigid else None
-    rig_tilts = roller_tilts(np.zeros_like(slopes), cycle.roller_angles, rigid_forces, misalignment) \
-        if have_rigid else None
     for bc in comparison.bearings:
         i = bc.bearing
         flexible.append(bearing_depth(case, theta, cycle.roller_loads[:, i], tilts[:, i], bc.flexible.equivalent_N,
                                       speed_rpm, rating_N, i, "flexible", cache))
-        if have_rigid and bc.rigid is not None:
-            rigid.append(bearing_depth(case, theta, rig_loads[:, i], rig_tilts[:, i], bc.rigid.equivalent_N,
-                                       speed_rpm, rating_N, i, "rigid", cache))
+    rigid = () if rigid_depths is None else rigid_depths
+    if have_rigid and rigid_depths is None:
+        equivalent = {bc.bearing: bc.rigid.equivalent_N for bc in comparison.bearings if bc.rigid is not None}
+        rigid = rigid_bearing_depths(case, theta, rigid_forces, equivalent, rating_N, speed_rpm, cache)
     return CrankBearingDepth(flexible=tuple(flexible), rigid=tuple(rigid),
                              max_slope_mrad=1e3 * float(np.max(np.hypot(slopes[..., 0], slopes[..., 1]),
                                                                 initial=0.0)),
                              seconds=time.perf_counter() - t0)
+
+
+def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equivalent_loads_N: dict,
+                         rating_N: float, speed_rpm: float, cache: dict | None = None) -> tuple[BearingDepth, ...]:
+    """The crank bearing in depth under the handbook forces: rigid rings with the case's clearance,
+    rollers at their cage positions (:func:`rvfem.evaluate.roller_slices.case_rigid_roller_loads`),
+    untilted but for the case's extra misalignment; one :func:`bearing_depth` per bearing. Used by
+    the run's rigid column and by the rigid handbook evaluation alone (``rvfem rigid``).
+
+    Parameters
+    ----------
+    case : Case
+    theta : ndarray (n,)
+        Crank angles, rad (equally spaced over one revolution).
+    rigid_forces : ndarray (n, N, 2)
+        Handbook force of every bearing on the disc, N.
+    equivalent_loads_N : dict of int to float
+        P = F_m of each 0-based bearing to evaluate, N.
+    rating_N, speed_rpm : float
+        C (N) and n_b (rpm).
+    cache : dict, optional
+        Influence matrices kept between calls (:func:`cycle_slices`).
+    """
+    loads = roller_slices.case_rigid_roller_loads(case, theta, rigid_forces)
+    angles = roller_slices.roller_angles(case, np.asarray(theta, dtype=float))
+    tilts = roller_tilts(np.zeros(np.shape(rigid_forces)), angles, rigid_forces,
+                         1e-3 * case.crank_bearing.profile.misalignment_mrad)
+    cache = {} if cache is None else cache
+    return tuple(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache)
+                 for i, p in sorted(equivalent_loads_N.items()))

@@ -46,7 +46,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rvfem.evaluate.hertz import hertz_half_width
+from rvfem.evaluate.hertz import PALMGREN_COEFFICIENT, hertz_half_width
+from rvfem.solve.models import roller_angles
 
 __all__ = [
     "PROFILE_KINDS",
@@ -60,6 +61,7 @@ __all__ = [
     "hertz_peak_from_line_load",
     "roller_contact",
     "rigid_ring_roller_loads",
+    "case_rigid_roller_loads",
 ]
 
 PROFILE_KINDS = ("straight", "arc", "logarithmic", "combined")
@@ -406,13 +408,18 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
                         max_shear_depth_mm=SHEAR_DEPTH_FACTOR * float(b[k]))
 
 
-def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarray, iterations: int = 30) -> np.ndarray:
-    """Roller loads of rigid rings without clearance under a radial force, N.
+def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarray, iterations: int = 30, *,
+                            radial_clearance_mm: float = 0.0, roller_length_mm: float | None = None) -> np.ndarray:
+    """Roller loads of rigid rings under a radial force, N: the rigid-ring (Stribeck) distribution
+    at the rollers' actual angles, with the bearing's radial clearance.
 
     The rings move by d relative to each other; roller j along e_j = (cos ψ_j, sin ψ_j) is
-    compressed by (d·e_j)₊ and carries Q_j = K·(d·e_j)₊^(10/9) (line contact, Harris &
-    Kotzalas); d solves Σ_j Q_j·e_j = F (Newton, from the symmetric solution
-    Q_j = F·c_j^(10/9)/Σ c_k^(19/9), c = cos(ψ − φ_F)₊). K drops out.
+    compressed by s_j = (d·e_j − c/2)₊ (c the radial clearance, negative for a preload) and carries
+    Q_j = K·s_j^(10/9), K = (L^0.8/(2·3.84·10⁻⁵))^(10/9) (Palmgren's line contact on both
+    raceways, Harris & Kotzalas, the law of the FE rollers); d solves Σ_j Q_j·e_j = F (Newton,
+    from the zero-clearance solution Q_j = F·c_j^(10/9)/Σ c_k^(19/9), c = cos(ψ − φ_F)₊). Without
+    clearance K drops out and Q_max → 4.08·F/Z for many rollers with one on the load line
+    (:func:`rvfem.evaluate.hertz.rigid_ring_factor` gives the exact discrete value).
 
     Parameters
     ----------
@@ -422,6 +429,10 @@ def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarra
         Angular positions of the rollers, rad, same frame.
     iterations : int
         Newton iterations (converged to round-off in about ten).
+    radial_clearance_mm : float
+        c, mm (0: zero clearance; negative: preload).
+    roller_length_mm : float, optional
+        L_we, mm (needed for a non-zero clearance, which makes the distribution depend on K).
 
     Returns
     -------
@@ -429,19 +440,48 @@ def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarra
     """
     f = np.asarray(bearing_forces, dtype=float)
     psi = np.asarray(roller_angles, dtype=float)
+    half_c = 0.5 * float(radial_clearance_mm)
+    if half_c != 0.0:
+        if roller_length_mm is None:
+            raise ValueError("rigid_ring_roller_loads needs roller_length_mm with a radial clearance")
+        k = (roller_length_mm ** 0.8 / (2.0 * PALMGREN_COEFFICIENT)) ** (10.0 / 9.0)
+    else:
+        k = 1.0                                                                # drops out
     e = np.stack([np.cos(psi), np.sin(psi)], axis=-1)                       # (..., Z, 2)
     mag = np.linalg.norm(f, axis=-1)
     unit = f / np.where(mag > 0, mag, 1.0)[..., None]
     c = np.clip(np.einsum("...zc,...c->...z", e, unit), 0.0, None)
     denom = np.sum(c ** (19.0 / 9.0), axis=-1)
     scale = np.where(denom > 0, mag / np.where(denom > 0, denom, 1.0), 0.0)
-    d = unit * (scale ** 0.9)[..., None]                                       # Q = (d·e)^(10/9)
+    d = unit * ((scale / k) ** 0.9 + max(half_c, 0.0))[..., None]           # Q = K·(d·e − c/2)^(10/9)
     for _ in range(iterations):
-        s = np.clip(np.einsum("...zc,...c->...z", e, d), 0.0, None)
-        q = s ** (10.0 / 9.0)
+        s = np.clip(np.einsum("...zc,...c->...z", e, d) - half_c, 0.0, None)
+        q = k * s ** (10.0 / 9.0)
         res = np.einsum("...z,...zc->...c", q, e) - f
-        jac = np.einsum("...z,...zc,...zd->...cd", (10.0 / 9.0) * s ** (1.0 / 9.0), e, e)
+        jac = np.einsum("...z,...zc,...zd->...cd", k * (10.0 / 9.0) * s ** (1.0 / 9.0), e, e)
         jac = jac + 1e-12 * np.max(np.abs(jac), initial=1.0) * np.eye(2)
         d = d - np.linalg.solve(jac, res[..., None])[..., 0]
-    s = np.clip(np.einsum("...zc,...c->...z", e, d), 0.0, None)
-    return np.where(mag[..., None] > 0, s ** (10.0 / 9.0), 0.0)
+    s = np.clip(np.einsum("...zc,...c->...z", e, d) - half_c, 0.0, None)
+    if half_c < 0.0:                                     # a preload loads the rollers without a force
+        return k * s ** (10.0 / 9.0)
+    return np.where(mag[..., None] > 0, k * s ** (10.0 / 9.0), 0.0)
+
+
+def case_rigid_roller_loads(case, theta: np.ndarray, bearing_forces: np.ndarray) -> np.ndarray:
+    """The rigid-ring roller loads of a case's crank bearings over a cycle, N, (n, N, Z): every
+    bearing's force on rigid rings (:func:`rigid_ring_roller_loads`) with the rollers at their cage
+    positions (:func:`rvfem.solve.models.roller_angles`, as in the FE) and the case's radial
+    clearance. Its largest value is the rigid most loaded roller of every output
+    (:data:`rvfem.evaluate.hertz.RIGID_ROLLER_MODEL`).
+
+    Parameters
+    ----------
+    case : Case
+    theta : ndarray (n,)
+        Crank angles, rad.
+    bearing_forces : ndarray (n, N, 2)
+        Force of every bearing on the disc, N (handbook or FE).
+    """
+    b = case.crank_bearing
+    return rigid_ring_roller_loads(bearing_forces, roller_angles(case, np.asarray(theta, dtype=float)),
+                                   radial_clearance_mm=b.radial_clearance, roller_length_mm=b.roller_length)

@@ -40,6 +40,7 @@ __all__ = [
     "LOAD_RATIO_LIMIT",
     "MIN_LIFE_H",
     "HERTZ_PRESSURE_LIMIT_MPA",
+    "bearing_check_warnings",
     "BEARING_STEEL_MODULUS_MPA",
     "BEARING_STEEL_POISSONS_RATIO",
     "hertz_pressure_limit_MPa",
@@ -296,8 +297,8 @@ def _duty_lives(duty) -> list[tuple[str, float | None]]:
     return out
 
 
-_HERTZ_LABELS = {"fe_rollers": "largest FE roller load", "stribeck_rigid": "Stribeck, rigid F_max",
-                 "stribeck_flexible": "Stribeck, FE F_max"}
+_HERTZ_LABELS = {"fe_rollers": "largest FE roller load", "stribeck_rigid": "rigid rings, handbook loads",
+                 "stribeck_flexible": "rigid rings, FE bearing loads"}
 
 
 def analysis_warnings(analysis) -> tuple[ResultWarning, ...]:
@@ -405,4 +406,29 @@ def roller_depth_warnings(depth) -> tuple[ResultWarning, ...]:
             out.append(ResultWarning(
                 "kappa_range", f"viscosity ratio κ = {_sig(kappa)} > {high:g}: ISO 281 evaluates a_ISO at κ = {high:g} "
                 "(more viscosity gives no more life)", kappa, high, ""))
+    return tuple(out)
+
+
+def bearing_check_warnings(checks) -> tuple[ResultWarning, ...]:
+    """The warnings of :class:`rvfem.evaluate.bearing_checks.BearingChecks` (None: none): the crank
+    bearing's static safety S0 below 1 (code ``static_safety``) and its smallest load under the
+    minimum-load rule 0.02·C (code ``minimum_load``), the worst model of each."""
+    if checks is None:
+        return ()
+    out = []
+    if checks.static:
+        model, worst = min(checks.static.items(), key=lambda kv: kv[1].s0)
+        if worst.s0 < 1.0:
+            out.append(ResultWarning(
+                "static_safety", f"static safety S0 = C0/P0 = {_sig(worst.s0)} ({model}, P0 = {worst.p0_N:.0f} N) < 1: "
+                "the most loaded roller deforms the raceway permanently (ISO 76's C0; bearing makers ask S0 ≥ 1, "
+                "≥ 2 for shock loads or high running accuracy)", worst.s0, 1.0, ""))
+    below = [(m, v) for m, v in checks.minimum.items() if v.below]
+    if below:
+        model, worst = min(below, key=lambda kv: kv[1].fraction_of_C)
+        out.append(ResultWarning(
+            "minimum_load", f"smallest crank-bearing load {worst.min_load_N:.0f} N = {100 * worst.fraction_of_C:.2f} % "
+            f"of C ({model}) < {100 * worst.required_fraction:g} % of C, the bearing makers' minimum load of "
+            "cylindrical roller bearings (SKF rule, not ISO): the rollers may skid and smear the raceways",
+            100 * worst.fraction_of_C, 100 * worst.required_fraction, "% of C"))
     return tuple(out)

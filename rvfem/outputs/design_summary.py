@@ -7,6 +7,7 @@ with the smallest factor), and the details under ``mass_strength`` (docs/outputs
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
@@ -126,3 +127,36 @@ def fatigue_point_data(analysis) -> dict:
         return {}
     return {f"fatigue_safety_factor_P{analysis.system.model.order}":
             fatigue_field(cy.signed_von_mises_max, cy.signed_von_mises_min, analysis.case.material)}
+
+
+def _fmt(value, fmt: str) -> str:
+    """A number for a line, a dash for None, ``inf`` for infinity."""
+    if value is None:
+        return "–"
+    return format(float(value), fmt) if math.isfinite(float(value)) else "inf"
+
+
+def bearing_check_lines(checks: dict | None) -> list[str]:
+    """The crank bearing's static safety S0 and minimum load (rigid and flexible, where there) and the
+    support bearings' loads and lives (the ``bearing_checks`` object of summary.json or ``rvfem rigid
+    --json``)."""
+    if not checks:
+        return []
+    models = [m for m in ("rigid", "flexible") if m in checks["static_safety"]]
+    st, mn = checks["static_safety"], checks["minimum_load"]
+    lines = ["  static safety S0 = C0/P0 (ISO 76, C0 = " + f"{st[models[0]]['C0_N']:.0f} N): " + ", ".join(
+        f"{m} {_fmt(st[m]['S0'], '.2f')}" for m in models) + "; makers ask ≥ 1, ≥ 2 with shock or high accuracy"]
+    change = mn.get("flexible_vs_rigid_percent")
+    lines.append("  minimum load (skidding): smallest bearing load " + ", ".join(
+        f"{m} {mn[m]['min_load_N']:.0f} N = {100 * mn[m]['fraction_of_C']:.2f} % of C" for m in models)
+        + (f" (flexible {change:+.0f} %)" if change is not None else "")
+        + f"; makers' rule ≥ {100 * mn['required_fraction_of_C']:g} % of C")
+    sup = checks.get("support_bearings")
+    if sup:
+        lines.append("  support bearings (crankshaft beam): " + "; ".join(
+            f"{b['support']} max {b['max_load_N']:.0f} N, F_m {b['equivalent_load_N']:.0f} N"
+            + (f", L10h {_fmt(b['L10h_h'], '.0f')} h" if b["L10h_h"] is not None else "") for b in sup)
+            + (f" ({checks['support_note']})" if checks.get("support_note") else ""))
+    elif checks.get("support_note"):
+        lines.append(f"  support bearings: {checks['support_note']}")
+    return lines

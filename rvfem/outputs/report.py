@@ -27,7 +27,6 @@ import jinja2
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
 from rvfem.case.definition import Case
 from rvfem.case.schema import toml_literal
-from rvfem.case.schema import file_fields, format_quantity
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_report
@@ -194,10 +193,12 @@ def _life_and_hertz_assumptions(summary: dict, handbook: bool) -> list[str]:
         f"F_m = (mean F^p)^(1/p) with p = {m['equivalent_load_exponent']:.4g} over a uniformly sampled turn, "
         f"L10h = 10⁶/(60·n_b)·(C/F_m)^(10/3), bearing speed n_b = {m['bearing_speed_rpm']:g} rpm; life ratio "
         + ("= L_flex/L_rigid." if handbook else "= L_flex/L_equal_share."),
-        "Hertz: line contact of the most loaded roller on the eccentric (convex, inner) and in the bore (concave, "
-        f"outer), from the largest FE roller load and from Stribeck's Q_max = {summary['hertz']['stribeck_factor']:g}"
-        "·F/Z " + ("with the rigid (handbook) and the FE bearing load." if handbook else
-                   "with the FE bearing load (no handbook load for Zp − Zc ≠ 1)."),
+        "Hertz: line contact of the most loaded roller (the largest roller load over the cycle, every bearing and "
+        "roller) on the eccentric (convex, inner) and in the bore (concave, outer): from the FE roller loads and "
+        f"from {summary['hertz'].get('rigid_roller_model', 'rigid rings')} "
+        + ("under the rigid (handbook) and the FE bearing loads" if handbook else
+           "under the FE bearing loads (no handbook load for Zp − Zc ≠ 1)")
+        + "; Q_max·Z/F is its k in Stribeck's Q_max = k·F/Z (4.08 for zero clearance, many rollers).",
     ]
 
 
@@ -403,8 +404,8 @@ def _hertz(summary: dict) -> dict:
     """The Hertz pressures of the most loaded roller, from the FE roller loads and from Stribeck."""
     h = summary["hertz"]
     rows = []
-    for key, label in (("fe_rollers", "FE roller loads (largest)"), ("stribeck_rigid", "Stribeck, rigid F_max"),
-                       ("stribeck_flexible", "Stribeck, FE F_max")):
+    for key, label in (("fe_rollers", "FE roller loads (largest)"), ("stribeck_rigid", "rigid rings, handbook loads"),
+                       ("stribeck_flexible", "rigid rings, FE bearing loads")):
         e = h.get(key)
         if not e:
             continue
@@ -413,10 +414,10 @@ def _hertz(summary: dict) -> dict:
             where.append(f"bearing {e['bearing']}" + (f", roller {e['roller']}" if e.get("roller") else ""))
         if e.get("theta_deg") is not None:
             where.append(f"θ = {e['theta_deg']:.1f}°")
-        rows.append([label, ", ".join(where), _num(e["roller_load_N"], ".0f"),
+        rows.append([label, ", ".join(where), _num(e["roller_load_N"], ".0f"), _num(e.get("factor"), ".2f"),
                      _num(e["inner"]["peak_pressure_MPa"], ".0f"), _num(1000 * e["inner"]["half_width_mm"], ".1f"),
                      _num(e["outer"]["peak_pressure_MPa"], ".0f"), _num(1000 * e["outer"]["half_width_mm"], ".1f")])
-    return _table(["source", "where", "Q N", "p_inner MPa", "b_inner µm", "p_outer MPa", "b_outer µm"], rows, left=2)
+    return _table(["source", "where", "Q_max N", "Q_max·Z/F", "p_inner MPa", "b_inner µm", "p_outer MPa", "b_outer µm"], rows, left=2)
 
 
 def _roller_depth(summary: dict) -> dict | None:
@@ -431,18 +432,25 @@ def _roller_depth(summary: dict) -> dict | None:
             e = b[model]
             if e is None:
                 continue
-            rows.append([f"bearing {b['bearing']}", model, _num(e["roller_peak_pressure_MPa"], ".0f"),
+            rows.append([f"bearing {b['bearing']}", model,
+                         f"{_num(e.get('max_roller_load_N'), '.0f')} (θ = {_num(e.get('max_roller_theta_deg'), '.0f')}°)",
+                         _num(e["roller_peak_pressure_MPa"], ".0f"),
                          _num(e["roller_edge_factor"], ".2f"), f"{e['peak_raceway']}, θ = {e['peak_theta_deg']:.0f}°",
                          _num(e["max_shear_MPa"], ".0f"), _num(1000 * e["max_shear_depth_mm"], ".0f"),
                          _num(e["film_thickness_min_um"], ".3f"), _num(e["kappa"], ".2f"), _num(e["a_iso"], ".2f"),
                          _num(e["L10h_h"], ".0f"), _num(e["L_nm_h"], ".0f"), _num(e["L10r_h"], ".0f")])
         if b["rigid"] is not None:
-            rows.append([f"bearing {b['bearing']}", "flexible/rigid", "", "", "", "", "", "", "", "",
+            rows.append([f"bearing {b['bearing']}", "flexible/rigid", "", "", "", "", "", "", "", "", "",
                          _num(b["L10h_ratio"], ".2f"), _num(b["L_nm_ratio"], ".2f"), _num(b["L10r_ratio"], ".2f")])
-    table = _table(["bearing", "loads", "p_max MPa", "edge factor", "where", "τ_max MPa", "depth µm", "h_min µm",
+    table = _table(["bearing", "loads", "Q_max N", "p_max MPa", "edge factor", "where", "τ_max MPa", "depth µm", "h_min µm",
                     "κ", "a_ISO", "L10h h", "L_nm h", "L10r h"], rows, left=2)
     return {"table": table, "profile": d["profile"], "slices": d["slices"],
             "slope": _num(d["max_slope_mrad"], ".3f")}
+
+
+def _bearing_checks(summary: dict) -> list[str]:
+    """Static safety, minimum load and support bearings as report lines (the screen's lines)."""
+    return [line.strip() for line in bearing_check_lines(summary.get("bearing_checks"))]
 
 
 def _duty_cycle(summary: dict) -> dict | None:
@@ -509,29 +517,6 @@ def _images(summary: dict, case: Case, root: Path) -> dict | None:
             "mesh": _figure(root, im.get("mesh"), "The mesh (linear triangles) and a close-up of the rim under bore 1.")}
 
 
-_PROFILE_KEYS = {"straight": ("kind", "misalignment_mrad", "slices"),
-                 "arc": ("kind", "crown_radius", "misalignment_mrad", "slices"),
-                 "logarithmic": ("kind", "design_load_N", "misalignment_mrad", "slices"),
-                 "combined": ("kind", "modification_length", "modification_drop", "misalignment_mrad", "slices")}
-"""The keys of ``[crank_bearing.profile]`` each kind uses (the others do not enter its drop)."""
-
-
-def _table_text(table, keys: tuple[str, ...] | None = None) -> str:
-    """A case table's keys with their values and units (``span = 33 mm, shear = true``), those set
-    (not None) and, with ``keys``, only those."""
-    parts = []
-    for spec in file_fields(type(table)):
-        value = getattr(table, spec.name)
-        if value is None or (keys is not None and spec.name not in keys):
-            continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            text = toml_text(value)
-        else:
-            text = format_quantity(value, spec.param.unit)
-        parts.append(f"{spec.name} = {text}")
-    return ", ".join(parts)
-
-
 def _case_rows(case: Case) -> list[list[str]]:
     """The case's parameters, one row per table (the hole shapes describe their own tables)."""
     c, p, k, b, mat, ld, an, ms = (case.cycloid, case.pins, case.cranks, case.crank_bearing, case.material,
@@ -549,12 +534,8 @@ def _case_rows(case: Case) -> list[list[str]]:
         ["material", f"{mat.name}: E = {mat.youngs_modulus:g} MPa, ν = {mat.poissons_ratio:g}"],
         ["loads", f"T_out = {ld.torque_Nm:g} N·m, {ld.speed_rpm:g} rpm output, {ld.discs} discs"
                   + (f", duty cycle of {len(ld.duty_cycle)} rows" if ld.duty_cycle else "")],
-        ["crank-bearing roller profile", _table_text(b.profile, _PROFILE_KEYS.get(b.profile.kind))],
-        ["crank support (crankshaft as a beam)", _table_text(case.crank_support)
-         if case.crank_support is not None else "none: rigid eccentrics (the crankshafts' flexibility left out)"],
-        ["lubricant", _table_text(case.lubricant) if getattr(case, "lubricant", None) is not None else "none"],
         ["analysis", f"angle step {an.angle_step_deg:g}°, P{an.element_order}, p = {an.equivalent_load_exponent:.4g}, "
-                     f"pin friction μ = {an.friction:g}, saved angles {', '.join(f'{a:g}°' for a in an.saved_angles_deg)}"],
+                     f"saved angles {', '.join(f'{a:g}°' for a in an.saved_angles_deg)}"],
         ["mesh sizes", f"flank {ms.size_flank:g} mm, bore {ms.size_bore:g} mm, interior {ms.size_interior:g} mm, holes "
                        + (f"{ms.size_hole:g} mm" if ms.size_hole is not None else
                           f"{min(2 * ms.size_bore, ms.size_interior):g} mm (default: 2 × bore size)")],
@@ -596,6 +577,7 @@ def report_context(summary: dict, case: Case, root: str | os.PathLike) -> dict:
         "depends_on": _depends_on(summary, case),
         "hertz": _hertz(summary),
         "roller_depth": _roller_depth(summary),
+        "bearing_checks": _bearing_checks(summary),
         "mass_strength": mass_strength_report(summary),
         "duty_cycle": _duty_cycle(summary),
         "plots": _plots(summary, root),

@@ -48,7 +48,8 @@ import numpy as np
 from rvfem import __version__
 from rvfem.case.definition import case_to_dict, file_sha256
 from rvfem.errors import OutputError
-from rvfem.evaluate.hertz import STRIBECK_FACTOR
+from rvfem.evaluate.bearing_checks import MINIMUM_LOAD_FRACTION, STATIC_SAFETY_NORMAL, STATIC_SAFETY_SHOCK
+from rvfem.evaluate.hertz import RIGID_ROLLER_MODEL
 from rvfem.evaluate.postprocess import user_feature_name
 from rvfem.evaluate.rigid import references
 from rvfem.geometry import crank_centres
@@ -295,9 +296,48 @@ def _hertz_dict(h) -> dict:
         "bearing": None if h.bearing is None else h.bearing + 1,
         "roller": None if h.roller is None else h.roller + 1,
         "theta_deg": _angle(h.theta_deg),
+        "factor": h.factor,
         "inner": dataclasses.asdict(h.inner),
         "outer": dataclasses.asdict(h.outer),
     }
+
+
+def _depth_life_dict(d) -> dict | None:
+    """κ, a_ISO and the lives of one BearingDepth (``rvfem rigid --json``'s bearings)."""
+    if d is None:
+        return None
+    return {"kappa": d.kappa, "a_iso": d.a_iso, "L_nm_h": d.L_nm_h, "L10r_h": d.L10r_h,
+            "film_thickness_min_um": d.film_thickness_min_um, "roller_peak_pressure_MPa": d.roller_peak_pressure_MPa}
+
+
+def bearing_checks_dict(checks) -> dict | None:
+    """The ``bearing_checks`` object of summary.json and ``rvfem rigid --json``
+    (:class:`rvfem.evaluate.bearing_checks.BearingChecks`)."""
+    if checks is None:
+        return None
+    static = {m: {"C0_N": v.static_rating_N, "P0_N": v.p0_N, "S0": v.s0, "verdict": v.verdict}
+              for m, v in checks.static.items()}
+    minimum = {m: {"min_load_N": v.min_load_N, "fraction_of_C": v.fraction_of_C, "below": v.below}
+               for m, v in checks.minimum.items()}
+    out = {
+        "static_safety": {**static, "limits": {"normal": STATIC_SAFETY_NORMAL, "shock_or_accuracy": STATIC_SAFETY_SHOCK},
+                          "source": "S0 = C0/P0, P0 = F_r,max (ISO 76); limits: bearing makers' rule (SKF catalogue)"},
+        "minimum_load": {**minimum, "required_fraction_of_C": MINIMUM_LOAD_FRACTION,
+                         "source": "P_min = 0.02·C for cylindrical roller bearings: bearing makers' rule "
+                                   "(SKF catalogue), not ISO"},
+        "support_bearings": None if checks.support is None else [
+            {"support": b.support, "crank": b.crank + 1, "max_load_N": b.max_N, "max_at_deg": _angle(b.max_at_deg),
+             "min_load_N": b.min_N, "equivalent_load_N": b.equivalent_N, "L10h_h": b.L10h} for b in checks.support],
+        "support_note": checks.support_note,
+    }
+    if "rigid" in checks.minimum and "flexible" in checks.minimum and checks.minimum["rigid"].min_load_N > 0:
+        out["minimum_load"]["flexible_vs_rigid_percent"] = 100.0 * (
+            checks.minimum["flexible"].min_load_N / checks.minimum["rigid"].min_load_N - 1.0)
+    return out
+
+
+def _piece_bearing_checks(a, ctx: SummaryContext) -> dict:
+    return {"bearing_checks": bearing_checks_dict(getattr(a, "bearing_checks", None))}
 
 
 ANGLE_DECIMALS = 6
@@ -544,7 +584,8 @@ def _hot_spot_dict(h, j: int) -> dict:
 def _piece_hertz(a, ctx: SummaryContext) -> dict:
     h = a.hertz
     return {"hertz": {
-        "stribeck_factor": STRIBECK_FACTOR,
+        "rigid_roller_model": RIGID_ROLLER_MODEL,
+        "stribeck_factor": h["stribeck_rigid"].factor if "stribeck_rigid" in h else h["stribeck_flexible"].factor,
         "fe_rollers": _hertz_dict(h["fe_rollers"]) if "fe_rollers" in h else None,
         "stribeck_rigid": _hertz_dict(h["stribeck_rigid"]) if "stribeck_rigid" in h else None,
         "stribeck_flexible": _hertz_dict(h["stribeck_flexible"]),
@@ -627,6 +668,9 @@ def _depth_dict(d) -> dict:
         "peak_theta_deg": _angle(d.theta_deg),
         "peak_roller": d.roller + 1,
         "peak_roller_load_N": d.roller_load_N,
+        "max_roller_load_N": d.max_roller_load_N,
+        "max_roller_theta_deg": _angle(d.max_roller_theta_deg),
+        "max_roller": d.max_roller + 1,
         "peak_tilt_mrad": d.tilt_mrad,
         "max_shear_MPa": d.max_shear_MPa,
         "max_shear_depth_mm": d.max_shear_depth_mm,
@@ -683,6 +727,7 @@ SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
     _piece_reducer_stage,
     _piece_attribution,
     _piece_roller_depth,
+    _piece_bearing_checks,
     _piece_accuracy,
     _piece_files,
 )
@@ -879,7 +924,7 @@ def _image_set(analysis, images: Path) -> _ImageSet:
 
 def mesh_picture(system, images: str | os.PathLike) -> dict:
     """The keyword arguments of :func:`rvfem.outputs.plots.mesh_plot` for ``images/mesh.png`` of a run:
-    the whole mesh and a close-up of the rim under bore 1 and the teeth. It needs the model only,
+    the whole mesh and a close-up of the rim under the bore of bearing 1. It needs the model only,
     so a run can have it drawn while the load cycle is solved (:func:`start_mesh_picture`)."""
 
     case, mesh = system.case, system.mesh
@@ -1130,14 +1175,16 @@ def rigid_summary(result) -> dict:
         "equivalent_load_N": b.loads.equivalent_N,
         "L10h_h": b.loads.L10h,
         "max_roller_load_N": b.max_roller_load_N,
+        "max_roller_at_deg": _angle(b.max_roller_theta_deg),
         "hertz_inner": dataclasses.asdict(b.hertz_inner),
         "hertz_outer": dataclasses.asdict(b.hertz_outer),
+        "depth": _depth_life_dict(b.depth),
     } for b in result.bearings]
     if not result.defined:   # the handbook is not defined (Zp − Zc ≠ 1): the same keys, null
         bearings = [{
             "bearing": i + 1, "crank_angle_deg": angle, "max_load_N": None, "max_at_deg": None, "min_load_N": None,
             "min_at_deg": None, "equivalent_load_N": None, "L10h_h": None, "max_roller_load_N": None,
-            "hertz_inner": None, "hertz_outer": None,
+            "max_roller_at_deg": None, "hertz_inner": None, "hertz_outer": None, "depth": None,
         } for i, angle in enumerate(case.cranks.angles_deg)]
 
     source = Path(case.source.removesuffix(" (with overrides)"))
@@ -1163,6 +1210,8 @@ def rigid_summary(result) -> dict:
         "angle_step_deg": result.angle_step_deg,
         "dynamic_load_rating_N": result.rating_N,
         "stribeck_factor": result.stribeck_factor,
+        "rigid_roller_model": RIGID_ROLLER_MODEL,
+        "bearing_checks": bearing_checks_dict(result.checks),
         "references": _references_dict(result.references or references(case, fe=False)),
         "warnings": [w.as_dict() for w in result.warnings],
         "bearings": bearings,
