@@ -27,6 +27,7 @@ import jinja2
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
 from rvfem.case.definition import Case
 from rvfem.case.schema import toml_literal
+from rvfem.case.schema import file_fields, format_quantity
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_report
@@ -517,6 +518,29 @@ def _images(summary: dict, case: Case, root: Path) -> dict | None:
             "mesh": _figure(root, im.get("mesh"), "The mesh (linear triangles) and a close-up of the rim under bore 1.")}
 
 
+_PROFILE_KEYS = {"straight": ("kind", "misalignment_mrad", "slices"),
+                 "arc": ("kind", "crown_radius", "misalignment_mrad", "slices"),
+                 "logarithmic": ("kind", "design_load_N", "misalignment_mrad", "slices"),
+                 "combined": ("kind", "modification_length", "modification_drop", "misalignment_mrad", "slices")}
+"""The keys of ``[crank_bearing.profile]`` each kind uses (the others do not enter its drop)."""
+
+
+def _table_text(table, keys: tuple[str, ...] | None = None) -> str:
+    """A case table's keys with their values and units (``span = 33 mm, shear = true``), those set
+    (not None) and, with ``keys``, only those."""
+    parts = []
+    for spec in file_fields(type(table)):
+        value = getattr(table, spec.name)
+        if value is None or (keys is not None and spec.name not in keys):
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            text = toml_text(value)
+        else:
+            text = format_quantity(value, spec.param.unit)
+        parts.append(f"{spec.name} = {text}")
+    return ", ".join(parts)
+
+
 def _case_rows(case: Case) -> list[list[str]]:
     """The case's parameters, one row per table (the hole shapes describe their own tables)."""
     c, p, k, b, mat, ld, an, ms = (case.cycloid, case.pins, case.cranks, case.crank_bearing, case.material,
@@ -534,8 +558,12 @@ def _case_rows(case: Case) -> list[list[str]]:
         ["material", f"{mat.name}: E = {mat.youngs_modulus:g} MPa, ν = {mat.poissons_ratio:g}"],
         ["loads", f"T_out = {ld.torque_Nm:g} N·m, {ld.speed_rpm:g} rpm output, {ld.discs} discs"
                   + (f", duty cycle of {len(ld.duty_cycle)} rows" if ld.duty_cycle else "")],
+        ["crank-bearing roller profile", _table_text(b.profile, _PROFILE_KEYS.get(b.profile.kind))],
+        ["crank support (crankshaft as a beam)", _table_text(case.crank_support)
+         if case.crank_support is not None else "none: rigid eccentrics (the crankshafts' flexibility left out)"],
+        ["lubricant", _table_text(case.lubricant) if getattr(case, "lubricant", None) is not None else "none"],
         ["analysis", f"angle step {an.angle_step_deg:g}°, P{an.element_order}, p = {an.equivalent_load_exponent:.4g}, "
-                     f"saved angles {', '.join(f'{a:g}°' for a in an.saved_angles_deg)}"],
+                     f"pin friction μ = {an.friction:g}, saved angles {', '.join(f'{a:g}°' for a in an.saved_angles_deg)}"],
         ["mesh sizes", f"flank {ms.size_flank:g} mm, bore {ms.size_bore:g} mm, interior {ms.size_interior:g} mm, holes "
                        + (f"{ms.size_hole:g} mm" if ms.size_hole is not None else
                           f"{min(2 * ms.size_bore, ms.size_interior):g} mm (default: 2 × bore size)")],
