@@ -1229,10 +1229,19 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
         t = stages.start("attribution")
         attribution, attribution_seconds = pending.result()
         stages.end("attribution", t)
+    # the secondary analyses below (and the attribution's steps) may not refuse a case whose load
+    # cycle solved: one that cannot be made is left out with a warning that says why
+    not_computed = list(attribution_warnings(attribution))
     if duty is not None and duty_fe:
         t = stages.start("duty_cycle")
-        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
-                                                                   duty.flexible.service_life_h))
+        try:
+            duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
+                                                                       duty.flexible.service_life_h))
+        except ContactError as exc:
+            log.warning("the flexible FE at every duty-cycle torque not computed: %s", exc)
+            not_computed.append(validity.ResultWarning(
+                "not_computed", f"the flexible FE at every duty-cycle torque not computed: {exc}; the service "
+                "life is the linear scaling of the case's own cycle", 1.0, 0.0, ""))
         stages.end("duty_cycle", t)
 
     accuracy, accuracy_seconds = _timed(run_accuracy, system)
@@ -1247,7 +1256,8 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
                       comparison=comparison, stress=stress, hertz=roller_hertz,
                       torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
                       attribution=attribution, references=references, accuracy=accuracy)
-    return _with_roller_depth(result)
+    result = _with_roller_depth(result)
+    return dataclasses.replace(result, warnings=result.warnings + tuple(not_computed)) if not_computed else result
 
 
 def _with_roller_depth(result: Analysis) -> Analysis:
@@ -1299,6 +1309,12 @@ def attribution_of(system, thetas, cycle):
     compliance."""
 
     return attribution.attribution(system, thetas, cycles={attribution.case_step(system.case): cycle})
+
+
+def attribution_warnings(result) -> tuple:
+    """The warnings of the attribution steps that could not be made
+    (:func:`rvfem.evaluate.attribution.skipped_warnings`); none for None."""
+    return attribution.skipped_warnings(result)
 
 
 def _timed(function, *args, **kwargs):

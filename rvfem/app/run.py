@@ -340,6 +340,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
     if computed:
         (value, seconds), = computed
         result = dataclasses.replace(result, attribution=value,
+                                     warnings=result.warnings + _analysis.attribution_warnings(value),
                                      timings={**result.timings, "attribution_compute": seconds})
 
     last = [w for w in registered if w.needs_summary]

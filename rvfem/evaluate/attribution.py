@@ -1,14 +1,21 @@
 """What the flexibility effect is made of: the attribution of the flexible bearing loads to the
 modelling steps handbook → equal share of the FE pin resultant → one flexible disc with T/discs →
 two discs sharing the carrier → crankshaft compliance, on the same crank angles and the same
-compliance."""
+compliance.
+
+The attribution is a secondary analysis: a step whose cycle cannot be solved (a contact problem the
+step's model does not settle, though the case's own model does) is left out of the chain and named
+with its reason (:attr:`Attribution.skipped`, :func:`skipped_warnings`); the other steps and the
+run's results stand."""
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem.errors import ContactError
 from rvfem.evaluate.compare import equal_share_forces
 from rvfem.evaluate.iso281 import life_ratio
 from rvfem.evaluate.rigid import (
@@ -16,10 +23,13 @@ from rvfem.evaluate.rigid import (
     handbook_applicable,
     handbook_bearing_loads,
 )
+from rvfem.evaluate.validity import ResultWarning
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve.cycle import build_stage, load_cycle
 
-__all__ = ["Attribution", "AttributionStep", "STEP_LABELS", "attribution", "case_step"]
+__all__ = ["Attribution", "AttributionStep", "STEP_LABELS", "attribution", "case_step", "skipped_warnings"]
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -46,12 +56,15 @@ class Attribution:
     """The chain handbook → equal share of the FE pin resultant → one flexible disc with T/discs
     → two discs sharing the carrier → crankshaft compliance, on the same crank angles.
 
-    ``final`` names the step that is the case's own model (the full FE answer).
+    ``final`` names the step that is the case's own model (the full FE answer). ``skipped`` holds
+    ``(key, why)`` for every step that could not be made (its cycle did not solve, or the cycle it is
+    built from did not); those steps are left out of ``steps``.
     """
 
     theta: np.ndarray
     steps: tuple[AttributionStep, ...]
     final: str
+    skipped: tuple[tuple[str, str], ...] = ()
 
     def step(self, key: str) -> AttributionStep:
         return next(s for s in self.steps if s.key == key)
@@ -103,6 +116,13 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
         Already solved cycles by step key (``one_disc``, ``two_discs``, ``crankshafts``), e.g. the
         run's own cycle, so that it is not solved twice. All steps share the disc's compliance.
 
+    Raises
+    ------
+    rvfem.errors.ContactError
+        Only if the case's own step (:func:`case_step`) is not in ``cycles`` and its cycle does not
+        solve. Any other step that does not solve is left out and named in
+        :attr:`Attribution.skipped` (logged as a warning).
+
     Notes
     -----
     The equal share is built from the one-disc cycle's pin resultant (the handbook's load sharing
@@ -121,22 +141,45 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     f = crankshaft_influence(case)
     if f is not None:
         need.append("crankshafts")
+    skipped: dict[str, str] = {}
     for key in need:
         if key in cycles:
             continue
         stage = build_stage(system, discs=1 if key == "one_disc" else discs,
                             influence=f if key == "crankshafts" else None)
-        cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
+        try:
+            cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
+        except ContactError as exc:
+            if key == case_step(case):      # the case's own model: no chain to end in
+                raise
+            skipped[key] = f"its load cycle does not solve: {exc}"
     if handbook_applicable(case)[0]:
         steps = [AttributionStep("handbook", STEP_LABELS["handbook"], handbook_bearing_loads(case, thetas).magnitude)]
-        base, label = cycles["one_disc"], STEP_LABELS["equal_share"]
+        base, label = cycles.get("one_disc"), STEP_LABELS["equal_share"]
     else:   # Zp − Zc ≠ 1: start at the run's own reference
         steps, base, label = [], cycles[case_step(case)], STEP_LABELS["equal_share_reference"]
-    share = np.linalg.norm(equal_share_forces(case, base), axis=2).T
-    steps.append(AttributionStep("equal_share", label, share))
+    if base is not None:
+        share = np.linalg.norm(equal_share_forces(case, base), axis=2).T
+        steps.append(AttributionStep("equal_share", label, share))
+    else:
+        skipped["equal_share"] = "it is built from the pin forces of the one-disc step, which was not made"
     for key in need:
-        steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
-    return Attribution(np.asarray(thetas), tuple(steps), case_step(case))
+        if key in cycles:
+            steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
+    for key, why in skipped.items():
+        log.warning("attribution step %s (%s) not made: %s", key, STEP_LABELS[key], why)
+    return Attribution(np.asarray(thetas), tuple(steps), case_step(case), tuple(skipped.items()))
+
+
+def skipped_warnings(result: Attribution | None) -> tuple[ResultWarning, ...]:
+    """One warning (code ``not_computed``) per attribution step that could not be made, naming the
+    step and why; ``value`` is 1 (one step left out), ``limit`` 0. Empty without an attribution or
+    with every step made."""
+    if result is None:
+        return ()
+    return tuple(ResultWarning("not_computed", f"attribution step {key} ({STEP_LABELS[key]}) not made: {why}; "
+                               "the other steps and the run's results stand", 1.0, 0.0, "")
+                 for key, why in result.skipped)
 
 
 def case_step(case) -> str:

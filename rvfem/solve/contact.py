@@ -1188,8 +1188,32 @@ def initial_iterate(problem: ContactProblem, start: list | None, tol_gap: float)
         it = NewtonIterate(lam, np.concatenate([s.rigid for s in start]), start[0].carrier_rotation, active)
     else:
         active = sig & (gap0 <= tol_gap) & (problem.moment * problem.torque <= 0)
+        active |= first_to_close(problem, active)
         it = NewtonIterate(np.zeros(problem.nc), np.zeros(problem.nr), 0.0, active)
     return it.update(problem)
+
+
+def first_to_close(problem: ContactProblem, active: np.ndarray) -> np.ndarray:
+    """The rigid contacts a cold start adds to ``active``: per body whose rigid contacts on the
+    torque's side (force on the body against the torque) are all open, the one that a rotation of
+    the body about its centre closes first (smallest gap / |moment arm|).
+
+    Such a body has a backlash all round (a positive equidistant modification with rigid pins: at
+    zero load no pin touches). With none of its rigid contacts active, the rotation of the body and
+    the carrier is held by nothing: the first Newton matrix is singular, exactly so for a profile
+    without pitch errors (the solve then stops as a mechanism) and up to round-off otherwise (the
+    step then depends on the round-off). The torque turns the body through its backlash onto its
+    pins; starting with the first pin it meets active, the active-set loop adds the others."""
+    out = np.zeros(problem.nc, dtype=bool)
+    if not problem.carrier or not problem.torque:
+        return out
+    arm = np.abs(problem.moment)
+    side = problem.sig & (problem.moment * problem.torque < 0) & (arm > 0)
+    for lo, hi in zip(problem.offs[:-1], problem.offs[1:]):
+        candidates = np.flatnonzero(side[lo:hi]) + lo
+        if candidates.size and not active[candidates].any():
+            out[candidates[np.argmin(problem.gap0[candidates] / arm[candidates])]] = True
+    return out
 
 
 def penalty_scale(problem: ContactProblem, active: np.ndarray) -> float:
