@@ -1429,5 +1429,5 @@ def _report_html(study: Study, rows: list[dict], plots: dict, wall_s: float, com
         parts.append(f"<tr{cls}>" + "".join(
             f"<td class='{c}'>{_fmt(r.get(n), spec) if spec != 's' else e(_value_text(r.get(n)) if r.get(n) is not None else '')}</td>"
             for n, c, spec in cols) + "</tr>")
-    parts.append("</table><p>All numbers at full precision: <code>study.csv</code>.</p></body></html>")
+    parts.append("</table></div><p>All numbers at full precision: <code>study.csv</code>.</p></body></html>")
     return "\n".join(parts)

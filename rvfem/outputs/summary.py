@@ -924,7 +924,7 @@ def _image_set(analysis, images: Path) -> _ImageSet:
 
 def mesh_picture(system, images: str | os.PathLike) -> dict:
     """The keyword arguments of :func:`rvfem.outputs.plots.mesh_plot` for ``images/mesh.png`` of a run:
-    the whole mesh and a close-up of the rim under the bore of bearing 1. It needs the model only,
+    the whole mesh and a close-up of the rim under bore 1 and the teeth. It needs the model only,
     so a run can have it drawn while the load cycle is solved (:func:`start_mesh_picture`)."""
 
     case, mesh = system.case, system.mesh
