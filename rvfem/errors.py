@@ -33,5 +33,18 @@ class OutputError(RvfemError, RuntimeError):
     is a file, or the file system refuses."""
 
 
+class FolderNotEmptyError(OutputError):
+    """A result folder rvfem wrote earlier is in the way and replacing it was not allowed.
+
+    The message says so in the library's words (the ``overwrite`` argument); the command line
+    words it with its option. ``folder`` is the folder's path.
+    """
+
+    def __init__(self, folder, message: str | None = None):
+        self.folder = folder
+        super().__init__(message or f"{folder} exists and is not empty; choose another output folder, or allow "
+                                    "replacing it (overwrite)")
+
+
 class RenderError(RvfemError, RuntimeError):
     """Off-screen rendering of the images is not possible on this machine."""

@@ -65,7 +65,7 @@ from scipy.spatial import cKDTree
 from rvfem import NOTICE
 from rvfem._arrays import chain_edges
 from rvfem.case.definition import Case, case_to_dict, registered_hole_shapes
-from rvfem.errors import MeshError
+from rvfem.errors import MeshError, OutputError
 from rvfem.geometry import (
     SPLINE_POINTS_PER_SEGMENT,
     Arc,
@@ -890,6 +890,28 @@ def read_msh(path: str | os.PathLike, from_cache: bool = True) -> DiscMesh:
         return _extract(g, path, from_cache)
 
 
+def _cache_file(path: Path) -> tuple[int, str]:
+    """Create the folder of ``path`` (the mesh cache) and a temporary file in it; ``(fd, name)``.
+
+    Raises
+    ------
+    OutputError
+        The folder is a file, or cannot be created or written (the error names the mesh cache,
+        not the results).
+    """
+    folder = path.parent
+    blocked = next((p for p in (folder, *folder.parents) if p.exists() and not p.is_dir()), None)
+    if blocked is not None:
+        raise OutputError(f"the mesh cache folder {folder} cannot be used: {blocked} is a file, not a folder; "
+                          "choose another mesh cache folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        return tempfile.mkstemp(dir=folder, prefix=f".{path.stem}.", suffix=".tmp.msh")
+    except OSError as exc:
+        raise OutputError(f"cannot write into the mesh cache folder {folder}: {exc.strerror or exc}; choose another "
+                          "mesh cache folder") from None
+
+
 def mesh_geometry(geom: DiscGeometry, path: str | os.PathLike) -> DiscMesh:
     """Mesh a checked :class:`~rvfem.geometry.DiscGeometry` and write the ``.msh`` to ``path``.
 
@@ -904,8 +926,7 @@ def mesh_geometry(geom: DiscGeometry, path: str | os.PathLike) -> DiscMesh:
     """
     path = Path(path)
     cut = _sector_cut(geom)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp.msh")
+    fd, tmp_name = _cache_file(path)
     os.close(fd)
     tmp = Path(tmp_name)
     try:
@@ -959,6 +980,8 @@ def mesh_case(case: Case, cache_dir: str | os.PathLike = "meshes", *, use_cache:
         The geometry check failed (nothing is meshed).
     MeshError
         Gmsh failed or produced an unusable mesh.
+    OutputError
+        ``cache_dir`` is a file or cannot be written.
     """
     geom = geometry if geometry is not None else disc_geometry(case)
     path = mesh_path(case, cache_dir)

@@ -21,11 +21,12 @@ import numpy as np
 import pytest
 from conftest import CaseText, documented_keys, written_keys
 
+from rvfem import __version__
 from rvfem.app import cli, screen
 from rvfem.app.analysis import analyse
 from rvfem.app.run import IMAGE_SIZE, run_case
 from rvfem.case.definition import file_sha256, load_case
-from rvfem.errors import OutputError, RenderError
+from rvfem.errors import FolderNotEmptyError, OutputError, RenderError
 from rvfem.evaluate.compare import rigid_vs_flexible
 from rvfem.mesh import mesh_case
 from rvfem.outputs import render
@@ -288,7 +289,8 @@ def test_report_states_the_reducer_stage_and_what_the_delta_depends_on(cli_run, 
 def test_files_listed_exist(cli_run, summary):
     listed = set(summary["files"])
     on_disk = {p.relative_to(cli_run).as_posix() for p in cli_run.rglob("*") if p.is_file()}
-    assert listed == on_disk
+    assert listed == on_disk - {outputs.RESULT_MARKER}     # the marker says who wrote the folder
+    assert (cli_run / outputs.RESULT_MARKER).read_text(encoding="utf-8").startswith(f"rvfem {__version__} run ")
     assert not any(p.name.startswith(".") for p in cli_run.parent.iterdir())  # no temporary folders left
 
 
@@ -348,16 +350,18 @@ def test_second_run_without_overwrite_fails_and_keeps_the_results(cli_run, coars
     assert "exists and is not empty" in err and "--overwrite" in err and "Traceback" not in err
     assert "overwrite=True" not in err                     # the command line's wording, not the API's
     assert {p: p.read_bytes() for p in cli_run.rglob("*") if p.is_file()} == before
-    with pytest.raises(OutputError, match="overwrite=True") as info:   # and the API's from Python
+    with pytest.raises(FolderNotEmptyError, match=r"allow replacing it \(overwrite\)") as info:  # the library's
         outputs.check_output_folder(cli_run, overwrite=False)
-    assert "--overwrite" not in str(info.value)
+    assert "--overwrite" not in str(info.value) and info.value.folder == cli_run
 
 
 def test_overwrite_replaces_and_options_override_the_case(cli_run, coarse_case_file, cache_dir, workspace, capsys):
+    """A second run with --overwrite replaces a result folder rvfem wrote (it holds the marker)."""
     import shutil
 
     out = workspace / "overwritten"
     shutil.copytree(cli_run, out)
+    assert outputs.is_rvfem_folder(out)
     code = cli.main(["run", str(coarse_case_file), "-o", str(out), "--cache-dir", str(cache_dir), "--overwrite",
                      "--no-images", "--step", "30", "--bearing-model", "rigid_bore"])
     stdout = capsys.readouterr().out
@@ -399,12 +403,13 @@ def test_interrupted_run_leaves_no_folder(coarse_case_file, cache_dir, tmp_path,
 def test_interrupted_overwrite_keeps_the_previous_results(coarse_case_file, cache_dir, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
+    outputs.mark_folder(out, "run")                # results rvfem wrote earlier
     (out / "old.txt").write_text("previous results")
     with pytest.raises(KeyboardInterrupt):
         run_case(coarse_case_file, out, overwrite=True, progress=Interrupt(KeyboardInterrupt()),
                  cache_dir=cache_dir, images=False)
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
-    assert [p.name for p in out.iterdir()] == ["old.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [outputs.RESULT_MARKER, "old.txt"]
 
 
 def test_cli_interrupt_exits_130(coarse_case_file, cache_dir, tmp_path, monkeypatch, capsys):
@@ -419,6 +424,40 @@ def test_cli_interrupt_exits_130(coarse_case_file, cache_dir, tmp_path, monkeypa
                      "--no-images"]) == 130
     assert "interrupted" in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
+
+
+def _foreign_folder(path: Path) -> dict:
+    """A non-empty folder rvfem did not write (a sibling result, a file, a sub-folder); its contents."""
+    (path / "sub").mkdir(parents=True)
+    (path / "notes.txt").write_text("mine")
+    (path / "sub" / "data.csv").write_text("1,2\n")
+    return {p.relative_to(path): p.read_bytes() for p in path.rglob("*") if p.is_file()}
+
+
+def test_overwrite_never_replaces_a_folder_rvfem_did_not_write(tmp_path):
+    out = tmp_path / "out"
+    before = _foreign_folder(out)
+    for overwrite in (False, True):
+        with pytest.raises(OutputError, match=r"rvfem did not write it \(no \.rvfem-results file in it\)"):
+            with outputs.result_folder(out, overwrite=overwrite):
+                pytest.fail("entered")
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]     # no temporary folder left
+    outputs.check_output_folder(tmp_path / "absent", overwrite=False)   # a new or empty folder is taken
+    (tmp_path / "empty").mkdir()
+    outputs.check_output_folder(tmp_path / "empty", overwrite=False)
+
+
+def test_cli_overwrite_of_a_folder_rvfem_did_not_write_is_refused(coarse_case_file, tmp_path, capsys):
+    """rvfem run --overwrite on a non-empty folder without the marker: one line, exit 2, the
+    folder's contents untouched (the 0.3 behaviour deleted them: a case named "" took results/)."""
+    out = tmp_path / "results"
+    before = _foreign_folder(out)
+    assert cli.main(["run", str(coarse_case_file), "-o", str(out), "--overwrite", "--no-images"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "rvfem did not write it" in err and "Traceback" not in err
+    assert {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()} == before
+    assert [p.name for p in tmp_path.iterdir()] == ["results"]
 
 
 def test_existing_file_as_output_is_an_error(coarse_case_file, tmp_path):
@@ -609,7 +648,7 @@ def test_result_folder_moves_into_place_only_when_complete(tmp_path):
     with outputs.result_folder(out) as folder:
         (folder / "x.txt").write_text("new")
         assert not out.exists() and folder.parent == out.parent
-    assert [p.name for p in out.iterdir()] == ["x.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [outputs.RESULT_MARKER, "x.txt"]
     assert [p.name for p in out.parent.iterdir()] == ["out"]
     # an existing folder is refused before anything is written, and kept
     with pytest.raises(OutputError, match="exists and is not empty"):
@@ -620,11 +659,12 @@ def test_result_folder_moves_into_place_only_when_complete(tmp_path):
         with outputs.result_folder(out, overwrite=True) as folder:
             (folder / "y.txt").write_text("half")
             1 / 0
-    assert [p.name for p in out.iterdir()] == ["x.txt"] and (out / "x.txt").read_text() == "new"
+    assert sorted(p.name for p in out.iterdir()) == [outputs.RESULT_MARKER, "x.txt"]
+    assert (out / "x.txt").read_text() == "new"
     assert [p.name for p in out.parent.iterdir()] == ["out"]
     with outputs.result_folder(out, overwrite=True) as folder:
         (folder / "y.txt").write_text("complete")
-    assert [p.name for p in out.iterdir()] == ["y.txt"]
+    assert sorted(p.name for p in out.iterdir()) == [outputs.RESULT_MARKER, "y.txt"]
     assert [p.name for p in out.parent.iterdir()] == ["out"]
 
 

@@ -23,6 +23,7 @@ from rvfem.app.run import run_case
 from rvfem.app.study import LOCK_NAME, load_study, read_study_csv, run_study
 from rvfem.case.definition import load_case
 from rvfem.errors import CaseError, OutputError
+from rvfem.outputs.summary import RESULT_MARKER, mark_folder
 
 BIN = Path(sys.executable).parent
 BASE_CASE = ROOT / "cases" / "rv40e_fanholes.toml"
@@ -284,6 +285,7 @@ def test_a_second_study_into_the_same_folder_is_refused(tmp_path):
     study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
     out = tmp_path / "out"
     out.mkdir()
+    mark_folder(out, "study")                  # a study folder in use holds the marker and the lock
     lock = out / LOCK_NAME
     lock.write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "started": "now"}))
     with pytest.raises(OutputError, match=r"in use by another study \(lock file .*\.study\.lock"):
@@ -415,10 +417,29 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path):
     study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
     address = f"tcp://127.0.0.1:{_free_port()}"  # nothing listens there
     with pytest.raises(ClusterError, match=f"cannot connect to the Dask scheduler at {address}") as info:
-        run_study(study_file, tmp_path / "out", scheduler=address, connect_timeout_s=1.0)
+        run_study(study_file, tmp_path / "a" / "out", scheduler=address, connect_timeout_s=1.0)
     assert "\n" not in str(info.value)
-    assert not (tmp_path / "out" / LOCK_NAME).exists()
-    assert not [p for p in (tmp_path / "out" / "variants").iterdir()]
+    # reached before anything is created: no study.csv, study.json, variants/ or created parent left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_an_unreachable_scheduler_from_the_command_line_leaves_nothing(tmp_path, capsys):
+    study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
+    out = tmp_path / "out"
+    assert cli.main(["study", str(study_file), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "cannot connect to the Dask scheduler at tcp://127.0.0.1:1" in err[-1] and "Traceback" not in err[-1]
+    assert not out.exists()
+
+
+def test_a_study_into_a_folder_rvfem_did_not_write_is_refused(tmp_path):
+    study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match="rvfem did not write it"):
+        run_study(study_file, out, scheduler="tcp://127.0.0.1:1", connect_timeout_s=1.0)
+    assert [p.name for p in out.iterdir()] == ["notes.txt"]
 
 
 def _fake_summary(max_n: float, fm_n: float, life_h: float) -> dict:
@@ -468,11 +489,12 @@ high = "rigid_bore"
     assert rows["fan_holes.ligament=5.5"]["max_load_N"] is None
     assert rows["fan_holes.ligament=5.5"]["error"] == "GeometryError: too thin"
     (tmp_path / "plots").mkdir()
+    mark_folder(tmp_path / "plots", "study plots")   # the plots of an earlier run
     (tmp_path / "plots" / "response_old.png").write_bytes(b"stale")
     files = _plots(study, list(rows.values()), tmp_path / "plots")
     assert set(files) == {"tornado", "variants"}
     assert all(p.stat().st_size > 5000 for p in files.values())
-    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == ["tornado.png", "variants.png"]
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [RESULT_MARKER, "tornado.png", "variants.png"]
     before = {p.name: p.read_bytes() for p in files.values()}
 
     def interrupted(*args):
@@ -481,7 +503,7 @@ high = "rigid_bore"
     monkeypatch.setattr(study_module, "study_figures", interrupted)
     with pytest.raises(KeyboardInterrupt):
         _plots(study, list(rows.values()), tmp_path / "plots")
-    assert {p.name: p.read_bytes() for p in (tmp_path / "plots").iterdir()} == before
+    assert {p.name: p.read_bytes() for p in (tmp_path / "plots").iterdir() if p.name != RESULT_MARKER} == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plots", "s.toml"]   # no temporary folder left
 
 

@@ -39,7 +39,7 @@ from rvfem.app.run import STAGES, run_case, run_stages, summary_text
 from rvfem.app.screen import rigid_text
 from rvfem.case.definition import Case, load_case
 from rvfem.case.registry import bearing_model_names
-from rvfem.errors import OutputError, RvfemError
+from rvfem.errors import FolderNotEmptyError, RvfemError
 from rvfem.evaluate.postprocess import feature_label
 from rvfem.geometry import disc_geometry
 from rvfem.geometry.features import feature_text
@@ -266,10 +266,7 @@ class _RunProgress:
 def _run_run(args: argparse.Namespace) -> int:
     case = _load(args)
     out_dir = Path(args.output) if args.output else Path("results") / case.name
-    try:
-        check_output_folder(out_dir, args.overwrite)
-    except OutputError as exc:  # the command line's wording: the option, not the keyword argument
-        raise OutputError(str(exc).replace("overwrite=True", "--overwrite")) from None
+    check_output_folder(out_dir, args.overwrite)   # before the progress display: a refusal is one line
 
     progress = _RunProgress(sys.stderr, sys.stderr.isatty(), run_stages(case, images=not args.no_images))
     if _notices is not None:
@@ -428,6 +425,10 @@ def main(argv: list[str] | None = None) -> int:
     remove_notices = _setup_logging(args.verbose, args.command)
     try:
         return args.run(args)
+    except FolderNotEmptyError as exc:  # the command line's words: the option, not the keyword argument
+        print(f"rvfem {args.command}: error: {exc.folder} exists and is not empty; choose another output folder "
+              "(-o DIR) or pass --overwrite to replace it", file=sys.stderr)
+        return EXIT_USER_ERROR
     except RvfemError as exc:
         print(f"rvfem {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_USER_ERROR

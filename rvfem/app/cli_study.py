@@ -31,6 +31,7 @@ from rvfem.app.result_compare import (
 from rvfem.app.study import MAX_ID_LENGTH, load_study, run_study, short_id
 from rvfem.case.definition import load_case
 from rvfem.errors import CaseError
+from rvfem.outputs.summary import check_output_folder, prepare_output_folder
 
 __all__ = ["COMPARE", "STUDY"]
 
@@ -51,7 +52,7 @@ def _add_compare_arguments(parser: argparse.ArgumentParser) -> None:
                         "temporary folder)")
     parser.add_argument("b", metavar="B", help="the other result folder or case file; ratios are B / A")
     parser.add_argument("-o", "--output", metavar="DIR", help="write the overlaid load curves (compare.png) and "
-                        "a self-contained page (compare.html) into DIR")
+                        "a self-contained page (compare.html) into DIR (new, empty, or a folder rvfem wrote)")
     parser.add_argument("--json", action="store_true", help="write the comparison as JSON to stdout")
     _add_set_argument(parser, "of A and B where they are case files")
     parser.add_argument("--cache-dir", default="meshes", help="directory of cached meshes (default: meshes)")
@@ -100,6 +101,8 @@ def _run_compare(args: argparse.Namespace) -> int:
     if args.overrides and not (_is_case_file(args.a) or _is_case_file(args.b)):
         raise CaseError("--set applies to case files; A and B are result folders")
 
+    if args.output:   # before running anything: rvfem writes only into a folder that is new, empty or its own
+        check_output_folder(args.output, overwrite=True)
     inputs = []  # validate both before running either
     for given in (args.a, args.b):
         if _is_case_file(given) and not Path(given).is_dir():
@@ -117,7 +120,7 @@ def _run_compare(args: argparse.Namespace) -> int:
         a, b = results
         comparison = compare_results(a, b)
         if args.output:
-            out = Path(args.output)
+            out = prepare_output_folder(args.output, "compare")
             plot = comparison_plot(a, b, out / "compare.png")
             page = comparison_html(comparison, plot, out / "compare.html")
             comparison["files"] = {"plot": str(plot), "html": str(page)}

@@ -7,6 +7,7 @@ The library part (:func:`accuracy_study`) computes and writes; the command line 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import math
@@ -16,19 +17,21 @@ from pathlib import Path
 
 import numpy as np
 
-from rvfem.app.analysis import default_cache_dir
+from rvfem.app.analysis import analyse_rigid, default_cache_dir
 from rvfem.case.definition import MAX_FRICTION, Case
 from rvfem.errors import CaseError
+from rvfem.evaluate.validity import ResultWarning
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures, mean_loop
 from rvfem.geometry import disc_geometry
 from rvfem.mesh import mesh_case
 from rvfem.outputs import accuracy as files
+from rvfem.outputs.summary import result_folder
 from rvfem.solve import accuracy
 from rvfem.solve.cycle import build_system, case_stage
 
 log = logging.getLogger(__name__)
 
-__all__ = ["LEFT_OUT", "accuracy_study", "mesh_period_angles"]
+__all__ = ["LEFT_OUT", "accuracy_study", "loop_option_problem", "loop_warnings", "mesh_period_angles"]
 
 LEFT_OUT = ("The stage model holds both discs, the pins (Hertz contact at the gaps of the modified profile), "
             "the crank-bearing rollers with their clearance, the crankshafts as beams and their support "
@@ -47,8 +50,54 @@ def mesh_period_angles(case: Case, count: int = 9) -> np.ndarray:
     """``count`` crank angles spread over one tooth-mesh period 2π/Zc (rad): the disc's contact
     pattern at θ + 2π/Zc is the one at θ turned by a tooth (docs/theory.md)."""
     if count < 1:
-        raise CaseError(f"--angles needs at least 1 crank angle, got {count}")
+        raise CaseError(f"angle_count needs at least 1 crank angle, got {count}")
     return np.arange(count) * 2.0 * math.pi / (count * case.cycloid.teeth)
+
+
+def loop_option_problem(*, torque_Nm: float | None = None, angles_deg: tuple[float, ...] | None = None,
+                        angle_count: int | None = None, steps: int = 40,
+                        friction: float | None = None) -> tuple[str, str] | None:
+    """The first option of :func:`accuracy_study` that cannot be used, as ``(parameter, why)``, or
+    None. ``why`` follows the parameter's name, so that the library says ``torque_Nm …`` and the
+    command line its own option (``--torque …``).
+
+    Refused: a torque that is not positive (the loop goes to +T and −T); ``steps`` that are not a
+    multiple of 4 of at least 8; a friction outside [0, :data:`~rvfem.case.definition.MAX_FRICTION`];
+    crank angles outside [0, 360)° (given as they are reported: a crank angle of 400° is not
+    silently taken as 40°); an ``angle_count`` below 1; and ``angles_deg`` together with
+    ``angle_count`` (the given crank angles, or that many spread over a mesh period: one or the
+    other).
+    """
+    if torque_Nm is not None and not float(torque_Nm) > 0:
+        return "torque_Nm", f"must be positive (the loop goes to +T and −T), got {torque_Nm:g}"
+    if steps < 8 or steps % 4:
+        return "steps", (f"must be a multiple of 4 and at least 8 (0 → +T → 0 → −T → 0 in equal steps), "
+                         f"got {steps}")
+    if friction is not None and not 0.0 <= friction <= MAX_FRICTION:
+        return "friction", f"must be in [0, {MAX_FRICTION:g}] (the range of analysis.friction), got {friction:g}"
+    if angles_deg:
+        if angle_count is not None:
+            return "angles_deg", ("and angle_count exclude each other: give the crank angles, or how many to "
+                                  "spread over one mesh period")
+        for a in angles_deg:
+            if not 0.0 <= a < 360.0:
+                return "angles_deg", f"must lie in [0, 360)° (one crank revolution), got {a:g}"
+    if angle_count is not None and angle_count < 1:
+        return "angle_count", f"needs at least 1 crank angle, got {angle_count}"
+    return None
+
+
+def loop_warnings(case: Case, torque_Nm: float) -> tuple[ResultWarning, ...]:
+    """The range warnings of the loop's torque: those ``rvfem rigid`` and ``rvfem run`` give for
+    the case at ``torque_Nm`` (:func:`rvfem.evaluate.validity.rigid_warnings` of the handbook at
+    that torque, without the duty cycle: P/C, L10h and the Stribeck Hertz pressures). Empty where
+    the handbook is not defined (a modified tooth count)."""
+    loads = dataclasses.replace(case.loads, torque_Nm=float(torque_Nm), duty_cycle=())
+    try:
+        rigid = analyse_rigid(case.replace(loads=loads))
+    except CaseError:   # the handbook is not defined for this case: nothing to check against
+        return ()
+    return tuple(rigid.warnings)
 
 
 def _loops(stage, thetas, torque, friction, steps):
@@ -61,64 +110,81 @@ def _loops(stage, thetas, torque, friction, steps):
 
 
 def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float | None = None,
-                   angles_deg: tuple[float, ...] | None = None, angle_count: int = 9, steps: int = 40,
+                   angles_deg: tuple[float, ...] | None = None, angle_count: int | None = None, steps: int = 40,
                    friction: float | None = None, te: bool = False, shares: bool = True,
-                   cache_dir: str | os.PathLike | None = None) -> dict:
+                   cache_dir: str | os.PathLike | None = None, overwrite: bool = False) -> dict:
     """Solve the hysteresis loop (and the shares and TE) of ``case`` and write the files to
     ``out_dir``: hysteresis.csv, plots/hysteresis.png, plots/compliance_shares.png, te.csv and
     plots/transmission_error.png (``te``), summary.json and accuracy.md. Returns the summary.
 
     ``torque_Nm`` defaults to ``loads.torque_Nm`` (the rated torque), ``friction`` to
-    ``analysis.friction``; the loop is averaged over ``angles_deg`` or ``angle_count`` crank angles
-    of one mesh period (:func:`mesh_period_angles`).
+    ``analysis.friction``; the loop is averaged over ``angles_deg`` (in [0, 360)°) or
+    ``angle_count`` crank angles of one mesh period (:func:`mesh_period_angles`; default 9), not
+    both (:func:`loop_option_problem`). The summary's ``warnings`` are those of the case at the
+    loop's torque (:func:`loop_warnings`). ``out_dir`` is an atomic result folder
+    (:func:`rvfem.outputs.summary.result_folder`): it appears only when complete, and an existing
+    non-empty one is replaced only with ``overwrite`` and only if rvfem wrote it.
+
+    Raises
+    ------
+    CaseError
+        An option cannot be used (:func:`loop_option_problem`).
+    OutputError
+        ``out_dir`` cannot take the results.
     """
     t_start = time.perf_counter()
+    problem = loop_option_problem(torque_Nm=torque_Nm, angles_deg=angles_deg, angle_count=angle_count, steps=steps,
+                                  friction=friction)
+    if problem is not None:
+        raise CaseError(" ".join(problem))
     T = float(case.loads.torque_Nm if torque_Nm is None else torque_Nm)
     if not T > 0:
-        raise CaseError(f"--torque must be positive (the loop goes to +T and −T), got {T:g}")
-    if steps < 8 or steps % 4:
-        raise CaseError(f"--steps must be a multiple of 4 and at least 8 (0 → +T → 0 → −T → 0 in equal "
-                        f"steps), got {steps}")
+        raise CaseError(f"the loop's torque must be positive (the loop goes to +T and −T): loads.torque_Nm = {T:g}; "
+                        "give a positive torque_Nm")
     mu = float(case.analysis.friction if friction is None else friction)
-    if not 0.0 <= mu <= MAX_FRICTION:
-        raise CaseError(f"--friction must be in [0, {MAX_FRICTION:g}] (the range of analysis.friction), got {mu:g}")
-    out = Path(out_dir)
-    (out / "plots").mkdir(parents=True, exist_ok=True)
-    thetas = (np.radians(angles_deg) if angles_deg else mesh_period_angles(case, angle_count))
-    timings = {}
-    t0 = time.perf_counter()
-    geometry = disc_geometry(case)
-    mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
-    stage = case_stage(build_system(case, mesh, geometry=geometry))
-    timings["model_s"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    loops, per_angle = _loops(stage, thetas, T, mu, steps)
-    timings["loops_s"] = time.perf_counter() - t0
-    torque, branch = loops[0].torque_Nm, loops[0].branch
-    rotations = np.array([lp.rotation_rad for lp in loops])
-    mean = mean_loop(rotations)
-    fig = accuracy_figures(torque, mean, branch, T)
-    summary = {"case": case.name, "torque_Nm": T, "friction": mu, "steps": steps,
-               "angles_deg": [math.degrees(t) for t in thetas], **fig.as_dict(),
-               "per_angle": per_angle, "stage": stage.describe(), "left_out": LEFT_OUT}
-    files.write_loop_csv(out / "hysteresis.csv", torque, branch, mean, np.degrees(thetas), rotations)
-    files.hysteresis_plot(out / "plots" / "hysteresis.png", torque, branch, mean, fig, T,
-                          title=f"{case.name}: hysteresis loop, input locked (mean of {len(thetas)} crank angles)")
-    if shares:
+    thetas = (np.radians(angles_deg) if angles_deg else mesh_period_angles(case, 9 if angle_count is None else angle_count))
+    warnings = loop_warnings(case, T)
+    for w in warnings:   # in the summary; the command line prints them as rvfem run does
+        log.debug("loop torque %g N·m: %s", T, w.message)
+    with result_folder(out_dir, overwrite=overwrite, what="hysteresis") as out:
+        (out / "plots").mkdir()
+        timings = {}
         t0 = time.perf_counter()
-        cs = accuracy.compliance_shares(stage, float(thetas[0]), T, mu)
-        timings["shares_s"] = time.perf_counter() - t0
-        summary["compliance_shares"] = {"crank_angle_deg": math.degrees(thetas[0]), "rotation_arcmin": cs.rotation_arcmin,
-                                        "shares": cs.shares, "total": cs.total}
-        files.shares_plot(out / "plots" / "compliance_shares.png", cs.shares, title=f"{case.name}: where the compliance sits")
-    if te:
+        geometry = disc_geometry(case)
+        mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
+        stage = case_stage(build_system(case, mesh, geometry=geometry))
+        timings["model_s"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        summary["transmission_error"] = _te(case, stage, T, mu, out)
-        timings["te_s"] = time.perf_counter() - t0
-    timings["total_s"] = time.perf_counter() - t_start
-    summary["timings"] = timings
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")
-    (out / "accuracy.md").write_text(files.accuracy_report(summary), encoding="utf-8")
+        loops, per_angle = _loops(stage, thetas, T, mu, steps)
+        timings["loops_s"] = time.perf_counter() - t0
+        torque, branch = loops[0].torque_Nm, loops[0].branch
+        rotations = np.array([lp.rotation_rad for lp in loops])
+        mean = mean_loop(rotations)
+        fig = accuracy_figures(torque, mean, branch, T)
+        summary = {"case": case.name, "torque_Nm": T, "friction": mu, "steps": steps,
+                   "angles_deg": [math.degrees(t) for t in thetas], **fig.as_dict(),
+                   "per_angle": per_angle, "stage": stage.describe(), "left_out": LEFT_OUT,
+                   "warnings": [w.as_dict() for w in warnings]}
+        files.write_loop_csv(out / "hysteresis.csv", torque, branch, mean, np.degrees(thetas), rotations)
+        files.hysteresis_plot(out / "plots" / "hysteresis.png", torque, branch, mean, fig, T,
+                              title=f"{case.name}: hysteresis loop, input locked (mean of {len(thetas)} crank angles)")
+        if shares:
+            t0 = time.perf_counter()
+            cs = accuracy.compliance_shares(stage, float(thetas[0]), T, mu)
+            timings["shares_s"] = time.perf_counter() - t0
+            summary["compliance_shares"] = {"crank_angle_deg": math.degrees(thetas[0]),
+                                            "rotation_arcmin": cs.rotation_arcmin, "shares": cs.shares,
+                                            "total": cs.total}
+            files.shares_plot(out / "plots" / "compliance_shares.png", cs.shares,
+                              title=f"{case.name}: where the compliance sits")
+        if te:
+            t0 = time.perf_counter()
+            summary["transmission_error"] = _te(case, stage, T, mu, out)
+            timings["te_s"] = time.perf_counter() - t0
+        timings["total_s"] = time.perf_counter() - t_start
+        summary["timings"] = timings
+        (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")
+        (out / "accuracy.md").write_text(files.accuracy_report(summary), encoding="utf-8")
     return summary
 
 

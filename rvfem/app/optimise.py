@@ -72,18 +72,21 @@ from typing import Any, Callable, Sequence
 
 from rvfem._files import write_text_atomic
 from rvfem.app.study import (
+    ClusterError,
     SingleThreadedBlas,
     VariantTask,
     _acquire_lock,
     _connect,
     _one_line,
     _remove_partials,
+    _removed_if_new_on,
     local_cluster,
     run_variant,
 )
 from rvfem.case.definition import case_to_dict, load_case, parse_override
 from rvfem.case.schema import toml_literal
-from rvfem.errors import CaseError, RvfemError
+from rvfem.errors import CaseError, OutputError, RvfemError
+from rvfem.outputs.summary import prepare_output_folder
 
 log = logging.getLogger(__name__)
 
@@ -620,22 +623,27 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
     _optuna()  # before any folder or cluster: a missing optional dependency is said first
     out_dir = Path(out_dir).resolve()
     cache = Path(cache_dir).resolve()
-    (out_dir / "trials").mkdir(parents=True, exist_ok=True)
-    lock = _acquire_lock(out_dir)
-    try:
-        _remove_partials(out_dir / "trials")
-        earlier_rows = read_trials(out_dir / "trials.csv")
-        with _dask_client(scheduler, workers, client) as c:
-            base = _base_row(problem, c, out_dir, cache, earlier_rows)
-            fallback = base["objective"] if base and base.get("objective") is not None else 0.0
-            rows = _loop(problem, c, out_dir, cache, _earlier(problem, earlier_rows), fallback, progress,
-                         head=[base] if base else [])
-        all_rows = ([base] if base else []) + rows
-        write_text_atomic(out_dir / "trials.csv", _csv_text(problem, all_rows))
-        best = min((r for r in rows if r["feasible"]), key=lambda r: r["objective"], default=None)
-        files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started)
-    finally:
-        lock.unlink(missing_ok=True)
+    with _removed_if_new_on(ClusterError, out_dir):   # no cluster: a new folder is not left behind
+        prepare_output_folder(out_dir, "optimise")      # a non-empty folder rvfem did not write is refused
+        try:
+            (out_dir / "trials").mkdir(exist_ok=True)
+        except OSError as exc:
+            raise OutputError(f"cannot create the folder {out_dir / 'trials'}: {exc.strerror or exc}") from None
+        lock = _acquire_lock(out_dir)
+        try:
+            _remove_partials(out_dir / "trials")
+            earlier_rows = read_trials(out_dir / "trials.csv")
+            with _dask_client(scheduler, workers, client) as c:
+                base = _base_row(problem, c, out_dir, cache, earlier_rows)
+                fallback = base["objective"] if base and base.get("objective") is not None else 0.0
+                rows = _loop(problem, c, out_dir, cache, _earlier(problem, earlier_rows), fallback, progress,
+                             head=[base] if base else [])
+            all_rows = ([base] if base else []) + rows
+            write_text_atomic(out_dir / "trials.csv", _csv_text(problem, all_rows))
+            best = min((r for r in rows if r["feasible"]), key=lambda r: r["objective"], default=None)
+            files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started)
+        finally:
+            lock.unlink(missing_ok=True)
     return OptimisationResult(out_dir=out_dir, problem=problem, rows=tuple(rows), best=best, files=files,
                               wall_time_s=time.perf_counter() - started,
                               computed=sum(1 for r in rows if r["computed"]), base=base)

@@ -84,7 +84,7 @@ from rvfem.app.run import run_case
 from rvfem.case.definition import case_to_dict, load_case, parse_override
 from rvfem.case.schema import param, read_table, toml_literal
 from rvfem.errors import CaseError, OutputError, RvfemError
-from rvfem.outputs.summary import result_folder
+from rvfem.outputs.summary import check_output_folder, prepare_output_folder, result_folder
 
 log = logging.getLogger(__name__)
 
@@ -899,16 +899,57 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, s
         study = load_study(study)
     out_dir = Path(out_dir).resolve()
     cache = Path(cache_dir).resolve()
+    check_output_folder(out_dir, overwrite=True)   # a non-empty folder rvfem did not write is refused
+    own_client = None
+    if client is None and scheduler and _work_left(study, out_dir / "variants"):
+        # reach the scheduler before anything is created: an unreachable one leaves no folder behind
+        client = own_client = _connect(scheduler, connect_timeout_s)
     try:
-        (out_dir / "variants").mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"cannot create the study folder {out_dir}: {exc.strerror or exc}") from None
-    lock = _acquire_lock(out_dir)
-    try:
-        return _run_locked(study, out_dir, cache, scheduler=scheduler, workers=workers, client=client,
-                           progress=progress, plots=plots, connect_timeout_s=connect_timeout_s, started=started)
+        with _removed_if_new_on(ClusterError, out_dir):
+            prepare_output_folder(out_dir, "study")
+            try:
+                (out_dir / "variants").mkdir(exist_ok=True)
+            except OSError as exc:
+                raise OutputError(f"cannot create the study folder {out_dir}: {exc.strerror or exc}") from None
+            lock = _acquire_lock(out_dir)
+            try:
+                return _run_locked(study, out_dir, cache, scheduler=scheduler, workers=workers, client=client,
+                                   progress=progress, plots=plots, connect_timeout_s=connect_timeout_s,
+                                   started=started)
+            finally:
+                lock.unlink(missing_ok=True)
     finally:
-        lock.unlink(missing_ok=True)
+        if own_client is not None:
+            with _dask_logging_silenced():
+                own_client.close()
+
+
+def _work_left(study: Study, variants_dir: Path) -> bool:
+    """True if a case of ``study`` has no complete earlier result in ``variants_dir`` (a variant
+    of the same case as an earlier one is computed once, in the earlier one's folder)."""
+    first = {}
+    for v in study.variants:
+        first.setdefault(v.digest, v)
+    return any(_existing_record(v, variants_dir / v.id) is None for v in first.values())
+
+
+@contextlib.contextmanager
+def _removed_if_new_on(error: type[BaseException], folder: Path):
+    """Remove ``folder`` and the parents created with it if the block raises ``error`` and the
+    folder did not exist before: a study or optimisation that cannot start (no cluster) leaves
+    nothing behind. An existing folder (a run taken up again) is left as it is."""
+    new = [p for p in (folder, *folder.parents) if not p.exists()]
+    try:
+        yield
+    except error:
+        for p in new[:1]:
+            shutil.rmtree(p, ignore_errors=True)
+        for p in new[1:]:
+            try:
+                p.rmdir()
+            except OSError:
+                break
+        raise
 
 
 def _run_locked(study: Study, out_dir: Path, cache: Path, *, scheduler, workers, client, progress, plots,
@@ -1360,7 +1401,7 @@ def _plots(study: Study, rows: list[dict], folder: Path) -> dict:
     plots of one run, and an interrupted run leaves the earlier plots as they were.
     """
     files: dict[str, Path] = {}
-    with result_folder(folder, overwrite=True) as tmp:
+    with result_folder(folder, overwrite=True, what="study plots") as tmp:
         for name, fig in study_figures(study, rows).items():
             fig.savefig(tmp / _plot_file_name(name), dpi=110)
             files[name] = folder / _plot_file_name(name)

@@ -161,5 +161,7 @@ def accuracy_report(summary: dict) -> str:
                   "Largest orders (per crank revolution) of the loaded TE: "
                   + ", ".join(f"{o['order']} ({o['amplitude_arcsec']:.4f} arcsec)" for o in te["loaded_orders"]),
                   "", "![TE](plots/transmission_error.png)"]
+    if s.get("warnings"):   # the range warnings of rvfem run at the loop's torque
+        lines += ["", "## Warnings at the loop's torque", ""] + [f"- {w['message']}" for w in s["warnings"]]
     lines += ["", "![loop](plots/hysteresis.png)", "", "## What the model leaves out", "", s["left_out"], ""]
     return "\n".join(lines)

@@ -47,7 +47,7 @@ import numpy as np
 
 from rvfem import __version__
 from rvfem.case.definition import case_to_dict, file_sha256
-from rvfem.errors import OutputError
+from rvfem.errors import FolderNotEmptyError, OutputError
 from rvfem.evaluate.bearing_checks import MINIMUM_LOAD_FRACTION, STATIC_SAFETY_NORMAL, STATIC_SAFETY_SHOCK
 from rvfem.evaluate.hertz import RIGID_ROLLER_MODEL
 from rvfem.evaluate.postprocess import user_feature_name
@@ -76,6 +76,10 @@ __all__ = [
     "SummaryContext",
     "SUMMARY_PIECES",
     "json_ready",
+    "RESULT_MARKER",
+    "is_rvfem_folder",
+    "mark_folder",
+    "prepare_output_folder",
     "check_output_folder",
     "result_folder",
     "image_count",
@@ -156,20 +160,73 @@ def _dump(obj: Any) -> str:
 # --------------------------------------------------------------------------------------------
 
 
+RESULT_MARKER = ".rvfem-results"
+"""The marker file in every folder rvfem writes (result folders of ``run`` and ``hysteresis``,
+study and optimisation folders, the folder of ``compare -o``). It holds one line naming what wrote
+the folder and the rvfem version. rvfem replaces or writes into an existing non-empty folder only
+if this file is in it: a folder rvfem did not write is never changed."""
+
+
 def _is_nonempty_dir(path: Path) -> bool:
     return path.is_dir() and any(path.iterdir())
 
 
+def is_rvfem_folder(path: str | os.PathLike) -> bool:
+    """True if ``path`` is a folder rvfem wrote (it holds :data:`RESULT_MARKER`)."""
+    return (Path(path) / RESULT_MARKER).is_file()
+
+
+def mark_folder(folder: str | os.PathLike, what: str) -> Path:
+    """Write :data:`RESULT_MARKER` into ``folder``: one line, ``rvfem <version> <what> <time>``
+    (``what`` names the command, e.g. ``"run"``); returns its path."""
+    path = Path(folder) / RESULT_MARKER
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    path.write_text(f"rvfem {__version__} {what} {stamp}: a folder rvfem wrote; rvfem replaces or writes into "
+                    "a non-empty folder only if this file is in it\n", encoding="utf-8")
+    return path
+
+
+def _foreign_folder_error(out_dir: Path) -> OutputError:
+    return OutputError(f"{out_dir} is not empty and rvfem did not write it (no {RESULT_MARKER} file in it); rvfem "
+                       "replaces or writes into only folders it wrote: choose another output folder, or move or "
+                       "delete this one yourself")
+
+
 def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
     """Raise :class:`~rvfem.errors.OutputError` if ``out_dir`` cannot take the results: it is a file,
-    or a non-empty folder and ``overwrite`` is false."""
+    a non-empty folder that rvfem did not write (no :data:`RESULT_MARKER` in it; refused whatever
+    ``overwrite`` says), or a non-empty folder rvfem wrote and ``overwrite`` is false
+    (:class:`~rvfem.errors.FolderNotEmptyError`)."""
     out_dir = Path(out_dir)
     if out_dir.exists() or out_dir.is_symlink():
         if not out_dir.is_dir():
             raise OutputError(f"{out_dir} exists and is not a folder; choose another output folder")
-        if _is_nonempty_dir(out_dir) and not overwrite:
-            raise OutputError(f"{out_dir} exists and is not empty; choose another output folder or pass "
-                              "overwrite=True to replace it")
+        if _is_nonempty_dir(out_dir):
+            if not is_rvfem_folder(out_dir):
+                raise _foreign_folder_error(out_dir)
+            if not overwrite:
+                raise FolderNotEmptyError(out_dir)
+
+
+def prepare_output_folder(out_dir: str | os.PathLike, what: str) -> Path:
+    """Create ``out_dir`` (and its parents) as a folder rvfem writes into in place, with
+    :data:`RESULT_MARKER`; an existing folder is taken if it is empty or rvfem wrote it (a study or
+    optimisation folder taken up again). Returns ``out_dir``.
+
+    Raises
+    ------
+    OutputError
+        ``out_dir`` is a file, a non-empty folder rvfem did not write, or cannot be created.
+    """
+    out_dir = Path(out_dir)
+    check_output_folder(out_dir, overwrite=True)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        if not is_rvfem_folder(out_dir):
+            mark_folder(out_dir, what)
+    except OSError as exc:
+        raise OutputError(f"cannot create the folder {out_dir}: {exc.strerror or exc}") from None
+    return out_dir
 
 
 def _make_parents(out_dir: Path) -> list[Path]:
@@ -212,19 +269,21 @@ def _commit(tmp: Path, out_dir: Path, overwrite: bool) -> None:
 
 
 @contextlib.contextmanager
-def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False) -> Iterator[Path]:
+def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False, what: str = "run") -> Iterator[Path]:
     """The atomic result folder: yields a temporary folder to write into, next to ``out_dir``.
 
     On entry ``out_dir`` is checked (:func:`check_output_folder`) and its missing parents are
-    created. When the block ends normally the temporary folder is renamed to ``out_dir`` (an
-    existing non-empty ``out_dir`` is replaced only then, and only with ``overwrite``). When the
-    block raises (an error, Ctrl-C) the temporary folder and the parents created are removed and
-    an existing ``out_dir`` stays as it was.
+    created. The temporary folder starts with the marker :data:`RESULT_MARKER` (naming ``what``
+    wrote it). When the block ends normally the temporary folder is renamed to ``out_dir`` (an
+    existing non-empty ``out_dir`` is replaced only then, only with ``overwrite``, and only if
+    rvfem wrote it: it holds the marker). When the block raises (an error, Ctrl-C) the temporary
+    folder and the parents created are removed and an existing ``out_dir`` stays as it was.
 
     Raises
     ------
     OutputError
-        ``out_dir`` is a file, is not empty (without ``overwrite``), or cannot be written.
+        ``out_dir`` is a file, a non-empty folder rvfem did not write, is not empty (without
+        ``overwrite``: :class:`~rvfem.errors.FolderNotEmptyError`), or cannot be written.
 
     Examples
     --------
@@ -245,6 +304,7 @@ def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False) -> Ite
         os.umask(umask)
         os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; the results are an ordinary folder
         try:
+            mark_folder(tmp, what)
             yield tmp
         except OSError as exc:
             raise OutputError(f"cannot write the results: {exc.strerror or exc}") from None
@@ -766,7 +826,7 @@ def write_summary(analysis, folder: str | os.PathLike, *, summary: dict | None =
 
 
 def _files_in(folder: Path, extra: Iterable[str] = ()) -> tuple[str, ...]:
-    found = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
+    found = {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file() and p.name != RESULT_MARKER}
     return tuple(sorted(found | set(extra)))
 
 
