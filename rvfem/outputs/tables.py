@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rvfem.evaluate import strength
+
 __all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
            "write_stress_history"]
 
@@ -156,18 +158,33 @@ def write_cycle_table(path: str | os.PathLike, theta: np.ndarray, pins_in_contac
 
 
 def write_stress_history(path: str | os.PathLike, history) -> Path:
-    """Write ``stress_history.csv``: per crank angle, the von Mises and principal stresses at each
-    hot spot of a :class:`rvfem.evaluate.postprocess.HotSpotHistory` (columns ``<name>_von_mises_MPa``,
-    ``<name>_s1_MPa``, ``<name>_s2_MPa``, ``<name>_dominant_MPa``: the principal stress of larger
-    magnitude, signed), MPa."""
+    """Write ``stress_history.csv``: per crank angle, the stresses at each hot spot of a
+    :class:`rvfem.evaluate.postprocess.HotSpotHistory`, MPa, first as the load cycle's model gives
+    them, then scaled by the hot spot's P2/P1 factor: the values the fatigue check of
+    ``summary.json`` uses (:func:`rvfem.evaluate.strength.hot_spot_fatigue`).
+
+    Columns per hot spot ``<name>``: ``<name>_cycle_von_mises_MPa``, ``<name>_cycle_s1_MPa``,
+    ``<name>_cycle_s2_MPa``, ``<name>_cycle_dominant_MPa`` (the cycle's element order, usually P1;
+    dominant: the in-plane principal stress of larger magnitude, signed), ``<name>_p2_factor`` (the
+    same number on every row; 1 where not re-solved on P2), then ``<name>_von_mises_MPa``,
+    ``<name>_s1_MPa``, ``<name>_s2_MPa``, ``<name>_dominant_MPa`` and ``<name>_signed_von_mises_MPa``
+    (FKM's signed von Mises stress, :func:`rvfem.evaluate.strength.signed_von_mises`): the cycle's
+    values times the factor, P2-consistent at the hot spot.
+    """
     header = ["theta_deg"]
     for name in history.names:
-        header += [f"{name}_von_mises_MPa", f"{name}_s1_MPa", f"{name}_s2_MPa", f"{name}_dominant_MPa"]
-    rows = []
+        header += [f"{name}_cycle_von_mises_MPa", f"{name}_cycle_s1_MPa", f"{name}_cycle_s2_MPa",
+                   f"{name}_cycle_dominant_MPa", f"{name}_p2_factor", f"{name}_von_mises_MPa", f"{name}_s1_MPa",
+                   f"{name}_s2_MPa", f"{name}_dominant_MPa", f"{name}_signed_von_mises_MPa"]
     dominant = history.dominant
+    factors = np.asarray(history.p2_factor, dtype=float)
+    signed = strength.signed_von_mises(factors * history.s1, factors * history.s2)
+    rows = []
     for k, theta in enumerate(history.theta):
         row = [math.degrees(float(theta))]
-        for j in range(len(history.names)):
-            row += [history.von_mises[k, j], history.s1[k, j], history.s2[k, j], dominant[k, j]]
+        for j, f in enumerate(factors):
+            row += [history.von_mises[k, j], history.s1[k, j], history.s2[k, j], dominant[k, j], f,
+                    f * history.von_mises[k, j], f * history.s1[k, j], f * history.s2[k, j], f * dominant[k, j],
+                    signed[k, j]]
         rows.append(row)
     return _write(path, header, rows)
