@@ -149,3 +149,21 @@ def test_the_wall_time_line_says_the_drawing_ran_beside_the_writing():
     text = _drawing_text({"plots": 0.2, "images": 0.1, "drawing_background": 11.4}, files)
     assert text == "10 images and the plots drawn in a background process within 11.4 s, 0.3 s of it waited for"
     assert _drawing_text({"images": 0.0}, ["summary.json"]) == "no images"
+
+
+@pytest.mark.parametrize("pitch_radius", [64.0, 80.0])
+def test_the_mesh_close_up_holds_the_bore_and_the_teeth_however_thick_the_rim(pitch_radius):
+    from rvfem.outputs.plots import rim_closeup
+
+    def circle(centre, radius, start, n=720):
+        a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+        pts = np.column_stack([centre[0] + radius * np.cos(a), centre[1] + radius * np.sin(a)])
+        edges = np.column_stack([np.arange(n), np.roll(np.arange(n), -1)]) + start
+        return pts, edges
+
+    bore, bore_edges = circle((0.0, 36.0), 18.0, 0)
+    profile, profile_edges = circle((0.0, 0.0), pitch_radius, len(bore))
+    (cx, cy), half = rim_closeup(np.vstack([bore, profile]), {"bore_0": bore_edges, "profile": profile_edges})
+    # the rim runs from the bore's top (0, 54) to the profile above it (0, R): both in the window
+    assert abs(cx) < 1e-9 and cy - half < 54.0 - 1.0 and cy + half > pitch_radius + 1.0
+    assert half >= 8.0
