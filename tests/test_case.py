@@ -767,3 +767,57 @@ def test_largest_allowed_boundary_sizes_follow_the_geometry(tmp_path):
     # the limits themselves are accepted
     case_text.set("mesh", "size_bore", "9.42").set("mesh", "size_flank", "1.6")
     assert load_case(case_text.write(tmp_path)).mesh.size_bore == 9.42
+
+
+# --------------------------------------------------------------------------------------------
+# Said, or refused: a key the case gives but does not use, values that contradict each other
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind, key, value, uses", [
+    ("straight", "crown_radius", "300.0", "arc"),          # a forgotten kind = "arc"
+    ("logarithmic", "crown_radius", "300.0", "arc"),
+    ("arc", "design_load_N", "5000.0", "logarithmic"),
+    ("straight", "modification_length", "2.0", "combined"),
+    ("arc", "modification_drop", "0.01", "combined"),
+])
+def test_a_profile_key_of_another_kind_is_refused(case_text, tmp_path, kind, key, value, uses):
+    case_text.set("crank_bearing", "profile.kind", f'"{kind}"').set("crank_bearing", f"profile.{key}", value)
+    expect_error(tmp_path, case_text, f"crank_bearing.profile.{key}",
+                 f"kind = '{kind}' does not use it", f"set crank_bearing.profile.kind = '{uses}'")
+
+
+def test_profile_keys_at_their_defaults_are_what_a_whole_case_holds(case_text, tmp_path):
+    """case.json and best.toml hold every key: the shape keys of the other kinds at their defaults
+    are taken, and the case round-trips."""
+    for key, value in (("kind", '"combined"'), ("crown_radius", "500.0"), ("design_load_N", "2000.0"),
+                       ("modification_length", "1.0"), ("modification_drop", "0.004")):
+        case_text.set("crank_bearing", f"profile.{key}", value)
+    case = load_case(case_text.write(tmp_path))
+    assert case.crank_bearing.profile.kind == "combined" and case.crank_bearing.profile.modification_length == 1.0
+    assert case_from_dict(case_to_dict(case), source="x.toml") == case
+
+
+def test_a_fatigue_limit_above_the_yield_strength_is_refused(case_text, tmp_path):
+    """yield_strength = 500 MPa against the default fatigue limit 960 MPa (the issue's case)."""
+    case_text.set("material", "yield_strength", "500.0")
+    expect_error(tmp_path, case_text, "material.yield_strength", "500 MPa is below the fatigue limit",
+                 "'material.fatigue_limit' = 960 MPa", "not physical")
+    case_text.set("material", "fatigue_limit", "400.0")          # both given, consistent: taken
+    assert load_case(case_text.write(tmp_path)).material.fatigue_limit == 400.0
+
+
+def test_iso_vg_with_nu40_and_nu100_is_refused(case_text, tmp_path):
+    case_text.lines += ["", "[lubricant]", "iso_vg = 68", "nu40 = 100.0", "nu100 = 11.0"]
+    expect_error(tmp_path, case_text, "lubricant.iso_vg", "are both given", "not both")
+
+
+def test_the_viscosity_is_the_grade_or_the_two_points(case_text, tmp_path):
+    """Without a viscosity the grade is ISO VG 68; with nu40/nu100 the case has no grade, and
+    writes none (case.json reads back)."""
+    assert load_case(case_text.write(tmp_path)).lubricant.iso_vg == 68
+    case_text.lines += ["", "[lubricant]", "nu40 = 100.0", "nu100 = 11.0"]
+    case = load_case(case_text.write(tmp_path))
+    assert (case.lubricant.iso_vg, case.lubricant.nu40, case.lubricant.nu100) == (None, 100.0, 11.0)
+    assert "iso_vg" not in case_to_dict(case)["lubricant"]
+    assert case_from_dict(case_to_dict(case), source="x.toml") == case

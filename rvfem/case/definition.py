@@ -291,6 +291,11 @@ class RollerProfile:
     slices: int = param(30, low=8, high=400, doc="slices along the roller of the slice model")
 
 
+DEFAULT_ISO_VG = 68
+"""ISO viscosity grade of a ``[lubricant]`` that gives no viscosity (neither ``iso_vg`` nor
+``nu40``/``nu100``)."""
+
+
 @dataclass(frozen=True)
 class Lubricant:
     """The lubricant of the crank bearings (table ``[lubricant]``, all keys optional).
@@ -301,9 +306,10 @@ class Lubricant:
     (given, or from a cleanliness level, ISO 281 Table 14 for D_pw < 100 mm) and the roughness.
     """
 
-    iso_vg: int | None = param(68, choices=(22, 32, 46, 68, 100, 150, 220, 320, 460),
-                               doc="ISO viscosity grade (ν40 = the grade; ν100 at viscosity index ≈ 100) unless "
-                                   "`nu40` and `nu100` are given")
+    iso_vg: int | None = param(None, choices=(22, 32, 46, 68, 100, 150, 220, 320, 460),
+                               default_doc="68 unless `nu40` and `nu100` are given",
+                               doc="ISO viscosity grade (ν40 = the grade; ν100 at viscosity index ≈ 100); not "
+                                   "together with `nu40` and `nu100` (one or the other)")
     nu40: float | None = param(None, unit="mm²/s", low=2.0, high=5000.0, doc="kinematic viscosity at 40 °C")
     nu100: float | None = param(None, unit="mm²/s", low=1.0, high=500.0, doc="kinematic viscosity at 100 °C")
     temperature_C: float = param(60.0, unit="°C", low=-30.0, high=150.0, doc="operating temperature of the bearing")
@@ -317,6 +323,12 @@ class Lubricant:
                              doc="ISO 281 cleanliness level giving e_C (Table 14, D_pw < 100 mm, mid-range)")
     roughness_Ra_um: float = param(0.1, unit="µm", low=0.005, high=5.0,
                                    doc="Ra of roller and raceways (composite σ = 1.25·√2·Ra for Λ)")
+
+    def __post_init__(self) -> None:
+        # the grade is the default only where no viscosity is given: a case with nu40 and nu100
+        # has no iso_vg, so the two never stand side by side (Case refuses them together)
+        if self.iso_vg is None and self.nu40 is None and self.nu100 is None:
+            object.__setattr__(self, "iso_vg", DEFAULT_ISO_VG)
 
 
 @dataclass(frozen=True)
@@ -1244,6 +1256,18 @@ def _check_roller_profile(case: Case) -> None:
     if b.profile.kind == "arc" and b.profile.crown_radius <= half:
         raise _error(case, key + "crown_radius", f"({b.profile.crown_radius:g} mm) must exceed half the roller "
                      f"length ({half:g} mm)")
+    defaults = {f.name: f.default for f in dataclasses.fields(RollerProfile)}
+    for name, kind in _PROFILE_KEY_KIND.items():
+        value = getattr(b.profile, name)
+        if b.profile.kind != kind and value != defaults[name]:
+            raise _error(case, key + name, f"= {value:g} is given, but kind = {b.profile.kind!r} does not use it "
+                         f"(it shapes the {kind!r} profile): set {key}kind = {kind!r}, or leave {name} out")
+
+
+_PROFILE_KEY_KIND = {"crown_radius": "arc", "design_load_N": "logarithmic", "modification_length": "combined",
+                     "modification_drop": "combined"}
+"""The profile keys that only one ``kind`` uses. Given with another kind they are refused, unless
+they hold their default (a case written out whole, as ``case.json``, holds every key)."""
 
 
 def _check_lubricant(case: Case) -> None:
@@ -1254,14 +1278,28 @@ def _check_lubricant(case: Case) -> None:
                                                                                         "lubricant.nu40")
         raise _error(case, missing, f"is missing: '{given}' alone does not fix the viscosity–temperature line; "
                      "give both, or neither and 'lubricant.iso_vg'")
+    if oil.nu40 is not None and oil.iso_vg is not None:
+        raise _error(case, "lubricant.iso_vg", f"= {oil.iso_vg} and 'lubricant.nu40'/'lubricant.nu100' "
+                     f"({oil.nu40:g}/{oil.nu100:g} mm²/s) are both given: give the grade or the two viscosities, "
+                     "not both")
     if oil.nu40 is not None and oil.nu100 >= oil.nu40:
         raise _error(case, "lubricant.nu100", f"({oil.nu100:g} mm²/s) must be below 'lubricant.nu40' "
                      f"({oil.nu40:g} mm²/s): an oil thins as it warms")
 
 
+_MATERIAL_DEFAULT_FATIGUE_LIMIT = next(f.default for f in dataclasses.fields(Material) if f.name == "fatigue_limit")
+
+
 def _check_material(case: Case) -> None:
-    """σ_W < R_m and R_p0.2 ≤ R_m (the fatigue check's Goodman line, docs/theory.md "Mass and strength")."""
+    """σ_W < R_m, R_p0.2 ≤ R_m (the fatigue check's Goodman line, docs/theory.md "Mass and strength") and
+    σ_W ≤ R_p0.2: a fully reversed stress amplitude above the yield strength yields the material in
+    every cycle, so it cannot be an endurance limit (for steels σ_W ≈ 0.4–0.5·R_m, below R_p0.2)."""
     m = case.material
+    if m.yield_strength < m.fatigue_limit:
+        raise _error(case, "material.yield_strength", f"{m.yield_strength:g} MPa is below the fatigue limit "
+                     f"'material.fatigue_limit' = {m.fatigue_limit:g} MPa ({_MATERIAL_DEFAULT_FATIGUE_LIMIT:g} MPa, that of 100Cr6, when not given): a "
+                     "fatigue limit above the yield strength is not physical (the material would yield in every "
+                     "cycle); give the strengths of the disc's material together")
     if m.yield_strength > m.ultimate_strength:
         raise _error(case, "material.yield_strength", f"{m.yield_strength:g} MPa is above the ultimate strength "
                      f"{m.ultimate_strength:g} MPa; give a yield strength ≤ 'material.ultimate_strength'")
