@@ -150,14 +150,17 @@ def test_rigid_overload_warns_on_screen_and_in_json(torque, capsys):
     assert cli.main(["rigid", CRV80E, "--set", f"loads.torque_Nm={torque}"]) == 0
     out = capsys.readouterr().out
     lines = [line for line in out.splitlines() if line.startswith("  warning: ")]
-    assert [line.split(":")[1].split()[0] for line in lines] == ["P/C", "life", "Hertz"]
+    # 48× the rated torque also crushes the raceways statically: S0 = C0/P0 < 1 (ISO 76)
+    assert [line.split(":")[1].split()[0] for line in lines] == ["P/C", "life", "Hertz", "static"]
     assert cli.main(["rigid", CRV80E, "--json", "--set", f"loads.torque_Nm={torque}"]) == 0
     out, err = capsys.readouterr()
     report = json.loads(out)
-    assert [w["code"] for w in report["warnings"]] == ["load_ratio", "life_under_1h", "hertz_pressure"]
+    assert [w["code"] for w in report["warnings"]] == ["load_ratio", "life_under_1h", "hertz_pressure", "static_safety"]
+    s0 = report["bearing_checks"]["static_safety"]["rigid"]
+    assert report["warnings"][3]["value"] == pytest.approx(s0["C0_N"] / max(b["max_load_N"] for b in report["bearings"]))
     assert report["warnings"][0]["value"] == pytest.approx(
         report["bearings"][0]["equivalent_load_N"] / report["dynamic_load_rating_N"])
-    assert err.count("rvfem rigid: warning: ") == 3
+    assert err.count("rvfem rigid: warning: ") == 4
 
 
 def test_rigid_duty_cycle_life_under_an_hour_warns(tmp_path):
@@ -194,7 +197,7 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     codes = [w["code"] for w in summary["warnings"]]
     assert codes == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield", "large_displacement",
-                     "fatigue_safety", "roller_pressure"]
+                     "fatigue_safety", "roller_pressure", "static_safety"]
     for w in summary["warnings"]:
         assert set(w) == {"code", "message", "value", "limit", "unit"}
         assert f"  warning: {w['message']}" in screen.splitlines()
@@ -209,11 +212,14 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_shipped_cases_do_not_warn(name, tmp_path):
-    """Every shipped case, coarse and at 30° steps, is inside every model's range."""
+    """Every shipped case, coarse and at 30° steps, is inside every model's range — but for the
+    minimum-load rule (0.02·C, a maker's rule), which warns exactly when the smallest bearing load
+    of the cycle is under it (the FE lowers it below the rule on most shipped cases)."""
     from rvfem.app.analysis import analyse
 
     a = analyse(coarse_case(name), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
-    assert a.warnings == (), [w.message for w in a.warnings]
+    below = any(m.fraction_of_C < 0.02 for m in a.bearing_checks.minimum.values())
+    assert _codes(a.warnings) == (["minimum_load"] if below else []), [w.message for w in a.warnings]
 
 
 @pytest.mark.slow
@@ -225,7 +231,7 @@ def test_overload_cases_warn(changes, tmp_path):
 
     a = analyse(coarse_case("rv40e_fanholes", **changes), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
     assert _codes(a.warnings) == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield",
-                                  "large_displacement", "fatigue_safety", "roller_pressure"]
+                                  "large_displacement", "fatigue_safety", "roller_pressure", "static_safety"]
 
 
 def test_hertz_limit_scales_with_a_material_that_is_not_steel():
