@@ -197,7 +197,10 @@ def test_run_at_48_times_the_rated_torque_warns_everywhere(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
     codes = [w["code"] for w in summary["warnings"]]
     assert codes == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield", "large_displacement",
-                     "fatigue_safety", "roller_pressure", "static_safety"]
+                     "fatigue_safety", "roller_pressure", "roller_pressure",     # rigid and flexible slices
+                     "static_safety"]
+    slices = [w["message"] for w in summary["warnings"] if w["code"] == "roller_pressure"]
+    assert ["rigid" in m for m in slices] == [True, False] and all("> 4000 MPa" in m for m in slices)
     for w in summary["warnings"]:
         assert set(w) == {"code", "message", "value", "limit", "unit"}
         assert f"  warning: {w['message']}" in screen.splitlines()
@@ -223,15 +226,18 @@ def test_shipped_cases_do_not_warn(name, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("changes", [{"loads": {"torque_Nm": 1e6}},
-                                     {"cycloid": {"pitch_error": {"amplitude": 1.0, "values": []}}}])
-def test_overload_cases_warn(changes, tmp_path):
-    """1e6 N·m and a 1 mm pitch error (the issue's examples): every limit is crossed."""
+@pytest.mark.parametrize("changes, slices", [({"loads": {"torque_Nm": 1e6}}, ["roller_pressure"] * 2),
+                                             ({"cycloid": {"pitch_error": {"amplitude": 1.0, "values": []}}},
+                                              ["roller_pressure"])])
+def test_overload_cases_warn(changes, slices, tmp_path):
+    """1e6 N·m and a 1 mm pitch error (the issue's examples): every limit is crossed. The slice
+    pressure warns for the rigid and the flexible loads at 1e6 N·m, for the flexible ones alone
+    with the pitch error (the rigid handbook has none)."""
     from rvfem.app.analysis import analyse
 
     a = analyse(coarse_case("rv40e_fanholes", **changes), angle_step_deg=30.0, cache_dir=tmp_path / "meshes")
     assert _codes(a.warnings) == ["load_ratio", "life_under_1h", "hertz_pressure", "disc_stress_yield",
-                                  "large_displacement", "fatigue_safety", "roller_pressure", "static_safety"]
+                                  "large_displacement", "fatigue_safety", *slices, "static_safety"]
 
 
 def test_hertz_limit_scales_with_a_material_that_is_not_steel():

@@ -44,6 +44,7 @@ __all__ = [
     "BEARING_STEEL_MODULUS_MPA",
     "BEARING_STEEL_POISSONS_RATIO",
     "hertz_pressure_limit_MPa",
+    "bearing_depth_warnings",
     "PLACEHOLDER_YIELD_STRENGTH_MPA",
     "DISPLACEMENT_FRACTION_LIMIT",
     "ResultWarning",
@@ -379,16 +380,28 @@ defined (the standard leaves such lubrication outside its scope); above 4 a_ISO 
 
 def roller_depth_warnings(depth) -> tuple[ResultWarning, ...]:
     """The warnings of the crank bearing in depth (:class:`rvfem.evaluate.roller_life.CrankBearingDepth`,
-    None: none): the largest slice pressure along a roller above :data:`HERTZ_PRESSURE_LIMIT_MPA`
-    (code ``roller_pressure``), κ outside :data:`KAPPA_RANGE` (code ``kappa_range``) and P/C of the
-    modified lives above :data:`LOAD_RATIO_LIMIT` (already the ``load_ratio`` warning of the basic
-    lives; not repeated)."""
+    None: none): :func:`bearing_depth_warnings` of its rigid and flexible bearings. (P/C of the
+    modified lives above :data:`LOAD_RATIO_LIMIT` is already the ``load_ratio`` warning of the
+    basic lives; not repeated.)"""
     if depth is None:
         return ()
+    return bearing_depth_warnings(list(depth.rigid) + list(depth.flexible))
+
+
+def bearing_depth_warnings(items) -> tuple[ResultWarning, ...]:
+    """The warnings of slice-model results (:class:`rvfem.evaluate.roller_life.BearingDepth` of any
+    bearings and load models; one code path for the rigid and the flexible slice results): for each
+    load model (rigid, flexible) whose largest slice pressure along a roller is above
+    :data:`HERTZ_PRESSURE_LIMIT_MPA`, one ``roller_pressure`` warning naming the worst bearing of
+    that model (the rigid model's is not hidden behind a larger flexible one); κ outside
+    :data:`KAPPA_RANGE` (code ``kappa_range``, once: κ is a property of the lubricant and the
+    speed, the same for every bearing and model)."""
+    items = list(items)
+    if not items:
+        return ()
     out = []
-    items = list(depth.rigid) + list(depth.flexible)
-    if items:
-        worst = max(items, key=lambda d: d.roller_peak_pressure_MPa)
+    for model in dict.fromkeys(d.model for d in items):   # in the order given: rigid, then flexible
+        worst = max((d for d in items if d.model == model), key=lambda d: d.roller_peak_pressure_MPa)
         if worst.roller_peak_pressure_MPa > HERTZ_PRESSURE_LIMIT_MPA:
             out.append(ResultWarning(
                 "roller_pressure",
@@ -396,16 +409,16 @@ def roller_depth_warnings(depth) -> tuple[ResultWarning, ...]:
                 f"{worst.model}, {worst.raceway}) > {HERTZ_PRESSURE_LIMIT_MPA:.0f} MPa, the static limit of roller "
                 "bearings (ISO 76): the raceway deforms plastically, the slice model and L10r do not hold",
                 worst.roller_peak_pressure_MPa, HERTZ_PRESSURE_LIMIT_MPA, "MPa"))
-        kappa = items[0].kappa
-        low, high = KAPPA_RANGE
-        if kappa < low:
-            out.append(ResultWarning(
-                "kappa_range", f"viscosity ratio κ = {_sig(kappa)} < {low:g}: outside ISO 281's a_ISO; L_nm is "
-                f"evaluated at κ = {low:g} and is not meaningful", kappa, low, ""))
-        elif kappa > high:
-            out.append(ResultWarning(
-                "kappa_range", f"viscosity ratio κ = {_sig(kappa)} > {high:g}: ISO 281 evaluates a_ISO at κ = {high:g} "
-                "(more viscosity gives no more life)", kappa, high, ""))
+    kappa = items[0].kappa
+    low, high = KAPPA_RANGE
+    if kappa < low:
+        out.append(ResultWarning(
+            "kappa_range", f"viscosity ratio κ = {_sig(kappa)} < {low:g}: outside ISO 281's a_ISO; L_nm is "
+            f"evaluated at κ = {low:g} and is not meaningful", kappa, low, ""))
+    elif kappa > high:
+        out.append(ResultWarning(
+            "kappa_range", f"viscosity ratio κ = {_sig(kappa)} > {high:g}: ISO 281 evaluates a_ISO at κ = {high:g} "
+            "(more viscosity gives no more life)", kappa, high, ""))
     return tuple(out)
 
 

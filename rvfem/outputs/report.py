@@ -446,7 +446,19 @@ def _roller_depth(summary: dict) -> dict | None:
     table = _table(["bearing", "loads", "Q_max N", "p_max MPa", "edge factor", "where", "τ_max MPa", "depth µm", "h_min µm",
                     "κ", "a_ISO", "L10h h", "L_nm h", "L10r h"], rows, left=2)
     return {"table": table, "profile": d["profile"], "slices": d["slices"],
-            "slope": _num(d["max_slope_mrad"], ".3f")}
+            "slope": _num(d["max_slope_mrad"], ".3f"), "rigid_tilt": _rigid_tilt_words(d)}
+
+
+def _rigid_tilt_words(d: dict) -> str:
+    """How the rigid slice model's rollers are tilted, from the tilts it used: the rigid model has
+    no crankshaft slope, so only the case's misalignment (``crank_bearing.profile.misalignment_mrad``)
+    tilts them."""
+    tilts = [abs(b["rigid"]["peak_tilt_mrad"]) for b in d["bearings"]
+             if b["rigid"] is not None and b["rigid"].get("peak_tilt_mrad") is not None]
+    if not tilts or max(tilts) < 1e-9:
+        return "untilted"
+    return (f"tilted only by the case's misalignment (crank_bearing.profile.misalignment_mrad; up to "
+            f"{max(tilts):.2f} mrad at the pressure peak)")
 
 
 def _bearing_checks(summary: dict) -> list[str]:
