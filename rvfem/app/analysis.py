@@ -1238,7 +1238,7 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
             duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
                                                                        duty.flexible.service_life_h))
         except ContactError as exc:
-            log.warning("the flexible FE at every duty-cycle torque not computed: %s", exc)
+            log.info("the flexible FE at every duty-cycle torque not computed: %s", exc)
             not_computed.append(validity.ResultWarning(
                 "not_computed", f"the flexible FE at every duty-cycle torque not computed: {exc}; the service "
                 "life is the linear scaling of the case's own cycle", 1.0, 0.0, ""))

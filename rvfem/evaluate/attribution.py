@@ -121,7 +121,7 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     rvfem.errors.ContactError
         Only if the case's own step (:func:`case_step`) is not in ``cycles`` and its cycle does not
         solve. Any other step that does not solve is left out and named in
-        :attr:`Attribution.skipped` (logged as a warning).
+        :attr:`Attribution.skipped` (and given as a warning by :func:`skipped_warnings`).
 
     Notes
     -----
@@ -152,7 +152,7 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
         except ContactError as exc:
             if key == case_step(case):      # the case's own model: no chain to end in
                 raise
-            skipped[key] = f"its load cycle does not solve: {exc}"
+            skipped[key] = f"its load cycle does not solve: {str(exc).rstrip('.')}"
     if handbook_applicable(case)[0]:
         steps = [AttributionStep("handbook", STEP_LABELS["handbook"], handbook_bearing_loads(case, thetas).magnitude)]
         base, label = cycles.get("one_disc"), STEP_LABELS["equal_share"]
@@ -167,7 +167,7 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
         if key in cycles:
             steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
     for key, why in skipped.items():
-        log.warning("attribution step %s (%s) not made: %s", key, STEP_LABELS[key], why)
+        log.info("attribution step %s (%s) not made: %s", key, STEP_LABELS[key], why)
     return Attribution(np.asarray(thetas), tuple(steps), case_step(case), tuple(skipped.items()))
 
 
