@@ -188,3 +188,24 @@ def test_the_report_says_the_rigid_slice_models_tilt():
     assert report._rigid_tilt_words(_summary_depth(None)) == "untilted"
     words = report._rigid_tilt_words(_summary_depth(-4.99))     # misalignment_mrad = 5 on the case
     assert "untilted" not in words and "misalignment" in words and "4.99 mrad" in words
+
+
+# --------------------------------------------------------------------------------------------
+# optimise: only into a folder that is new, empty or its own
+# --------------------------------------------------------------------------------------------
+
+
+def test_an_optimisation_into_a_folder_rvfem_did_not_write_is_refused(tmp_path):
+    pytest.importorskip("optuna")
+    from rvfem.app.optimise import run_optimisation
+    from rvfem.errors import OutputError
+
+    problem = tmp_path / "p.toml"
+    problem.write_text('name = "p"\nproblem = "analytic"\ntrials = 2\n\n[[parameter]]\nkey = "x"\nlow = -1.0\n'
+                       'high = 1.0\n\n[[parameter]]\nkey = "y"\nlow = -1.0\nhigh = 1.0\n', encoding="utf-8")
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "trials.csv").write_text("my own table")
+    with pytest.raises(OutputError, match="rvfem did not write it"):
+        run_optimisation(problem, out, scheduler="tcp://127.0.0.1:1")   # refused before any cluster
+    assert [p.name for p in out.iterdir()] == ["trials.csv"] and (out / "trials.csv").read_text() == "my own table"

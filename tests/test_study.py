@@ -423,15 +423,6 @@ def test_an_unreachable_scheduler_is_one_line(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
 
 
-def test_an_unreachable_scheduler_from_the_command_line_leaves_nothing(tmp_path, capsys):
-    study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
-    out = tmp_path / "out"
-    assert cli.main(["study", str(study_file), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert "cannot connect to the Dask scheduler at tcp://127.0.0.1:1" in err[-1] and "Traceback" not in err[-1]
-    assert not out.exists()
-
-
 def test_a_study_into_a_folder_rvfem_did_not_write_is_refused(tmp_path):
     study_file = _write(tmp_path / "s.toml", _study_text("list", LIST_BODY))
     out = tmp_path / "mine"
