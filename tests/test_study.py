@@ -225,6 +225,7 @@ def test_a_failing_variant_is_recorded_and_the_study_goes_on(scheduler, cluster_
     _, done, _ = cluster_study
     out = tmp_path / "out"
     shutil.copytree(done / "variants" / "base", out / "variants" / "base")  # same base case: reused
+    mark_folder(out, "study")                                               # a study folder of rvfem
     study_file = _write(tmp_path / "fail.toml", _study_text("list", """
 [[variant]]
 id = "too-thin"
