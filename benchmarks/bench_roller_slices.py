@@ -4,10 +4,17 @@ Runs the load cycle of a case once (default ``cases/rv40e_fanholes.toml``, 360 a
 re-solve, no attribution), then times :func:`rvfem.evaluate.roller_life.crank_bearing_depth` (both
 raceways of every bearing, rigid and flexible, plus the worst roller's re-solve, film and lives)
 and the flexible slices alone (:func:`rvfem.evaluate.roller_life.cycle_slices` on both raceways of
-every bearing), best of ``--repeat``, for each roller profile. Prints the number of roller contacts
-solved and the time per contact.
+every bearing), best of ``--repeat``, for each roller profile (``--kinds``) with the case's number of
+slices or ``--slices N``. Prints the number of roller contacts solved and the time per contact.
 
-Run: ``python benchmarks/bench_roller_slices.py [CASE] [--repeat 5]`` (about half a minute).
+Run: ``python benchmarks/bench_roller_slices.py [CASE] [--repeat 5] [--slices 400] [--kinds logarithmic]``
+(about half a minute with the case's 30 slices).
+
+Measured on two shared cores (rv40e_fanholes, 360 angles, logarithmic profile, 400 slices,
+rigid + flexible with film and lives): 356 s with one dense solve of n + 1 unknowns per contact
+and active-set iteration (and far longer with two BLAS threads contending for the cores), 17 s
+with the block inverse through C⁻¹ (k = min(|S|, |I|) unknowns) and single-threaded BLAS; the
+slice loads agree to 4e-12 (relative).
 """
 
 from __future__ import annotations
@@ -34,17 +41,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("case", nargs="?", default="cases/rv40e_fanholes.toml")
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--slices", type=int, default=None, help="slices per roller (default: the case's)")
+    parser.add_argument("--kinds", nargs="+", default=["straight", "arc", "logarithmic", "combined"],
+                        help="roller profiles to time")
     args = parser.parse_args()
     a = analyse(args.case, recover_stress=False, attribute=False)
     cyc = a.cycle
     contacts = int(np.count_nonzero(cyc.roller_loads > 0)) * 2
     print(f"{a.case.name}: {len(a.theta)} crank angles, {cyc.roller_loads.shape[1]} bearings × "
           f"{cyc.roller_loads.shape[2]} rollers; {contacts} loaded roller–raceway contacts (flexible)")
-    for kind in ("straight", "arc", "logarithmic", "combined"):
+    slices = args.slices or a.case.crank_bearing.profile.slices
+    print(f"  {slices} slices per roller")
+    for kind in args.kinds:
         case = a.case.replace(crank_bearing=a.case.crank_bearing.__class__(
             **{**a.case.crank_bearing.__dict__,
                "profile": a.case.crank_bearing.profile.__class__(**{**a.case.crank_bearing.profile.__dict__,
-                                                                     "kind": kind})}))
+                                                                     "kind": kind, "slices": slices})}))
         geoms = roller_life.raceways(case)
         slopes = roller_life.eccentric_slopes(case, cyc)
         tilts = roller_life.roller_tilts(slopes, cyc.roller_angles, cyc.bearing_forces)
