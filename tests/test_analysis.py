@@ -232,7 +232,7 @@ def test_the_comparison_holds_the_cycle_and_the_handbook_loads(coarse):
 
 def test_every_stage_is_timed_and_reported_in_order(coarse):
     a, reports = coarse
-    ran = ["check", "mesh", "model", "rigid", "cycle", "evaluation", "attribution"]
+    ran = ["check", "mesh", "model", "rigid", "cycle", "evaluation", "attribution", "accuracy", "roller_slices"]
     started = [stage for stage, done, _ in reports if done == 0]
     assert started == [s for s in STAGES if s in ran] == ran     # no stress re-solve, no duty cycle
     for stage in ran:

@@ -112,6 +112,8 @@ STAGES: dict[str, str] = {
     "stress": "structural stress peak re-solved on P2 at its crank angles",
     "attribution": "attribution: the reducer-stage models step by step (computed beside other stages)",
     "duty_cycle": "flexible load cycle at the other duty-cycle torques",
+    "accuracy": "torsional rigidity and lost motion at crank angle 0",
+    "roller_slices": "crank bearing in depth: slices along every roller, film and lives",
 }
 """Stages of :func:`analyse` in order, with a one-line description (what the progress callback
 reports)."""
@@ -163,6 +165,24 @@ class Stages:
         self.seconds[name] = time.perf_counter() - started
         if self.progress is not None:
             self.progress(name, total, total)
+
+
+class _StageSteps:
+    """``progress(done, total)`` of a library function's steps within stage ``name`` of ``stages``
+    (``extra`` steps of the stage follow the function's); the last step is reported by
+    :meth:`end`, which ends the stage."""
+
+    def __init__(self, stages: Stages, name: str, extra: int = 0):
+        self.stages, self.name, self.extra, self.total = stages, name, extra, 1
+
+    def __call__(self, done: int, total: int) -> None:
+        self.total = total + self.extra
+        if done < self.total:
+            self.stages.tick(self.name, done, self.total)
+
+    def end(self, started: float) -> None:
+        """End the stage started at ``started`` (:meth:`Stages.start`)."""
+        self.stages.end(self.name, started, self.total)
 
 
 # --------------------------------------------------------------------------------------------
@@ -478,7 +498,8 @@ class RigidAnalysis:
         return bool(self.bearings)
 
 
-def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
+def analyse_rigid(case: Case, theta: np.ndarray | None = None,
+                  progress: Callable[[int, int], None] | None = None) -> RigidAnalysis:
     """Rigid handbook evaluation of a case (Gao et al. eqs. 4-14 and 20-22; see docs/theory.md).
 
     Parameters
@@ -487,6 +508,8 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
     theta : ndarray, optional
         Crank angles, rad; default one turn at ``analysis.angle_step_deg``
         (:func:`rvfem.evaluate.rigid.load_cycle_angles`).
+    progress : callable, optional
+        ``progress(done, total)`` after the slices of each bearing (bearing model ``rollers``).
 
     Returns
     -------
@@ -517,7 +540,8 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None) -> RigidAnalysis:
     depths = {}
     if case.crank_bearing.model == "rollers":
         depths = {d.bearing: d for d in roller_life.rigid_bearing_depths(
-            case, loads.theta, forces, {s.bearing: s.equivalent_N for s in summaries}, rating, speed)}
+            case, loads.theta, forces, {s.bearing: s.equivalent_N for s in summaries}, rating, speed,
+            progress=progress)}
     bearings, factors = [], []
     for s in summaries:
         k, j = np.unravel_index(int(np.argmax(rollers[:, s.bearing])), rollers[:, s.bearing].shape)
@@ -1179,11 +1203,12 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
     references = rigid.references(case)
     if not (references.handbook.defined or references.equal_share.defined):
         raise CaseError(f"{case.source}: {references.equal_share.why}")
-    rigid_analysis = analyse_rigid(case, thetas)
+    steps = _StageSteps(stages, "rigid", extra=1)   # the slices of each bearing, then the rest
+    rigid_analysis = analyse_rigid(case, thetas, progress=steps)
     classical = (rigid.classical_pin_forces(case, thetas, exact_moment=True)
                  if references.classical_pin_forces.defined else None)
     log.info("%s: bearing loads compared with %s", case.name, rigid.REFERENCE_NAMES[references.bearing_loads])
-    stages.end("rigid", t)
+    steps.end(t)
 
     n = len(thetas)
     t = stages.start("cycle", n)
@@ -1233,20 +1258,10 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
     # cycle solved: one that cannot be made is left out with a warning that says why
     not_computed = list(attribution_warnings(attribution))
     if duty is not None and duty_fe:
-        t = stages.start("duty_cycle")
-        try:
-            duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
-                                                                       duty.flexible.service_life_h))
-        except ContactError as exc:
-            log.info("the flexible FE at every duty-cycle torque not computed: %s", exc)
-            not_computed.append(validity.ResultWarning(
-                "not_computed", f"the flexible FE at every duty-cycle torque not computed: {exc}; the service "
-                "life is the linear scaling of the case's own cycle", 1.0, 0.0, ""))
-        stages.end("duty_cycle", t)
+        duty = _duty_cycle_stage(stages, system, thetas, cycle, comparison, duty, not_computed)
 
-    accuracy, accuracy_seconds = _timed(run_accuracy, system)
+    accuracy = _accuracy_stage(stages, system)
     timings = dict(stages.seconds)
-    timings["accuracy"] = accuracy_seconds
     if pending is not None:
         timings["attribution_compute"] = attribution_seconds
     timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
@@ -1256,20 +1271,55 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
                       comparison=comparison, stress=stress, hertz=roller_hertz,
                       torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
                       attribution=attribution, references=references, accuracy=accuracy)
-    result = _with_roller_depth(result)
+    result = _with_roller_depth(result, stages)
     return dataclasses.replace(result, warnings=result.warnings + tuple(not_computed)) if not_computed else result
 
 
-def _with_roller_depth(result: Analysis) -> Analysis:
+def _accuracy_stage(stages: Stages, system) -> dict | None:
+    """The ``accuracy`` stage of :func:`analyse` (:func:`run_accuracy`)."""
+    t = stages.start("accuracy")
+    accuracy = run_accuracy(system)
+    stages.end("accuracy", t)
+    return accuracy
+
+
+def _duty_cycle_stage(stages, system, thetas, cycle, comparison, duty, not_computed: list):
+    """The ``duty_cycle`` stage of :func:`analyse`: ``duty`` with the flexible FE at every duty-cycle
+    torque (:func:`duty_cycle_fe`); if that does not solve, ``duty`` as it is and a ``not_computed``
+    warning appended to ``not_computed``."""
+    t = stages.start("duty_cycle")
+    try:
+        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
+                                                                   duty.flexible.service_life_h))
+    except ContactError as exc:
+        log.info("the flexible FE at every duty-cycle torque not computed: %s", exc)
+        not_computed.append(validity.ResultWarning(
+            "not_computed", f"the flexible FE at every duty-cycle torque not computed: {exc}; the service "
+            "life is the linear scaling of the case's own cycle", 1.0, 0.0, ""))
+    stages.end("duty_cycle", t)
+    return duty
+
+
+def _with_roller_depth(result: Analysis, stages: Stages | None = None) -> Analysis:
     """The analysis with the crank bearing in depth (slices of every roller, film, a_ISO, L_nm and
-    L10r, rigid and flexible; :func:`rvfem.evaluate.roller_life.crank_bearing_depth`) and all warnings."""
+    L10r, rigid and flexible; :func:`rvfem.evaluate.roller_life.crank_bearing_depth`; stage
+    ``roller_slices`` of ``stages`` when the cycle has roller loads) and all warnings."""
+    stages = Stages(None) if stages is None else stages
+    sliced = result.cycle.roller_loads is not None
+    if sliced:
+        t = stages.start("roller_slices")
+    steps = _StageSteps(stages, "roller_slices")
     rigid_depths = tuple(b.depth for b in result.rigid.bearings if b.depth is not None)
     depth = roller_life.crank_bearing_depth(result.case, result.theta, result.cycle, result.rigid_forces,
                                             result.comparison, result.rigid.rating_N, result.rigid.bearing_speed_rpm,
-                                            rigid_depths=rigid_depths or None)
+                                            rigid_depths=rigid_depths or None,
+                                            progress=steps)
     if depth is not None:
         result.timings["roller_depth"] = depth.seconds
     checks = _bearing_checks(result)
+    if sliced:
+        steps.end(t)
+        result.timings["roller_slices"] = stages.seconds["roller_slices"]
     return dataclasses.replace(result, roller_depth=depth, bearing_checks=checks,
                                warnings=validity.analysis_warnings(result) + validity.roller_depth_warnings(depth)
                                + validity.bearing_check_warnings(checks))

@@ -190,13 +190,16 @@ def _add_run_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 class _RunProgress:
-    """Progress of ``rvfem run`` on stderr: a tqdm bar for the load cycle and the images on a
-    terminal, plain lines otherwise (one per stage, and every tenth of the cycle).
+    """Progress of ``rvfem run`` on stderr: a tqdm bar for the rigid model (its roller slices), the
+    load cycle, the roller slices, the VTK files and the images on a terminal (a status line for the other stages), plain lines
+    otherwise (one per stage, and every tenth of a stage that reports its steps).
 
     Stages are numbered in the order they start, out of the stages the run reports
     (``stages``, :func:`rvfem.app.run.run_stages`; default every stage of :data:`rvfem.app.run.STAGES`)."""
 
-    BAR_STAGES = ("cycle", "vtk", "images")
+    BAR_STAGES = ("rigid", "cycle", "roller_slices", "vtk", "images")
+    UNITS = {"cycle": "angle", "rigid": "step", "roller_slices": "step"}   # else "file"
+    QUIET_SECONDS = 1.0   # without a terminal, steps of a stage other than the cycle are told after this
 
     def __init__(self, stream: TextIO, tty: bool, stages: tuple[str, ...] | None = None):
         self.stream, self.tty = stream, tty
@@ -219,10 +222,7 @@ class _RunProgress:
             self.started[stage] = now
             self.last_tenth = -1
             if self.tty and stage in self.BAR_STAGES and total > 1:
-                from tqdm import tqdm  # progress bars of the command line only
-
-                self.bar = tqdm(total=total, desc=self._head(stage), file=self.stream, leave=False,
-                                unit="angle" if stage == "cycle" else "file", dynamic_ncols=True)
+                self._open_bar(stage, total)
             elif self.tty:  # a status line, replaced when the stage ends
                 self.pending = f"{self._head(stage)} …"
                 self.stream.write(self.pending)
@@ -240,16 +240,28 @@ class _RunProgress:
             self.stream.write(line + "\n")
             self.stream.flush()
             return
+        if self.bar is None and self.tty and stage in self.BAR_STAGES and total > 1:
+            # a stage that knows its number of steps only once it runs: its status line becomes a bar
+            if self.pending:
+                self.stream.write("\r" + " " * len(self.pending) + "\r")
+                self.pending = ""
+            self._open_bar(stage, total)
         if self.bar is not None:
             self.bar.update(done - self.bar.n)
-        elif not self.tty and stage == "cycle":
+        elif not self.tty and (stage == "cycle" or elapsed >= self.QUIET_SECONDS):
             tenth = 10 * done // total
             if tenth > self.last_tenth:
                 self.last_tenth = tenth
                 if tenth > 0:
-                    self.stream.write(f"rvfem run: cycle {done}/{total} angles ({100 * done // total} %), "
-                                      f"{elapsed:.1f} s\n")
+                    self.stream.write(f"rvfem run: {stage} {done}/{total} {self.UNITS.get(stage, 'file')}s "
+                                      f"({100 * done // total} %), {elapsed:.1f} s\n")
                     self.stream.flush()
+
+    def _open_bar(self, stage: str, total: int) -> None:
+        from tqdm import tqdm  # progress bars of the command line only
+
+        self.bar = tqdm(total=total, desc=self._head(stage), file=self.stream, leave=False,
+                        unit=self.UNITS.get(stage, "file"), dynamic_ncols=True)
 
     def close(self) -> None:
         """Remove a bar still drawn and end a status line (at the end of a stage, or before an

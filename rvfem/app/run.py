@@ -50,7 +50,7 @@ from rvfem.app.analysis import (
     analyse,
     resolve_case,
 )
-from rvfem.app.screen import summary_text
+from rvfem.app import screen
 from rvfem.case.definition import Case
 from rvfem.outputs import summary as outputs
 from rvfem.outputs.render import RenderWorker
@@ -66,6 +66,7 @@ __all__ = [
     "RunSummary",
     "ProgressCallback",
     "run_stages",
+    "outside_stages",
     "run_case",
     "summary_text",
 ]
@@ -88,13 +89,20 @@ the summary and the report; stage ``attribution``, reported after ``vtk``); the 
 ``images`` stages are then the waits for the child process."""
 
 
+def summary_text(summary: dict) -> str:
+    """The screen text of a run's summary (:func:`rvfem.app.screen.summary_text`) with the time of
+    its stages."""
+    return screen.summary_text(summary, tuple(STAGES))
+
+
 def run_stages(case: Case, *, images: bool = True) -> tuple[str, ...]:
     """The stages a run of ``case`` reports, in the order it reports them (each once; a subset of
     :data:`STAGES`).
 
     With images the attribution is computed after the VTK files, while the render worker draws,
     and the ``images`` stage is the wait for the images; without images it is computed beside the
-    stress stage. The ``duty_cycle`` stage is there only when the case has a duty cycle.
+    stress stage. The ``duty_cycle`` stage is there only when the case has a duty cycle, the
+    ``roller_slices`` stage only with the bearing model ``rollers``.
 
     Parameters
     ----------
@@ -108,6 +116,7 @@ def run_stages(case: Case, *, images: bool = True) -> tuple[str, ...]:
     """
     analysis = ["mesh", "model", "rigid", "cycle", "evaluation", "stress"]
     duty = ["duty_cycle"] if case.loads.duty_cycle else []
+    duty += ["accuracy"] + (["roller_slices"] if case.crank_bearing.model == "rollers" else [])
     if images:
         order = ["check", *analysis, *duty, "tables", "vtk", "attribution", "plots", "images", "report"]
     else:
@@ -348,6 +357,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
     timings = {"check": stages.seconds["check"], **result.timings,
                **{k: v for k, v in stages.seconds.items() if k != "check"}}
     timings["total"] = time.perf_counter() - t_run
+    timings["other"] = outside_stages(timings)
     files = tuple(sorted({p.relative_to(tmp).as_posix() for p in written} | {f for w in last for f in w.files}))
     summary = outputs.build_summary(result, outputs.SummaryContext(files=files, timings=timings))
     for w in last:
@@ -356,10 +366,20 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
     stages.end("report", t)
     summary["timings_s"]["report"] = stages.seconds["report"]
     summary["timings_s"]["total"] = time.perf_counter() - t_run
+    summary["timings_s"]["other"] = outside_stages(summary["timings_s"])
     for w in last:
         if w.stage is None:
             w.write(result, tmp, summary=summary)   # summary.json, with the time of every stage
     return summary, files, result
+
+
+def outside_stages(timings: dict) -> float:
+    """The part of the wall time ``timings["total"]`` that no stage of :data:`STAGES` holds, s:
+    the handing over between the stages (the summary, the bearing checks, starting the child
+    processes). The stages are spans of this process's wall time one after the other (work done
+    beside them by a thread or a child process counts only as the wait for it), so
+    ``total = Σ stages + other``."""
+    return timings["total"] - sum(float(timings.get(stage, 0.0)) for stage in STAGES)
 
 
 def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[outputs.Writer], mesh_call: int | None = None,

@@ -11,7 +11,8 @@ from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_lines
 from rvfem.outputs.report import toml_text
 
-__all__ = ["SCREEN_DIGITS", "summary_text", "rigid_text", "warning_lines", "reference_lines", "stress_lines"]
+__all__ = ["SCREEN_DIGITS", "summary_text", "stage_time_lines", "rigid_text", "warning_lines", "reference_lines",
+           "stress_lines"]
 
 
 
@@ -149,8 +150,10 @@ def _duty_lines(duty: dict | None) -> list[str]:
     return lines
 
 
-def summary_text(summary: dict) -> str:
-    """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints)."""
+def summary_text(summary: dict, stages=None) -> str:
+    """One screen of text with the key numbers of a ``summary.json`` (what ``rvfem run`` prints);
+    with ``stages`` (the names of the run's stages, :data:`rvfem.app.run.STAGES`) also where the
+    wall time went (:func:`stage_time_lines`)."""
 
     handbook = summary["references"]["bearing_loads"] == "handbook"
     pins, t = summary["pins_in_contact"], summary["timings_s"]
@@ -170,8 +173,25 @@ def summary_text(summary: dict) -> str:
     lines += _duty_lines(summary.get("duty_cycle"))
     lines.append(f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, {_drawing_text(t, summary['files'])}); "
                  f"{len(summary['files'])} files")
+    lines += stage_time_lines(t, stages)
     lines += warning_lines(summary.get("warnings", []))
     return "\n".join(lines)
+
+
+def stage_time_lines(timings: dict, stages=None, shown: int = 8) -> list[str]:
+    """Where the wall time went: ``total = Σ stages + other`` (``timings_s`` of a run,
+    :func:`rvfem.app.run.outside_stages`), the ``shown`` longest of ``stages`` (names) by name,
+    the rest summed; nothing without ``stages`` or for timings without ``other`` (a summary of
+    an earlier version)."""
+    if stages is None or "other" not in timings:
+        return []
+    spans = sorted(((float(timings[k]), k) for k in stages if k in timings), reverse=True)
+    parts = [f"{name} {seconds:.1f}" for seconds, name in spans[:shown]]
+    rest = spans[shown:]
+    if rest:
+        parts.append(f"{len(rest)} shorter stages {sum(sec for sec, _ in rest):.1f}")
+    parts.append(f"between the stages {timings['other']:.1f}")
+    return [f"  time {timings['total']:.1f} s = " + " + ".join(parts) + " s"]
 
 
 def _drawing_text(t: dict, files) -> str:

@@ -21,9 +21,11 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from rvfem.evaluate import lubrication, roller_slices
 from rvfem.evaluate.bearing_checks import crank_bearing_static_rating
@@ -155,7 +157,7 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
     every group is solved at once (:func:`rvfem.evaluate.roller_slices.solve_slices`). Contacts
     lighter than ``light_fraction`` of the heaviest share the group of that load (their
     rectangles are then a little too wide; they carry under 10⁻⁵ of the damage). ``cache`` keeps
-    the influence matrices between calls (key: group, E*, L, slices).
+    the influence matrices and their inverses between calls (key: group, E*, L, slices).
     """
     q = np.asarray(roller_loads, dtype=float)
     shape = q.shape
@@ -177,10 +179,14 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
         idx = loaded[group == key]
         b_g = bin_ratio ** (key + 0.5)
         ckey = (int(key), bin_ratio, e_star, length_mm, x.size)
-        if ckey not in cache:
-            cache[ckey] = roller_slices.rectangle_influence(x, dx, b_g, e_star)
-        p, _ = roller_slices.solve_slices(cache[ckey], 2.0 * b_g * dx,
-                                          flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx])
+        if ckey not in cache:   # C and C⁻¹ (the solver's block inverse uses it)
+            influence = roller_slices.rectangle_influence(x, dx, b_g, e_star)
+            with threadpool_limits(limits=1, user_api="blas"):   # small: threads only contend
+                cache[ckey] = influence, np.linalg.inv(influence)
+        influence, inverse = cache[ckey]
+        p, _ = roller_slices.solve_slices(influence, 2.0 * b_g * dx,
+                                          flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx],
+                                          inverse=inverse)
         out[idx] = p * 2.0 * b_g
     return out.reshape(shape + (x.size,))
 
@@ -412,7 +418,8 @@ class CrankBearingDepth:
 
 
 def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison, rating_N: float,
-                        speed_rpm: float, rigid_depths: tuple | None = None) -> CrankBearingDepth | None:
+                        speed_rpm: float, rigid_depths: tuple | None = None,
+                        progress: Callable[[int, int], None] | None = None) -> CrankBearingDepth | None:
     """The crank bearing in depth over a load cycle, rigid and flexible (None without FE rollers).
 
     Parameters
@@ -431,6 +438,9 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
     rigid_depths : tuple of BearingDepth, optional
         The rigid column already computed at the same angles (:func:`rigid_bearing_depths`, as the
         rigid handbook evaluation has it); computed here when not given.
+    progress : callable, optional
+        ``progress(done, total)`` after each bearing's flexible slices and after the rigid column
+        (when computed here).
     """
     if cycle.roller_loads is None or cycle.roller_angles is None:
         return None
@@ -440,14 +450,19 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
     tilts = roller_tilts(slopes, cycle.roller_angles, cycle.bearing_forces, misalignment)
     flexible, cache = [], {}
     have_rigid = isinstance(rigid_forces, np.ndarray) and np.all(np.isfinite(rigid_forces))
+    steps = len(comparison.bearings) + int(have_rigid and rigid_depths is None)
     for bc in comparison.bearings:
         i = bc.bearing
         flexible.append(bearing_depth(case, theta, cycle.roller_loads[:, i], tilts[:, i], bc.flexible.equivalent_N,
                                       speed_rpm, rating_N, i, "flexible", cache))
+        if progress is not None:
+            progress(len(flexible), steps)
     rigid = () if rigid_depths is None else rigid_depths
     if have_rigid and rigid_depths is None:
         equivalent = {bc.bearing: bc.rigid.equivalent_N for bc in comparison.bearings if bc.rigid is not None}
         rigid = rigid_bearing_depths(case, theta, rigid_forces, equivalent, rating_N, speed_rpm, cache)
+        if progress is not None:
+            progress(steps, steps)
     return CrankBearingDepth(flexible=tuple(flexible), rigid=tuple(rigid),
                              max_slope_mrad=1e3 * float(np.max(np.hypot(slopes[..., 0], slopes[..., 1]),
                                                                 initial=0.0)),
@@ -455,7 +470,8 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
 
 
 def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equivalent_loads_N: dict,
-                         rating_N: float, speed_rpm: float, cache: dict | None = None) -> tuple[BearingDepth, ...]:
+                         rating_N: float, speed_rpm: float, cache: dict | None = None,
+                         progress: Callable[[int, int], None] | None = None) -> tuple[BearingDepth, ...]:
     """The crank bearing in depth under the handbook forces: rigid rings with the case's clearance,
     rollers at their cage positions (:func:`rvfem.evaluate.roller_slices.case_rigid_roller_loads`),
     untilted but for the case's extra misalignment; one :func:`bearing_depth` per bearing. Used by
@@ -474,11 +490,17 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
         C (N) and n_b (rpm).
     cache : dict, optional
         Influence matrices kept between calls (:func:`cycle_slices`).
+    progress : callable, optional
+        ``progress(done, total)`` after each bearing.
     """
     loads = roller_slices.case_rigid_roller_loads(case, theta, rigid_forces)
     angles = roller_slices.roller_angles(case, np.asarray(theta, dtype=float))
     tilts = roller_tilts(np.zeros(np.shape(rigid_forces)), angles, rigid_forces,
                          1e-3 * case.crank_bearing.profile.misalignment_mrad)
     cache = {} if cache is None else cache
-    return tuple(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache)
-                 for i, p in sorted(equivalent_loads_N.items()))
+    depths = []
+    for i, p in sorted(equivalent_loads_N.items()):
+        depths.append(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache))
+        if progress is not None:
+            progress(len(depths), len(equivalent_loads_N))
+    return tuple(depths)
