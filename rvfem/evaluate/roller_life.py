@@ -25,7 +25,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from rvfem.evaluate import lubrication, roller_slices
 from rvfem.evaluate.bearing_checks import crank_bearing_static_rating
@@ -181,8 +180,7 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
         ckey = (int(key), bin_ratio, e_star, length_mm, x.size)
         if ckey not in cache:   # C and C⁻¹ (the solver's block inverse uses it)
             influence = roller_slices.rectangle_influence(x, dx, b_g, e_star)
-            with threadpool_limits(limits=1, user_api="blas"):   # small: threads only contend
-                cache[ckey] = influence, np.linalg.inv(influence)
+            cache[ckey] = influence, roller_slices.influence_inverse(influence)
         influence, inverse = cache[ckey]
         p, _ = roller_slices.solve_slices(influence, 2.0 * b_g * dx,
                                           flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx],

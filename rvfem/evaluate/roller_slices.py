@@ -45,7 +45,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from rvfem.evaluate.hertz import PALMGREN_COEFFICIENT, hertz_half_width
 from rvfem.solve.models import roller_angles
@@ -61,6 +61,7 @@ __all__ = [
     "solve_slices",
     "hertz_peak_from_line_load",
     "roller_contact",
+    "influence_inverse",
     "rigid_ring_roller_loads",
     "case_rigid_roller_loads",
 ]
@@ -256,9 +257,7 @@ def solve_slices(influence: np.ndarray, area_mm2: np.ndarray, interference_mm: n
     g = np.atleast_2d(np.asarray(interference_mm, dtype=float))
     q = np.asarray(load_N, dtype=float).reshape(-1)
     a = np.asarray(area_mm2, dtype=float)
-    # the systems are small (n ≤ 400) and many: threaded BLAS only contends for the cores there
-    # (the same 100-slice evaluation took 7 s single-threaded and 84 s with two threads on two loaded cores)
-    with threadpool_limits(limits=1, user_api="blas"):
+    with _single_threaded_blas():
         h = np.linalg.inv(c) if inverse is None else np.asarray(inverse, dtype=float)
         # all slices in contact: p = H·(δ·1 + g), H = C⁻¹, δ from the load balance
         h1 = h.sum(axis=1)
@@ -271,6 +270,27 @@ def solve_slices(influence: np.ndarray, area_mm2: np.ndarray, interference_mm: n
             p[todo] = p_t
             delta[todo] = d_t
     return p, delta
+
+
+def influence_inverse(influence: np.ndarray) -> np.ndarray:
+    """C⁻¹ of an influence matrix (:func:`rectangle_influence`), for :func:`solve_slices`'s
+    ``inverse``, 1/(mm/MPa)."""
+    with _single_threaded_blas():
+        return np.linalg.inv(np.asarray(influence, dtype=float))
+
+
+_BLAS: ThreadpoolController | None = None
+
+
+def _single_threaded_blas():
+    """A context with BLAS single-threaded. The systems are small (n ≤ 400) and many: threaded
+    BLAS only contends for the cores there (the same 100-slice evaluation took 7 s single-threaded
+    and 84 s with two threads on two loaded cores). The libraries are found once (reading the
+    process's memory map takes about 2 ms, as long as a 30-slice group's solve)."""
+    global _BLAS
+    if _BLAS is None:
+        _BLAS = ThreadpoolController()
+    return _BLAS.limit(limits=1, user_api="blas")
 
 
 DENSE_SLICES = 60
