@@ -1,5 +1,6 @@
-"""Fuzzing of the case reader and the first two subcommands: mutated shipped cases through
-``rvfem check`` and ``rvfem rigid --json``.
+"""Fuzzing of the case reader and the subcommands: mutated shipped cases through ``rvfem check``
+and ``rvfem rigid --json`` and, with ``--run N``, valid-looking ones through ``rvfem mesh`` and
+``rvfem run`` too.
 
 Each input is a shipped case file mutated at random: keys deleted, misspelled or added; values
 replaced by wrong types, zero, negative, nan, ±inf, huge, tiny or denormal numbers; lists made too
@@ -22,8 +23,16 @@ deleted). Both commands run in-process (:func:`rvfem.app.cli.main`) and every ru
 ``hang``
     an input took longer than the time limit (``--timeout``).
 
+``refused after check``
+    (``--run``) ``check`` accepted the case but ``mesh`` or ``run`` refused it: a valid case refused
+    later, a bug unless the message names a physical cause ``check`` cannot know.
+
+The mutations include the 0.4 tables and keys (roller profile, lubricant, strength, preload,
+profile modifications, rigid or linear pins and rollers).
+
 Run: ``python benchmarks/fuzz_cases.py --count 5000 --seed 1`` (prints the counts per outcome and
-the first failing inputs). ``tests/test_fuzz.py`` draws its inputs from the same generator.
+the first failing inputs); ``python benchmarks/fuzz_cases.py --run 30 --seed 1`` runs 30 valid
+inputs through ``mesh`` and ``run`` as well (about 15 s each). ``tests/test_fuzz.py`` draws its inputs from the same generator.
 """
 
 from __future__ import annotations
@@ -118,6 +127,59 @@ OPTIONAL_TABLES = {
                                          [[_num(r, 2e-6), 1e-6], [1e-6, _num(r, 2e-6)]], [[1e-6]], [1e-6]])},
     ]),
 }
+# Tables inside tables, and keys of existing tables, that the 0.4 capabilities added (the roller
+# profile, the lubricant, the strength of the material, preload, profile modifications): added to the
+# mutated bases so the fuzzer reaches them.
+NESTED_OPTIONAL = {
+    ("crank_bearing", "profile"): lambda r: {
+        "kind": r.choice(["straight", "arc", "logarithmic", "combined", "crowned", "straight"]),
+        **({"crown_radius": _num(r, 500.0)} if r.random() < 0.4 else {}),
+        **({"design_load_N": _num(r, 2000.0)} if r.random() < 0.3 else {}),
+        **({"modification_length": _num(r, 1.23), "modification_drop": _num(r, 0.006)} if r.random() < 0.3 else {}),
+        **({"misalignment_mrad": _num(r, 1.0)} if r.random() < 0.3 else {}),
+        **({"slices": r.choice([8, 12, 30, 7, 401, 30.5])} if r.random() < 0.3 else {})},
+    ("lubricant",): lambda r: {
+        **({"iso_vg": r.choice([22, 68, 100, 460, 67, "68"])} if r.random() < 0.5 else {}),
+        **({"nu40": _num(r, 68.0), "nu100": _num(r, 8.7)} if r.random() < 0.4 else {}),
+        **({"temperature_C": _num(r, 60.0)} if r.random() < 0.4 else {}),
+        **({"contamination_factor": _num(r, 0.5)} if r.random() < 0.2 else {}),
+        **({"cleanliness": r.choice(["normal", "high", "severe", "dirty"])} if r.random() < 0.3 else {}),
+        **({"roughness_Ra_um": _num(r, 0.1)} if r.random() < 0.3 else {})},
+    ("cycloid", "modification"): lambda r: {
+        "equidistant": r.choice([0.01, 0.005, -0.01, _num(r, 0.01)]),
+        "shift": r.choice([-0.01, 0.0, 0.005, _num(r, -0.01)]),
+        **({"rotation_deg": _num(r, 0.01)} if r.random() < 0.3 else {})},
+}
+NESTED_KEYS = {
+    ("material", "yield_strength"): lambda r: _num(r, 1800.0),
+    ("material", "ultimate_strength"): lambda r: _num(r, 2400.0),
+    ("material", "fatigue_limit"): lambda r: _num(r, 960.0),
+    ("material", "density_kg_m3"): lambda r: _num(r, 7810.0),
+    ("crank_bearing", "radial_clearance"): lambda r: r.choice([-0.005, -0.01, 0.005, 0.02, _num(r, -0.005)]),
+    ("pins", "model"): lambda r: r.choice(["rigid", "linear", "hertz", "palmgren"]),
+    ("crank_bearing", "stiffness_law"): lambda r: r.choice(["linear", "palmgren"]),
+}
+
+
+def _add_nested(r: random.Random, data: dict) -> str:
+    """Add one of the 0.4 tables or keys (with its companions where a choice needs them)."""
+    if r.random() < 0.5:
+        path = r.choice(list(NESTED_OPTIONAL))
+        make = NESTED_OPTIONAL[path]
+    else:
+        path = r.choice(list(NESTED_KEYS))
+        make = NESTED_KEYS[path]
+    parent = data
+    for key in path[:-1]:
+        parent = parent.setdefault(key, {})
+        if not isinstance(parent, dict):
+            return "no-op"
+    parent[path[-1]] = make(r)
+    if path == ("pins", "model") and parent[path[-1]] == "linear":
+        parent["linear_stiffness_N_per_mm"] = _num(r, 5e5)
+    if path == ("crank_bearing", "stiffness_law") and parent[path[-1]] == "linear":
+        parent["linear_stiffness_N_per_mm"] = _num(r, 5e5)
+    return f"add {'.'.join(path)} = {parent[path[-1]]!r}"
 
 
 def _wrong_type(r: random.Random) -> Any:
@@ -198,10 +260,14 @@ def _misspell(r: random.Random, word: str) -> str:
     return word[:i] + r.choice("abcdefghijklmnopqrstuvwxyz_") + word[i:]
 
 
-def _mutate_data(r: random.Random, data: dict) -> str:
-    """Apply one mutation to the parsed case in place; return its description."""
-    op = r.choice(["delete", "misspell", "type", "extreme", "extreme", "extreme", "scale", "list", "add_table",
-                   "add_duty", "discs", "choice", "in_range", "in_range", "in_range", "in_range", "all_in_range"])
+def _mutate_data(r: random.Random, data: dict, op: str | None = None) -> str:
+    """Apply one mutation (of the kind ``op``, default drawn at random) to the parsed case in place;
+    return its description."""
+    op = op or r.choice(["delete", "misspell", "type", "extreme", "extreme", "extreme", "scale", "list", "add_table",
+                   "add_duty", "discs", "choice", "in_range", "in_range", "in_range", "in_range", "all_in_range",
+                   "add_nested", "add_nested", "add_nested"])
+    if op == "add_nested":
+        return _add_nested(r, data)
     paths = _paths(data)
     path = r.choice(paths)
     parent, key = _parent(data, path), path[-1]
@@ -236,6 +302,16 @@ def _mutate_data(r: random.Random, data: dict) -> str:
         parent = _parent(data, path)
         parent[path[-1]] = _in_range(r, low, high, isinstance(parent[path[-1]], int))
         return f"in range {'.'.join(map(str, path))} = {parent[path[-1]]!r}"
+    if op == "nudge":
+        numbers = [p for p in paths if isinstance(_parent(data, p)[p[-1]], (int, float))
+                   and not isinstance(_parent(data, p)[p[-1]], bool)]
+        if not numbers:
+            return "no-op"
+        path = r.choice(numbers)
+        parent, key = _parent(data, path), path[-1]
+        factor = r.choice([0.8, 0.9, 0.95, 1.05, 1.1, 1.25])
+        parent[key] = round(parent[key] * factor) if isinstance(parent[key], int) else parent[key] * factor
+        return f"nudge {'.'.join(map(str, path))} = {parent[key]!r}"
     if op in ("extreme", "scale"):
         numbers = [p for p in paths if isinstance(_parent(data, p)[p[-1]], (int, float))
                    and not isinstance(_parent(data, p)[p[-1]], bool)]
@@ -333,6 +409,22 @@ def fuzz_input(r: random.Random) -> tuple[str, bytes]:
     return f"{name}: " + "; ".join(steps), toml_dumps(data).encode("utf-8")
 
 
+VALID_OPS = ("nudge", "nudge", "nudge", "in_range", "add_nested", "add_nested", "add_nested")
+
+
+def fuzz_valid_input(r: random.Random) -> tuple[str, bytes]:
+    """A mutated case meant to stay valid (for the expensive commands): numbers moved inside their
+    declared ranges or nudged by a few per cent, the 0.4 tables and keys added. Some still fail
+    ``check`` (a combination out of range); ``--run`` skips those."""
+    name = r.choice(sorted(SHIPPED))
+    data = tomllib.loads(SHIPPED[name])
+    steps = []
+    for _ in range(r.choice([1, 2, 2, 3])):
+        op = r.choice(VALID_OPS)
+        steps.append(_mutate_data(r, data, op))
+    return f"{name}: " + "; ".join(steps), toml_dumps(data).encode("utf-8")
+
+
 # --------------------------------------------------------------------------------------------
 # Running one input
 # --------------------------------------------------------------------------------------------
@@ -386,6 +478,25 @@ def check_file(path: Path) -> list[tuple[str, str, str]]:
     return results
 
 
+def run_file(path: Path, workdir: Path) -> list[tuple[str, str, str]]:
+    """Run ``mesh`` and ``run --step 30 --no-images`` on a case that passed ``check``:
+    [(command, outcome, detail)]. A refusal (exit 2) here is a *valid case refused later*: the
+    outcome is then ``refused after check``."""
+    results = []
+    cache = workdir / "meshes"
+    for command, argv in (("mesh", ["mesh", str(path), "--cache-dir", str(cache)]),
+                          ("run", ["run", str(path), "-o", str(workdir / "out"), "--overwrite", "--step", "30",
+                                   "--no-images", "--cache-dir", str(cache)])):
+        code, stdout, stderr, tb = run_cli(argv)
+        outcome, detail = classify(command, code, stdout, stderr, tb)
+        if outcome == "exit 2":
+            outcome = "refused after check"
+        results.append((command, outcome, detail))
+        if outcome != "exit 0":
+            break
+    return results
+
+
 class _Timeout(Exception):
     pass
 
@@ -401,7 +512,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=10.0, help="time limit per input, s (default 10)")
     parser.add_argument("--workdir", default=None, help="folder for the input files (default: a temporary one)")
     parser.add_argument("--show", type=int, default=10, help="failing inputs to print (default 10)")
+    parser.add_argument("--run", type=int, default=0, metavar="N",
+                        help="also draw inputs meant to stay valid until N of them pass check, and run "
+                             "`mesh` and `run --step 30 --no-images` on those (default 0)")
     args = parser.parse_args(argv)
+    if args.run:
+        return _main_run(args)
 
     import tempfile
 
@@ -438,6 +554,46 @@ def main(argv: list[str] | None = None) -> int:
     kinds = Counter((c, o, d.split(":")[0][:80]) for _, c, o, _, d in failures)
     for (command, outcome, detail), n in kinds.most_common():
         print(f"  FAIL {n:5d} × {command} {outcome}: {detail}")
+    for i, command, outcome, description, detail in failures[: args.show]:
+        print(f"  input {i}: {command} {outcome}: {description!r} -> {detail}")
+    return 1 if failures else 0
+
+
+def _main_run(args: argparse.Namespace) -> int:
+    """``--run N``: valid-looking inputs through check, mesh and run; counts and failures."""
+    import tempfile
+
+    rng = random.Random(args.seed)
+    counts: Counter = Counter()
+    failures: list[tuple[int, str, str, str, str]] = []
+    start = time.perf_counter()
+    drawn = ran = 0
+    with tempfile.TemporaryDirectory(dir=args.workdir) as tmp:
+        work = Path(tmp)
+        path = work / "case.toml"
+        while ran < args.run:
+            description, content = fuzz_valid_input(rng)
+            drawn += 1
+            path.write_bytes(content)
+            (command, outcome, detail), = [check_file(path)[0]]
+            counts[("check", outcome)] += 1
+            if outcome not in ("exit 0", "exit 2"):
+                failures.append((drawn, command, outcome, description, detail))
+            if outcome != "exit 0":
+                continue
+            ran += 1
+            for command, outcome, detail in run_file(path, work):
+                counts[(command, outcome)] += 1
+                if outcome != "exit 0":
+                    failures.append((drawn, command, outcome, description, detail))
+                    (work / f"failed-{drawn}.toml").write_bytes(content)
+            print(f"  {ran}/{args.run} ({time.perf_counter() - start:.0f} s): {description[:100]}", flush=True)
+    elapsed = time.perf_counter() - start
+    print(f"fuzz_cases --run: {drawn} inputs drawn, {ran} passed check and ran, seed {args.seed}, "
+          f"{elapsed:.0f} s")
+    for command in ("check", "mesh", "run"):
+        row = {o: n for (c, o), n in sorted(counts.items()) if c == command}
+        print(f"  {command:6s} " + ", ".join(f"{o}: {n}" for o, n in row.items()))
     for i, command, outcome, description, detail in failures[: args.show]:
         print(f"  input {i}: {command} {outcome}: {description!r} -> {detail}")
     return 1 if failures else 0
