@@ -451,6 +451,17 @@ def test_overwrite_never_replaces_a_folder_rvfem_did_not_write(tmp_path):
     outputs.check_output_folder(tmp_path / "empty", overwrite=False)
 
 
+def test_a_result_folder_of_an_earlier_rvfem_is_refused_and_named(tmp_path):
+    """A folder from before the marker (a summary.json with rvfem_version, no marker) is still
+    refused, since files may have been added to it since, and the message says what it probably is."""
+    out = tmp_path / "old"
+    _foreign_folder(out)
+    (out / "summary.json").write_text('{"schema_version": 1, "rvfem_version": "0.3.0"}')
+    with pytest.raises(OutputError, match="suggests an earlier rvfem wrote it"):
+        outputs.check_output_folder(out, overwrite=True)
+    assert (out / "notes.txt").read_text() == "mine"
+
+
 def test_cli_overwrite_of_a_folder_rvfem_did_not_write_is_refused(coarse_case_file, tmp_path, capsys):
     """rvfem run --overwrite on a non-empty folder without the marker: one line, exit 2, the
     folder's contents untouched (the 0.3 behaviour deleted them: a case named "" took results/)."""

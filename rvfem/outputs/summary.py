@@ -187,9 +187,14 @@ def mark_folder(folder: str | os.PathLike, what: str) -> Path:
 
 
 def _foreign_folder_error(out_dir: Path) -> OutputError:
-    return OutputError(f"{out_dir} is not empty and rvfem did not write it (no {RESULT_MARKER} file in it); rvfem "
-                       "replaces or writes into only folders it wrote: choose another output folder, or move or "
-                       "delete this one yourself")
+    earlier = ""
+    if (out_dir / "summary.json").is_file() or (out_dir / "study.json").is_file():
+        # A result or study folder of an rvfem from before the marker: still refused (its files may
+        # have been added to since), but the message says what it probably is.
+        earlier = " (its summary.json or study.json suggests an earlier rvfem wrote it, before the marker)"
+    return OutputError(f"{out_dir} is not empty and rvfem did not write it (no {RESULT_MARKER} file in it){earlier}; "
+                       "rvfem replaces or writes into only folders it wrote: choose another output folder, or move "
+                       "or delete this one yourself")
 
 
 def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
