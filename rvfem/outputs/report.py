@@ -498,8 +498,9 @@ def _plots(summary: dict, root: Path) -> list[dict]:
                 + ("the classical rigid distribution." if refs["classical_pin_forces"]["defined"] else
                    "no rigid reference (the classical distribution is not defined for Zp − Zc ≠ 1).")),
         _figure(root, pl.get("roller_loads"), "Roller loads at the angle of the largest bearing load."),
-        _figure(root, pl.get("roller_pressure"), "Pressure along the most loaded roller of every bearing "
-                "(slice model): flexible (solid) and rigid (dashed)."),
+        _figure(root, pl.get("roller_pressure"), "Pressure along the roller of the highest contact pressure of "
+                "every bearing over the cycle (slice model; its load Q in the legend, which can be a little below the "
+                "most loaded roller's when the crankshaft's tilt moves the peak): flexible (solid) and rigid (dashed)."),
     ]
     return [f for f in figures if f]
 
