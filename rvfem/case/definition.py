@@ -49,7 +49,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
-from rvfem.case.registry import bearing_model_names, pin_model_names
+from rvfem.case.registry import bearing_model_names, model_requires, pin_model_names
 from rvfem.case.schema import (
     check_fields,
     closest,
@@ -70,6 +70,7 @@ __all__ = [
     "Cranks",
     "CrankBearing",
     "RollerProfile",
+    "ROLLER_PROFILE_KINDS",
     "Lubricant",
     "CrankSupport",
     "FanHoles",
@@ -254,6 +255,19 @@ its 10/3 power: at 0.4 the life is already (0.4/0.83)^(10/3) ≈ 9 % of the stan
 below says the bearing is not one ISO 281 rates, and near 0 the life underflows to 0 h."""
 
 
+ROLLER_PROFILE_KINDS: dict[str, tuple[str, ...]] = {
+    "straight": (),
+    "arc": ("crown_radius",),
+    "logarithmic": ("design_load_N",),
+    "combined": ("modification_length", "modification_drop"),
+}
+"""The kinds of roller profile (``crank_bearing.profile.kind``), each with the keys of
+``[crank_bearing.profile]`` that shape its drop and no other kind uses. The one list of kinds: the
+case accepts these, the report shows each one's keys, and the drop of each is a function of
+:data:`rvfem.evaluate.roller_slices.PROFILE_DROPS`, which refuses to import unless it has one
+for every kind here (a new kind without its drop fails at import, before any run)."""
+
+
 @dataclass(frozen=True)
 class RollerProfile:
     """Axial profile (generatrix) of the crank-bearing rollers (table ``[crank_bearing.profile]``).
@@ -275,7 +289,7 @@ class RollerProfile:
       eq. 10, R = (a² + b²)/(2b)).
     """
 
-    kind: str = param("straight", choices=("straight", "arc", "logarithmic", "combined"),
+    kind: str = param("straight", choices=tuple(ROLLER_PROFILE_KINDS),
                       doc="roller generatrix: straight, arc (crown radius), logarithmic (Johns–Gohar) or combined "
                           "(straight centre and a modified end segment)")
     crown_radius: float = param(500.0, unit="mm", low=10.0, high=1.0e6, doc="R of the `arc` profile")
@@ -961,8 +975,10 @@ def _check_cranks(case: Case) -> None:
 def _check_crank_bearing(case: Case) -> None:
     b = case.crank_bearing
     key = "crank_bearing."
-    if case.pins.model == "linear" and case.pins.linear_stiffness_N_per_mm is None:
-        raise _error(case, "pins.linear_stiffness_N_per_mm", "is missing (required when pins.model = 'linear')")
+    for table, kind, model in (("pins", "pin", case.pins.model), ("crank_bearing", "bearing", b.model)):
+        for name in model_requires(kind, model):   # the keys the model declares it needs
+            if getattr(getattr(case, table), name) is None:
+                raise _error(case, f"{table}.{name}", f"is missing (required when {table}.model = {model!r})")
     if b.stiffness_law == "linear" and b.linear_stiffness_N_per_mm is None:
         raise _error(case, key + "linear_stiffness_N_per_mm", "is missing (required when stiffness_law = 'linear')")
     if b.roller_diameter >= b.pitch_diameter:   # γ = D_we/D_m in (0, 1): ISO 281 f_c, inner raceway > 0
@@ -1264,8 +1280,7 @@ def _check_roller_profile(case: Case) -> None:
                          f"(it shapes the {kind!r} profile): set {key}kind = {kind!r}, or leave {name} out")
 
 
-_PROFILE_KEY_KIND = {"crown_radius": "arc", "design_load_N": "logarithmic", "modification_length": "combined",
-                     "modification_drop": "combined"}
+_PROFILE_KEY_KIND = {key: kind for kind, keys in ROLLER_PROFILE_KINDS.items() for key in keys}
 """The profile keys that only one ``kind`` uses. Given with another kind they are refused, unless
 they hold their default (a case written out whole, as ``case.json``, holds every key)."""
 

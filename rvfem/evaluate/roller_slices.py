@@ -47,11 +47,13 @@ from dataclasses import dataclass
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
+from rvfem.case.definition import ROLLER_PROFILE_KINDS
 from rvfem.evaluate.hertz import PALMGREN_COEFFICIENT, hertz_half_width
 from rvfem.solve.models import roller_angles
 
 __all__ = [
     "PROFILE_KINDS",
+    "PROFILE_DROPS",
     "SHEAR_FACTOR",
     "SHEAR_DEPTH_FACTOR",
     "SliceContact",
@@ -66,7 +68,8 @@ __all__ = [
     "case_rigid_roller_loads",
 ]
 
-PROFILE_KINDS = ("straight", "arc", "logarithmic", "combined")
+PROFILE_KINDS = tuple(ROLLER_PROFILE_KINDS)
+"""The roller-profile kinds (:data:`rvfem.case.definition.ROLLER_PROFILE_KINDS`, where they are declared)."""
 #: Maximum principal shear stress / p_h of a Hertz line contact (Johnson, Contact Mechanics, §4.2).
 SHEAR_FACTOR = 0.300
 #: Its depth / b.
@@ -142,28 +145,59 @@ def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: floa
       finite drop at the ends. It is the sag of a uniformly loaded strip on the half-space, so
       the pressure is uniform along the roller at Q_d.
     """
-    x = np.abs(np.asarray(x_mm, dtype=float))
-    half = 0.5 * length_mm
-    kind = profile.kind
-    if kind == "straight":
+    try:
+        drop = PROFILE_DROPS[profile.kind]
+    except KeyError:
+        raise ValueError(f"unknown roller profile kind {profile.kind!r}; expected one of {tuple(PROFILE_DROPS)}") from None
+    return drop(profile, length_mm, np.abs(np.asarray(x_mm, dtype=float)),
+                composite_modulus_MPa=composite_modulus_MPa, reduced_radius_mm=reduced_radius_mm)
+
+
+def _straight_drop(profile, length_mm, x, **contact):
+    """z = 0."""
+    return np.zeros_like(x)
+
+
+def _arc_drop(profile, length_mm, x, **contact):
+    """z = R − √(R² − x²), R the crown radius."""
+    r = profile.crown_radius
+    return r - np.sqrt(r * r - np.minimum(x, r) ** 2)
+
+
+def _combined_drop(profile, length_mm, x, **contact):
+    """Straight centre, circular end segments of length a dropping by b at the ends."""
+    a, b = profile.modification_length, profile.modification_drop
+    if b <= 0.0:
         return np.zeros_like(x)
-    if kind == "arc":
-        r = profile.crown_radius
-        return r - np.sqrt(r * r - np.minimum(x, r) ** 2)
-    if kind == "combined":
-        a, b = profile.modification_length, profile.modification_drop
-        if b <= 0.0:
-            return np.zeros_like(x)
-        r = (a * a + b * b) / (2.0 * b)
-        u = np.clip(x - (half - a), 0.0, None)
-        return r - np.sqrt(r * r - np.minimum(u, r) ** 2)
-    if kind == "logarithmic":
-        q = profile.design_load_N
-        b_d = hertz_half_width(q, length_mm, reduced_radius_mm, composite_modulus_MPa)
-        frac = min(b_d / half, 1.0)
-        arg = 1.0 - (1.0 - frac * frac) * np.minimum(x / half, 1.0) ** 2
-        return q / (math.pi * length_mm * composite_modulus_MPa) * np.log(1.0 / arg)   # 2Q/(π·L·E′), E′ = 2E*
-    raise ValueError(f"unknown roller profile kind {kind!r}; expected one of {PROFILE_KINDS}")
+    r = (a * a + b * b) / (2.0 * b)
+    u = np.clip(x - (0.5 * length_mm - a), 0.0, None)
+    return r - np.sqrt(r * r - np.minimum(u, r) ** 2)
+
+
+def _logarithmic_drop(profile, length_mm, x, *, composite_modulus_MPa, reduced_radius_mm):
+    """Johns–Gohar's drop for the design load (uniform pressure along the roller at that load)."""
+    half = 0.5 * length_mm
+    q = profile.design_load_N
+    b_d = hertz_half_width(q, length_mm, reduced_radius_mm, composite_modulus_MPa)
+    frac = min(b_d / half, 1.0)
+    arg = 1.0 - (1.0 - frac * frac) * np.minimum(x / half, 1.0) ** 2
+    return q / (math.pi * length_mm * composite_modulus_MPa) * np.log(1.0 / arg)   # 2Q/(π·L·E′), E′ = 2E*
+
+
+PROFILE_DROPS = {
+    "straight": _straight_drop,
+    "arc": _arc_drop,
+    "logarithmic": _logarithmic_drop,
+    "combined": _combined_drop,
+}
+"""The drop function of every roller-profile kind, ``drop(profile, length_mm, |x|, *,
+composite_modulus_MPa, reduced_radius_mm) -> z`` (mm; see :func:`profile_drop`). Its kinds are
+those of :data:`rvfem.case.definition.ROLLER_PROFILE_KINDS`: this module is not imported otherwise."""
+
+if set(PROFILE_DROPS) != set(ROLLER_PROFILE_KINDS):   # a kind the case accepts but nothing can draw
+    raise ImportError("rvfem.evaluate.roller_slices: the roller-profile kinds of the case format "
+                      f"({', '.join(ROLLER_PROFILE_KINDS)}) and those with a drop function in PROFILE_DROPS "
+                      f"({', '.join(PROFILE_DROPS)}) differ; give every kind its drop function")
 
 
 def slice_centres(length_mm: float, slices: int) -> tuple[np.ndarray, np.ndarray]:

@@ -9,8 +9,16 @@ file into ``folder`` and returns the paths it wrote. Its module registers it whe
 
 and :func:`writers` lists the registered writers in their ``order``: a run
 (:func:`rvfem.app.run.run_case`) calls them one after the other, so a new output is one
-registered function, with no change to the run. The built-in writers are those of
-:mod:`rvfem.outputs.summary` (importing it registers them).
+registered function, with no change to the run.
+
+The modules of rvfem's own writers are listed in one place, :data:`WRITER_MODULES` (as meshio lists
+its formats in its ``__init__``), and :func:`writers` imports them (:mod:`importlib`) before it
+answers: the list is complete whatever was imported first, and a writer in a new module of this
+package is that module plus its line in :data:`WRITER_MODULES` (a test fails for a module under
+``rvfem/outputs`` that registers a writer and is not listed). The import is lazy, in
+:func:`writers`, so that importing this module stays light and the writer modules (which import it)
+form no import circle. A writer registered from outside the package (a notebook, a test module)
+exists once its module has been imported.
 
 The options a writer may take (it names those it takes in ``options``; the run passes them):
 
@@ -28,11 +36,19 @@ The options a writer may take (it names those it takes in ``options``; the run p
 from __future__ import annotations
 
 import fnmatch
+import importlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-__all__ = ["OPTIONS", "Writer", "register_writer", "writers"]
+__all__ = ["OPTIONS", "WRITER_MODULES", "Writer", "register_writer", "writers"]
+
+WRITER_MODULES = (
+    "rvfem.outputs.summary",          # tables, case.json, vtk, plots, images, report, summary.json
+    "rvfem.outputs.roller_outputs",   # roller_pressure.csv
+)
+"""The modules of rvfem's own writers, each registering its writers with :func:`register_writer`;
+:func:`writers` imports them."""
 
 OPTIONS = ("tick", "pending", "summary")
 """The options a writer may take (see the module's docstring)."""
@@ -115,5 +131,8 @@ def register_writer(name: str, order: int, *, stage: str | None, options: Iterab
 
 
 def writers(*, images: bool = True) -> tuple[Writer, ...]:
-    """The registered writers in their order; without those that render if ``images`` is False."""
+    """The registered writers in their order (those of every module of :data:`WRITER_MODULES`, and
+    any registered since); without those that render if ``images`` is False."""
+    for module in WRITER_MODULES:
+        importlib.import_module(module)
     return tuple(w for w in sorted(_WRITERS.values(), key=lambda w: w.order) if images or not w.renders)

@@ -25,7 +25,7 @@ from typing import Any
 import jinja2
 
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
-from rvfem.case.definition import Case
+from rvfem.case.definition import ROLLER_PROFILE_KINDS, Case
 from rvfem.case.schema import toml_literal
 from rvfem.case.schema import file_fields, format_quantity
 from rvfem.errors import CaseError
@@ -531,10 +531,7 @@ def _images(summary: dict, case: Case, root: Path) -> dict | None:
             "mesh": _figure(root, im.get("mesh"), "The mesh (linear triangles) and a close-up of the rim under bore 1.")}
 
 
-_PROFILE_KEYS = {"straight": ("kind", "misalignment_mrad", "slices"),
-                 "arc": ("kind", "crown_radius", "misalignment_mrad", "slices"),
-                 "logarithmic": ("kind", "design_load_N", "misalignment_mrad", "slices"),
-                 "combined": ("kind", "modification_length", "modification_drop", "misalignment_mrad", "slices")}
+_PROFILE_KEYS = {kind: ("kind", *keys, "misalignment_mrad", "slices") for kind, keys in ROLLER_PROFILE_KINDS.items()}
 """The keys of ``[crank_bearing.profile]`` each kind uses (the others do not enter its drop)."""
 
 

@@ -1,7 +1,8 @@
 """Writers of an :class:`~rvfem.app.analysis.Analysis`: one per format, and the atomic result folder.
 
 Every writer has the form ``write_x(analysis, folder) -> list[Path]`` and writes into an existing
-folder (sub-folders it needs are created). Each registers itself (:mod:`rvfem.outputs.registry`);
+folder (sub-folders it needs are created). Each registers itself (:mod:`rvfem.outputs.registry`,
+whose ``WRITER_MODULES`` lists this module and the other writer modules);
 :func:`writers` lists them in the order a run calls them::
 
     write_tables      bearing_loads.csv, roller_loads.csv (bearing model "rollers"), pin_forces.csv,
@@ -58,7 +59,7 @@ from rvfem.outputs.design_summary import fatigue_point_data, piece_mass_strength
 from rvfem.outputs.plots import mesh_plot, rim_closeup
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
-from rvfem.outputs.roller_outputs import roller_pressure_calls  # also registers roller_pressure.csv
+from rvfem.outputs.roller_outputs import roller_pressure_calls
 from rvfem.outputs.vtkio import vtu_name
 
 log = logging.getLogger(__name__)
