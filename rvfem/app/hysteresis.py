@@ -28,15 +28,14 @@ from rvfem.outputs import accuracy as files
 from rvfem.outputs.summary import result_folder
 from rvfem.solve import accuracy
 from rvfem.solve.cycle import build_system, case_stage
+from rvfem.solve.stage_parts import held_in_words
 
 log = logging.getLogger(__name__)
 
 __all__ = ["LEFT_OUT", "accuracy_study", "loop_option_problem", "loop_warnings", "mesh_period_angles"]
 
-LEFT_OUT = ("The stage model holds both discs, the pins (Hertz contact at the gaps of the modified profile), "
-            "the crank-bearing rollers with their clearance, the crankshafts as beams and their support "
-            "bearings. It leaves out the main (output) bearings, the carrier's end plates and pins (the carrier is "
-            "rigid), the pin housing (the pins' seats are rigid), the input spur stage (with the input locked the "
+LEFT_OUT = (f"The stage model holds {held_in_words()}. It leaves out the main (output) bearings, the carrier's "
+            "end plates and pins (the carrier is rigid), the pin housing (the pins' seats are rigid), the input spur stage (with the input locked the "
             "crankshafts do not turn relative to the carrier) and the rotation of the pins in their grooves. The "
             "output rotation is the carrier rotation of the stage model's torque convention (each disc's torque about "
             "its own centre, the eccentrics turning about the disc centre). Pin friction is Coulomb with full "

@@ -26,6 +26,7 @@ from rvfem.evaluate.rigid import (
 from rvfem.evaluate.validity import ResultWarning
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve.cycle import build_stage, load_cycle
+from rvfem.solve.stage_parts import STAGE_PARTS
 
 __all__ = ["Attribution", "AttributionStep", "STEP_LABELS", "attribution", "case_step", "skipped_warnings"]
 
@@ -139,14 +140,17 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     if discs == 2:
         need.append("two_discs")
     f = crankshaft_influence(case)
-    if f is not None:
-        need.append("crankshafts")
+    # then the steps that bring in the stage's parts (the crankshafts' only where the case has them)
+    for part in STAGE_PARTS:
+        if part.step not in need and (f is not None or not part.crank):
+            need.append(part.step)
+    crank_steps = {p.step for p in STAGE_PARTS if p.crank}
     skipped: dict[str, str] = {}
     for key in need:
         if key in cycles:
             continue
         stage = build_stage(system, discs=1 if key == "one_disc" else discs,
-                            influence=f if key == "crankshafts" else None)
+                            influence=f if key in crank_steps else None)
         try:
             cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
         except ContactError as exc:

@@ -30,28 +30,26 @@ import dataclasses
 import logging
 import math
 from dataclasses import dataclass
-from types import SimpleNamespace
 
 import numpy as np
 
 from rvfem.errors import ContactError
-from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.geometry import pin_profile_contacts
-from rvfem.solve import models
 from rvfem.solve.cycle import (
     OperatingPoint,
     PairResult,
     ReducerStage,
-    build_system,
     solve_pair,
     symmetry_plan,
 )
+from rvfem.solve.stage_parts import COMPONENTS, STIFFEN, stiffened_stage
 
 log = logging.getLogger(__name__)
 
 __all__ = [
     "COMPONENTS",
     "LOST_MOTION_FRACTION",
+    "STIFFEN",
     "ZERO_FRACTION",
     "ComplianceShares",
     "HysteresisLoop",
@@ -249,78 +247,6 @@ def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, fric
 # ------------------------------------------------------------------------------------------------
 # Where the compliance sits
 # ------------------------------------------------------------------------------------------------
-
-STIFFEN = 1.0e3
-"""The factor a component is stiffened by to remove its compliance (:func:`compliance_shares`)."""
-
-COMPONENTS = ("pin–flank contact", "disc body", "crank-bearing rollers", "crankshaft bending/shear",
-              "support bearings")
-"""The series compliances of the stage, in the order of the load path from the pins to the carrier."""
-
-
-def stiffened_stage(stage: ReducerStage, component: str) -> ReducerStage:
-    """The stage with one component (:data:`COMPONENTS`) :data:`STIFFEN` times stiffer.
-
-    Pins: linear springs of STIFFEN × the secant stiffness of the Hertz contact at the mean pin load
-    (the gaps of the profile kept); disc: E × STIFFEN (a new factorisation); rollers: linear
-    springs of STIFFEN × the secant of their law at the mean roller load (clearance kept);
-    crankshaft: E × STIFFEN of the beam (bending and shear); support bearings (and carrier):
-    stiffness × STIFFEN. The stage shares the disc's factorisation and compliance except for the
-    disc body.
-    """
-    system = stage.first
-    case = system.case
-    influence = stage.influence
-    if component == COMPONENTS[0]:
-        k = STIFFEN * _secant_stiffness(system, "pins", stage)
-        system = dataclasses.replace(system, pin_model="linear", pin_stiffness_N_per_mm=k,
-                                     pins=models.pin_model("linear")(case, k), contact_sets={})
-    elif component == COMPONENTS[1]:
-        system = build_system(case, system.mesh, bearing_model=system.bearing_model, pin_model=system.pin_model,
-                              stiffness_scale=STIFFEN * system.stiffness_scale,
-                              pin_stiffness_N_per_mm=system.pin_stiffness_N_per_mm, geometry=system.geometry)
-    elif component == COMPONENTS[2]:
-        if system.bearing_model != "rollers":
-            raise ValueError("the roller share needs the 'rollers' bearing model")
-        k = STIFFEN * _secant_stiffness(system, "rollers", stage)
-        stiff = case.replace(crank_bearing=dataclasses.replace(case.crank_bearing, stiffness_law="linear",
-                                                               linear_stiffness_N_per_mm=k))
-        system = dataclasses.replace(system, case=stiff, bearings=models.bearing_model("rollers")(stiff),
-                                     contact_sets={})
-    elif component in COMPONENTS[3:]:
-        cs = case.crank_support
-        if cs is None or cs.influence_mm_per_N is not None or influence is None:
-            raise ValueError(f"the {component} share needs the beam keys of [crank_support]")
-        if component == COMPONENTS[3]:
-            cs = dataclasses.replace(cs, youngs_modulus=cs.youngs_modulus * STIFFEN, bending_stiffness_Nmm2=(
-                None if cs.bending_stiffness_Nmm2 is None else cs.bending_stiffness_Nmm2 * STIFFEN))
-        else:
-            scale = (lambda v: None if v is None else (v * STIFFEN if np.isscalar(v)
-                                                       else tuple(x * STIFFEN for x in v)))
-            cs = dataclasses.replace(cs, support_stiffness_N_per_mm=scale(cs.support_stiffness_N_per_mm),
-                                     carrier_stiffness_N_per_mm=scale(cs.carrier_stiffness_N_per_mm))
-        # the influence of the changed beam alone (E × 10³ is outside a case's bounds on purpose)
-        influence = crankshaft_influence(SimpleNamespace(crank_support=cs))[:stage.discs, :stage.discs]
-    else:
-        raise ValueError(f"unknown component {component!r}; known: {', '.join(COMPONENTS)}")
-    second = None if stage.second is None else system
-    return ReducerStage(system, second, stage.second_phase, influence)
-
-
-def _secant_stiffness(system, which: str, stage: ReducerStage) -> float:
-    """Secant stiffness (N/mm) of the pins' or the rollers' law at their mean load at the rated torque:
-    a stand-in scale for 'STIFFEN times stiffer'."""
-    op = OperatingPoint.of(system.case)
-    pair = solve_pair(stage, 0.0, op=op)
-    sol = pair.results[0].solution
-    zp = system.case.pins.count
-    part = slice(0, zp) if which == "pins" else slice(zp, None)
-    force, approach = sol.force[part], -sol.gap[part]          # a spring's gap is −its approach
-    loaded = (force > 1e-3 * force.max()) & (approach > 0)
-    if not loaded.any():
-        raise ValueError(f"no loaded {which} to take a secant stiffness from")
-    return float(np.sum(force[loaded]) / np.sum(approach[loaded]))
-
 
 @dataclass(frozen=True)
 class ComplianceShares:

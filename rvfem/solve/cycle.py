@@ -276,9 +276,11 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     compliance = Compliance(factor.solve, iface.B, factor.batch, None if factor.concurrent else 1, rigid_modes=rigid,
                             vertex_dofs=model.node_dofs[:model.n_vertices].ravel(),
                             rotation=rotation, order=symmetry, free=(factor.free_dofs, factor.solve_free))
-    return DiscSystem(case, mesh, model, iface, compliance, factor.solve, rigid, bearing_model,
-                      stiffness_scale, pin_model, geometry, bearing_stiffness_scale,
-                      pin_stiffness_N_per_mm, times, bearings, pins, symmetry, node_rotation)
+    return DiscSystem(case=case, mesh=mesh, model=model, interface=iface, compliance=compliance, solve=factor.solve,
+                      rigid_modes=rigid, bearing_model=bearing_model, stiffness_scale=stiffness_scale,
+                      pin_model=pin_model, geometry=geometry, bearing_stiffness_scale=bearing_stiffness_scale,
+                      pin_stiffness_N_per_mm=pin_stiffness_N_per_mm, setup_seconds=times, bearings=bearings,
+                      pins=pins, symmetry=symmetry, node_rotation=node_rotation)
 
 
 def _footprint_interface(case: Case, mesh, model, rigid: np.ndarray, column_stride: int) -> Interface:
@@ -607,8 +609,8 @@ def turn_result(system: DiscSystem, result: AngleResult, k: int,
     c, s_ = math.cos(beta), math.sin(beta)
     a = sol.rigid
     rigid = np.array([c * a[0] - s_ * a[1], s_ * a[0] + c * a[1], a[2]])
-    turned = AngleSolution(lam, vectors, M @ sol.gap, rigid, sol.carrier_rotation, sol.iterations,
-                           dict(sol.residual))
+    turned = dataclasses.replace(sol, force=lam, vectors=vectors, gap=M @ sol.gap, rigid=rigid,
+                                 residual=dict(sol.residual))
     root, k0 = result.origin if result.origin is not None else (result, 0)
     return angle_result(system, theta, turned, cset, origin=(root, k0 + k))
 
@@ -1072,7 +1074,7 @@ def build_stage(system, *, discs: int, influence: np.ndarray | None, second=None
     case = system.case
     if discs == 1:
         f = None if influence is None else np.asarray(influence, dtype=float)[:1, :1]
-        return ReducerStage(system, None, 0.0, f)
+        return ReducerStage(first=system, second=None, second_phase=0.0, influence=f)
     if discs != 2:
         raise CaseError(f"a reducer stage has one or two discs, got {discs}")
     if case.loads.discs != 2:
@@ -1083,10 +1085,10 @@ def build_stage(system, *, discs: int, influence: np.ndarray | None, second=None
     if f is not None and f.shape != (2, 2):
         raise CaseError("the crankshaft influence matrix of two discs must be 2×2")
     if second_disc == "same_as_first":
-        return ReducerStage(system, system, 0.0, f)
+        return ReducerStage(first=system, second=system, second_phase=0.0, influence=f)
     if second is None:
         raise CaseError("second_disc = 'half_pitch' needs the second disc's model (see half_pitch_case)")
-    return ReducerStage(system, second, second_disc_phase(case), f)
+    return ReducerStage(first=system, second=second, second_phase=second_disc_phase(case), influence=f)
 
 
 def single_disc_stage(system) -> ReducerStage:
