@@ -271,7 +271,14 @@ def test_report_writes_case_values_as_in_a_case_file(cli_run, summary):
     assert summary["case"]["defaults_used"]["mesh.symmetric"] is True
     assert "<code>true</code>" in table and "True" not in table
     assert "{equidistant = 0.0, shift = 0.0, rotation_deg = 0.0}" in table and "{'" not in table
-    assert "class='warnings'" not in text                # the default case warns of nothing
+    # The default case warns only where its smallest bearing load is under the makers' minimum-load
+    # rule 0.02·C (the FE lowers it below the rule), and then of nothing else.
+    codes = [w["code"] for w in summary["warnings"]]
+    minimum = summary["bearing_checks"]["minimum_load"]
+    below = any(minimum[m]["fraction_of_C"] < minimum["required_fraction_of_C"] for m in ("rigid", "flexible")
+                if minimum.get(m))
+    assert codes == (["minimum_load"] if below else [])
+    assert ("class='warnings'" in text) == below
 
 
 def test_report_states_the_reducer_stage_and_what_the_delta_depends_on(cli_run, summary):
@@ -884,7 +891,7 @@ def test_screen_gives_the_stribeck_pressure_without_roller_loads_and_stiffness_p
     rigid_bore["hertz"]["fe_rollers"] = None           # what the 'rigid_bore' bearing model gives
     text = screen.summary_text(rigid_bore)
     sf = summary["hertz"]["stribeck_flexible"]
-    assert f"FE bearing load with Stribeck Q = {sf['roller_load_N']:.0f} N" in text
+    assert f"rigid rings under the FE bearing loads Q = {sf['roller_load_N']:.0f} N" in text
     assert "N·m/arcmin per disc" in text
 
 
