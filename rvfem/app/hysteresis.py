@@ -21,7 +21,7 @@ from rvfem.app.analysis import analyse_rigid, default_cache_dir
 from rvfem.case.definition import MAX_FRICTION, Case
 from rvfem.errors import CaseError
 from rvfem.evaluate.validity import ResultWarning
-from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, accuracy_figures, mean_loop
+from rvfem.evaluate.accuracy import accuracy_figures, mean_loop
 from rvfem.geometry import disc_geometry
 from rvfem.mesh import mesh_case
 from rvfem.outputs import accuracy as files
@@ -29,6 +29,7 @@ from rvfem.outputs.summary import result_folder
 from rvfem.solve import accuracy
 from rvfem.solve.cycle import build_system, case_stage
 from rvfem.solve.stage_parts import held_in_words
+from rvfem.units import ARCSEC_PER_RAD
 
 log = logging.getLogger(__name__)
 
@@ -194,7 +195,7 @@ def _te(case: Case, stage, torque: float, friction: float, out: Path) -> dict:
     files.write_te_csv(out / "te.csv", np.degrees(thetas), no_load, loaded)
     files.te_plot(out / "plots" / "transmission_error.png", np.degrees(thetas), no_load, loaded, torque,
                   title=f"{case.name}: transmission error over one crank revolution")
-    arcsec = ARCMIN_PER_RAD * 60.0
+    arcsec = ARCSEC_PER_RAD
 
     def orders(te):
         return [{"order": k, "amplitude_arcsec": a} for k, a in accuracy.te_orders(te * arcsec, thetas, 6)]

@@ -10,6 +10,7 @@ import math
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_lines
 from rvfem.outputs.report import toml_text
+from rvfem.units import nm_from_nmm
 
 __all__ = ["SCREEN_DIGITS", "summary_text", "stage_time_lines", "rigid_text", "warning_lines", "reference_lines",
            "stress_lines"]
@@ -69,7 +70,7 @@ def _header_lines(summary: dict) -> list[str]:
          if c["overrides"] else ""),
         f"  model: bearings '{m['bearing_model']}', P{m['element_order']}, {m['nodes']} nodes, {m['dofs']} dofs, "
         f"{m['elements']} elements; {m['angles']} crank angles (step {m['angle_step_deg']:g}°)",
-        f"  torque {m['output_torque_Nm']:g} N·m on {m['discs']} discs = {m['disc_torque_Nmm'] / 1000:g} N·m per disc "
+        f"  torque {m['output_torque_Nm']:g} N·m on {m['discs']} discs = {nm_from_nmm(m['disc_torque_Nmm']):g} N·m per disc "
         f"about the disc centre; C = {m['dynamic_load_rating_N']:.0f} N, n_b = {m['bearing_speed_rpm']:g} rpm",
         "",
         f"  {'bearing':>7} {'model':<9} {'max N':>8} {'at °':>6} {'min N':>8} {'at °':>6} {'F_m N':>8} {'L10h h':>9}",
@@ -307,7 +308,7 @@ def rigid_text(report: dict) -> str:
     defined = report["references"]["handbook"]["defined"]
     lines = [
         f"Case {report['case']} ({report['source']}): {report['model']}",
-        f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {report['disc_torque_Nmm'] / 1000:g} N·m, "
+        f"  output torque {report['output_torque_Nm']:g} N·m, disc torque {nm_from_nmm(report['disc_torque_Nmm']):g} N·m, "
         f"output speed {report['output_speed_rpm']:g} rpm, bearing speed {report['bearing_speed_rpm']:g} rpm",
         f"  k = {report['k']:.4f}, k_y = {_num(report['k_y'], '.4f')}, ΣPx = {_sig(report['sum_px_N'], '.1f')} N, "
         f"ΣPy = {_sig(report['sum_py_N'], '.1f')} N, crank-angle step {report['angle_step_deg']:g}°",

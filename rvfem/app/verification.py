@@ -56,6 +56,7 @@ from rvfem.geometry import Circle, FanHole, disc_geometry, mass
 from rvfem.mesh import gmsh_session, mesh_case
 from rvfem.solve import accuracy, contact, cycle, models
 from rvfem.solve.cycle import build_system
+from rvfem.units import nmm_from_nm
 
 log = logging.getLogger(__name__)
 
@@ -517,7 +518,7 @@ def rigid_limit_section(discs: _Discs) -> Section:
     loaded = set(int(n) for n in one.pins_in_contact)
     pair_stage = cycle.build_stage(system, discs=2, influence=None)
     pair = cycle.load_cycle(system, theta, saved_angles_deg=(), stage=pair_stage)
-    T = case.loads.torque_Nm * 1000.0
+    T = nmm_from_nm(case.loads.torque_Nm)
     share = np.abs(pair.disc_torque_Nmm / (T / 2) - 1.0).max()
     e_pair = np.abs(pair.bearing_loads.T - hb.magnitude).max() / f_max
     linear = discs.system("rv40e_solid", stiffness_scale=1e3)
@@ -563,7 +564,7 @@ def invariants_section(discs: _Discs) -> tuple[Section, Section]:
     fan = discs.system("rv40e_fanholes")
     stage = cycle.case_stage(fan)
     pair = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=stage)
-    T = fan.case.loads.torque_Nm * 1000.0
+    T = nmm_from_nm(fan.case.loads.torque_Nm)
     e_carrier = np.abs(pair.disc_torque_Nmm.sum(axis=1) / T - 1.0).max()
     eq = Section("5. Equilibrium", "Every solve: pins and bearings balance on each disc; the carrier "
                  "takes the output torque.", (

@@ -59,6 +59,7 @@ from rvfem.case.schema import (
     table_error,
 )
 from rvfem.errors import CaseError
+from rvfem.units import nmm_from_nm
 
 __all__ = [
     "Case",
@@ -642,7 +643,7 @@ class Loads:
     @property
     def disc_torque_Nmm(self) -> float:
         """Torque carried by one disc, N·mm: T·1000 / discs (the handbook's T/2 for two discs)."""
-        return self.torque_Nm * 1000.0 / self.discs
+        return nmm_from_nm(self.torque_Nm) / self.discs
 
 
 MAX_FRICTION = 0.3

@@ -16,12 +16,12 @@ tooth surface and bearing wear*, section 4.4; the RV catalogues' hysteresis curv
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from rvfem.solve.accuracy import LOST_MOTION_FRACTION, loop_at_torques
+from rvfem.units import ARCMIN_PER_RAD
 
 __all__ = [
     "ARCMIN_PER_RAD",
@@ -33,7 +33,6 @@ __all__ = [
     "quick_figures",
 ]
 
-ARCMIN_PER_RAD = 180.0 * 60.0 / math.pi
 """arcmin per rad."""
 
 

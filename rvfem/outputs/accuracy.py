@@ -15,6 +15,7 @@ import numpy as np
 
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, LOST_MOTION_FRACTION
 from rvfem.outputs.plots import _figure, _save
+from rvfem.units import ARCSEC_PER_RAD
 
 __all__ = ["accuracy_report", "hysteresis_plot", "shares_plot", "te_plot", "write_loop_csv", "write_te_csv"]
 
@@ -91,7 +92,7 @@ def write_te_csv(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np
                  ) -> Path:
     """``te.csv``: crank angle (deg), the no-load (kinematic) and the loaded TE (arcsec)."""
     path = Path(path)
-    arcsec = ARCMIN_PER_RAD * 60.0
+    arcsec = ARCSEC_PER_RAD
     with path.open("w", newline="", encoding="utf-8") as f:
         w = csv.writer(f)
         w.writerow(["crank_angle_deg", "te_no_load_arcsec", "te_loaded_arcsec"])
@@ -105,7 +106,7 @@ def te_plot(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndar
     """TE over one crank revolution (one output pin pitch), each about its mean, arcsec."""
     fig = _figure((7.0, 4.0))
     ax = fig.add_subplot(111)
-    arcsec = ARCMIN_PER_RAD * 60.0
+    arcsec = ARCSEC_PER_RAD
     for te, label in ((no_load_rad, "no load (kinematic)"), (loaded_rad, f"at {torque_Nm:g} N·m")):
         te = np.asarray(te) * arcsec
         ax.plot(theta_deg, te - te.mean(), label=f"{label}: p-p {np.ptp(te):.3f} arcsec, mean {te.mean():.2f} arcsec "

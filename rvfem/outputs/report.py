@@ -32,6 +32,7 @@ from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_report
 from rvfem.solve.models import bearing_model, pin_model
+from rvfem.units import nm_from_nmm
 
 __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "report_context", "toml_text",
            "write_report"]
@@ -167,7 +168,7 @@ def _stage_assumption(summary: dict) -> list:
                     f"{share['max']:.3f} × T/2 over the cycle). ")
     else:
         text.append(f"Each of the {m['discs']} discs carries T_disc = T_out/{m['discs']} = "
-                    f"{m['disc_torque_Nmm'] / 1000:g} N·m (the handbook's equal share). ")
+                    f"{nm_from_nmm(m['disc_torque_Nmm']):g} N·m (the handbook's equal share). ")
     if rs["crank_support_rigid"]:
         return text + ["The eccentrics are rigid: the flexibility effect reported is an ", _b("upper bound"), "."]
     return text + ["Each crankshaft is a beam on two elastic support bearings (case table crank_support) carrying "

@@ -61,6 +61,7 @@ from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
 from rvfem.outputs.roller_outputs import roller_pressure_calls
 from rvfem.outputs.vtkio import vtu_name
+from rvfem.units import arcmin_from_rad
 
 log = logging.getLogger(__name__)
 
@@ -576,7 +577,7 @@ def _piece_bearings(a, ctx: SummaryContext) -> dict:
 
 def _piece_cycle(a, ctx: SummaryContext) -> dict:
     cy = a.cycle
-    arcmin = np.degrees(cy.carrier_rotation) * 60.0
+    arcmin = arcmin_from_rad(np.asarray(cy.carrier_rotation))
     return {
         "pins_in_contact": {
             "min": int(cy.pins_in_contact.min()),

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from rvfem.evaluate import strength
+from rvfem.units import arcmin_from_rad
 
 __all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
            "write_stress_history"]
@@ -150,7 +151,7 @@ def write_cycle_table(path: str | os.PathLike, theta: np.ndarray, pins_in_contac
                       carrier_rotation: np.ndarray, residual: np.ndarray, iterations: np.ndarray) -> Path:
     """Write ``cycle.csv`` (per-angle solver quantities; carrier rotation given in rad, written in
     arcmin)."""
-    arcmin = np.degrees(carrier_rotation) * 60.0
+    arcmin = arcmin_from_rad(np.asarray(carrier_rotation))
     rows = ([math.degrees(t), int(p), a, r, int(i)]
             for t, p, a, r, i in zip(theta, pins_in_contact, arcmin, residual, iterations))
     return _write(path, ["theta_deg", "pins_in_contact", "carrier_rotation_arcmin", "equilibrium_residual",

@@ -43,6 +43,7 @@ from rvfem.solve.cycle import (
     symmetry_plan,
 )
 from rvfem.solve.stage_parts import COMPONENTS, STIFFEN, stiffened_stage
+from rvfem.units import arcmin_from_rad, nm_from_nmm
 
 log = logging.getLogger(__name__)
 
@@ -182,7 +183,7 @@ MAX_SUBSTEPS = 6
 
 def _pair_torque_Nm(stage: ReducerStage, pair: PairResult) -> float:
     """The output torque a solved pair carries, N·m."""
-    return float(np.sum(pair.torque_Nmm)) / 1000.0 * stage.first.case.loads.discs / stage.discs
+    return nm_from_nmm(float(np.sum(pair.torque_Nmm))) * stage.first.case.loads.discs / stage.discs
 
 
 def _step(stage: ReducerStage, theta: float, op: OperatingPoint, start: PairResult | None,
@@ -278,7 +279,7 @@ def compliance_shares(stage: ReducerStage, theta: float, torque_Nm: float, frict
 
     def rotation(s: ReducerStage) -> float:
         r, _, _ = loop_at_torques(s, theta, torques, friction, slips)
-        return float(r[0] - r[1]) * 180.0 * 60.0 / math.pi
+        return arcmin_from_rad(float(r[0] - r[1]))
 
     a = rotation(stage)
     shares = {}

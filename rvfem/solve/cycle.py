@@ -96,6 +96,7 @@ from rvfem.solve.models import (
     contact_columns_many,
     roller_angles,
 )
+from rvfem.units import arcmin_from_rad, nm_from_nmm, nmm_from_nm
 
 log = logging.getLogger(__name__)
 
@@ -155,7 +156,7 @@ class OperatingPoint:
 
     def disc_torque_Nmm(self, case: Case) -> float:
         """The torque of one disc with the equal share T_out/discs, N·mm."""
-        return self.torque_Nm * 1000.0 / case.loads.discs
+        return nmm_from_nm(self.torque_Nm) / case.loads.discs
 
 
 @dataclass(frozen=True)
@@ -968,7 +969,7 @@ class CycleResult:
     def torsional_stiffness_Nm_per_arcmin(self, torque_Nmm: float) -> float:
         """Mean disc torque / carrier rotation, N·m/arcmin."""
         phi = float(np.mean(np.abs(self.carrier_rotation)))
-        return abs(torque_Nmm) / 1000.0 / (phi * 180.0 * 60.0 / math.pi)
+        return nm_from_nmm(abs(torque_Nmm)) / arcmin_from_rad(phi)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -1024,7 +1025,7 @@ class ReducerStage:
     def carrier_torque_Nmm(self, op: OperatingPoint) -> float:
         """Torque on the carrier from the discs modelled here at the operating point, N·mm: T_out
         for two discs, T_out/discs for one disc (the handbook's equal share)."""
-        return op.torque_Nm * 1000.0 * self.discs / self.first.case.loads.discs
+        return nmm_from_nm(op.torque_Nm) * self.discs / self.first.case.loads.discs
 
     @property
     def mirrored_pairs(self) -> bool:
