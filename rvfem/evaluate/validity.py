@@ -357,8 +357,10 @@ def _fatigue_warnings(analysis) -> tuple[ResultWarning, ...]:
 
 def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:
     """The warnings of the rigid handbook evaluation (:class:`rvfem.app.analysis.RigidAnalysis`, what
-    ``rvfem rigid`` prints): P/C and L10h of every bearing, the duty-cycle service life and the
-    Hertz pressures of Stribeck's most loaded roller. Nothing where the handbook is not defined."""
+    ``rvfem rigid`` prints): P/C and L10h of every bearing, the duty-cycle service life, the
+    Hertz pressures of the rigid rings' most loaded roller and, where the slice model ran, the
+    pressure along the roller and κ (:func:`bearing_depth_warnings`, the same code path as the
+    run's). Nothing where the handbook is not defined."""
     ratios, lives, pressures = [], [], []
     for b in rigid_analysis.bearings:
         where = f"bearing {b.loads.bearing + 1}, rigid"
@@ -370,7 +372,8 @@ def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:
         lives.append(("duty-cycle service life, rigid", rigid_analysis.duty_cycle.service_life_h))
     mat = rigid_analysis.case.material
     return check_limits(load_ratios=ratios, lives_h=lives, hertz_MPa=pressures,
-                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio))
+                        hertz_limit_MPa=hertz_pressure_limit_MPa(mat.youngs_modulus, mat.poissons_ratio)) + \
+        bearing_depth_warnings(b.depth for b in rigid_analysis.bearings if b.depth is not None)
 
 
 KAPPA_RANGE = (0.1, 4.0)
