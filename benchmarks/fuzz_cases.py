@@ -292,33 +292,26 @@ def _mutate_data(r: random.Random, data: dict, op: str | None = None) -> str:
                 parent[path[-1]] = _in_range(r, *bounds, isinstance(value, int))
                 changed += 1
         return f"{changed} numbers in range"
+    numbers = [p for p in paths if isinstance(_parent(data, p)[p[-1]], (int, float))
+               and not isinstance(_parent(data, p)[p[-1]], bool)]
     if op == "in_range":
-        numbers = [(p, _declared_range(p)) for p in paths if isinstance(_parent(data, p)[p[-1]], (int, float))
-                   and not isinstance(_parent(data, p)[p[-1]], bool)]
-        numbers = [(p, b) for p, b in numbers if b is not None]
-        if not numbers:
+        ranged = [(p, b) for p, b in ((p, _declared_range(p)) for p in numbers) if b is not None]
+        if not ranged:
             return "no-op"
-        path, (low, high) = r.choice(numbers)
+        path, (low, high) = r.choice(ranged)
         parent = _parent(data, path)
         parent[path[-1]] = _in_range(r, low, high, isinstance(parent[path[-1]], int))
         return f"in range {'.'.join(map(str, path))} = {parent[path[-1]]!r}"
-    if op == "nudge":
-        numbers = [p for p in paths if isinstance(_parent(data, p)[p[-1]], (int, float))
-                   and not isinstance(_parent(data, p)[p[-1]], bool)]
+    if op in ("nudge", "extreme", "scale"):
         if not numbers:
             return "no-op"
         path = r.choice(numbers)
         parent, key = _parent(data, path), path[-1]
+    if op == "nudge":
         factor = r.choice([0.8, 0.9, 0.95, 1.05, 1.1, 1.25])
         parent[key] = round(parent[key] * factor) if isinstance(parent[key], int) else parent[key] * factor
         return f"nudge {'.'.join(map(str, path))} = {parent[key]!r}"
     if op in ("extreme", "scale"):
-        numbers = [p for p in paths if isinstance(_parent(data, p)[p[-1]], (int, float))
-                   and not isinstance(_parent(data, p)[p[-1]], bool)]
-        if not numbers:
-            return "no-op"
-        path = r.choice(numbers)
-        parent, key = _parent(data, path), path[-1]
         if op == "extreme":
             parent[key] = r.choice(EXTREMES)
         else:

@@ -624,11 +624,7 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
     out_dir = Path(out_dir).resolve()
     cache = Path(cache_dir).resolve()
     with _removed_if_new_on(ClusterError, out_dir):   # no cluster: a new folder is not left behind
-        prepare_output_folder(out_dir, "optimise")      # a non-empty folder rvfem did not write is refused
-        try:
-            (out_dir / "trials").mkdir(exist_ok=True)
-        except OSError as exc:
-            raise OutputError(f"cannot create the folder {out_dir / 'trials'}: {exc.strerror or exc}") from None
+        prepare_output_folder(out_dir, "optimise", ("trials",))   # a non-empty folder rvfem did not write is refused
         lock = _acquire_lock(out_dir)
         try:
             _remove_partials(out_dir / "trials")

@@ -906,11 +906,7 @@ def run_study(study: Study | str | os.PathLike, out_dir: str | os.PathLike, *, s
         client = own_client = _connect(scheduler, connect_timeout_s)
     try:
         with _removed_if_new_on(ClusterError, out_dir):
-            prepare_output_folder(out_dir, "study")
-            try:
-                (out_dir / "variants").mkdir(exist_ok=True)
-            except OSError as exc:
-                raise OutputError(f"cannot create the study folder {out_dir}: {exc.strerror or exc}") from None
+            prepare_output_folder(out_dir, "study", ("variants",))
             lock = _acquire_lock(out_dir)
             try:
                 return _run_locked(study, out_dir, cache, scheduler=scheduler, workers=workers, client=client,

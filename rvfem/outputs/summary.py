@@ -215,24 +215,30 @@ def check_output_folder(out_dir: str | os.PathLike, overwrite: bool) -> None:
                 raise FolderNotEmptyError(out_dir)
 
 
-def prepare_output_folder(out_dir: str | os.PathLike, what: str) -> Path:
+def prepare_output_folder(out_dir: str | os.PathLike, what: str, subfolders: tuple[str, ...] = ()) -> Path:
     """Create ``out_dir`` (and its parents) as a folder rvfem writes into in place, with
-    :data:`RESULT_MARKER`; an existing folder is taken if it is empty or rvfem wrote it (a study or
-    optimisation folder taken up again). Returns ``out_dir``.
+    :data:`RESULT_MARKER` and the ``subfolders`` named (e.g. a study's ``variants``); an existing
+    folder is taken if it is empty or rvfem wrote it (a study or optimisation folder taken up
+    again). Returns ``out_dir``.
 
     Raises
     ------
     OutputError
-        ``out_dir`` is a file, a non-empty folder rvfem did not write, or cannot be created.
+        ``out_dir`` is a file, a non-empty folder rvfem did not write, or it or a subfolder cannot be
+        created.
     """
     out_dir = Path(out_dir)
     check_output_folder(out_dir, overwrite=True)
+    folder = out_dir
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         if not is_rvfem_folder(out_dir):
             mark_folder(out_dir, what)
+        for name in subfolders:
+            folder = out_dir / name
+            folder.mkdir(exist_ok=True)
     except OSError as exc:
-        raise OutputError(f"cannot create the folder {out_dir}: {exc.strerror or exc}") from None
+        raise OutputError(f"cannot create the folder {folder}: {exc.strerror or exc}") from None
     return out_dir
 
 
