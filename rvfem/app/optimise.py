@@ -58,7 +58,6 @@ import base64
 import contextlib
 import csv
 import html
-import io
 import json
 import logging
 import math
@@ -86,6 +85,7 @@ from rvfem.app.study import (
 from rvfem.case.definition import case_to_dict, load_case, parse_override
 from rvfem.case.schema import toml_literal
 from rvfem.errors import CaseError, OutputError, RvfemError
+from rvfem.outputs.csvfile import csv_text
 from rvfem.outputs.summary import prepare_output_folder
 
 log = logging.getLogger(__name__)
@@ -375,23 +375,9 @@ def _columns(problem: Problem) -> list[str]:
             + list(_response_keys(problem)) + ["error", "computed", "wall_time_s", "digest"])
 
 
-def _cell(value: Any) -> str:
-    if value is None:
-        return ""
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return "" if math.isnan(value) else repr(value)
-    return str(value)
-
-
 def _csv_text(problem: Problem, rows: Sequence[dict]) -> str:
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=_columns(problem), lineterminator="\n", extrasaction="ignore")
-    w.writeheader()
-    for r in rows:
-        w.writerow({k: _cell(r.get(k)) for k in _columns(problem)})
-    return buf.getvalue()
+    columns = _columns(problem)
+    return csv_text(columns, ([r.get(k) for k in columns] for r in rows), nan_as_empty=True)
 
 
 def _parse_cell(text: str) -> Any:

@@ -6,7 +6,6 @@ Matplotlib is imported only inside the plotting functions (:func:`rvfem.outputs.
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from pathlib import Path
@@ -14,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, LOST_MOTION_FRACTION
+from rvfem.outputs.csvfile import write_csv
 from rvfem.outputs.plots import _figure, _save
 from rvfem.units import ARCSEC_PER_RAD
 
@@ -26,15 +26,11 @@ def write_loop_csv(path: str | os.PathLike, torque_Nm: np.ndarray, branch: np.nd
                    angles_deg: np.ndarray, per_angle_rad: np.ndarray) -> Path:
     """``hysteresis.csv``: one row per load step: step, branch, torque (N·m), the rotation of the
     averaged loop (arcmin) and the rotation at each crank angle (arcmin)."""
-    path = Path(path)
-    with path.open("w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(["step", "branch", "torque_Nm", "rotation_arcmin"]
-                   + [f"rotation_arcmin_at_{a:g}deg" for a in angles_deg])
-        for i, (t, b, r) in enumerate(zip(torque_Nm, branch, rotation_rad)):
-            w.writerow([i, BRANCH_NAMES[int(b)], f"{t:.6g}", f"{r * ARCMIN_PER_RAD:.9g}"]
-                       + [f"{x * ARCMIN_PER_RAD:.9g}" for x in per_angle_rad[:, i]])
-    return path
+    header = (["step", "branch", "torque_Nm", "rotation_arcmin"]
+              + [f"rotation_arcmin_at_{a:g}deg" for a in angles_deg])
+    rows = ([i, BRANCH_NAMES[int(b)], t, r * ARCMIN_PER_RAD] + [x * ARCMIN_PER_RAD for x in per_angle_rad[:, i]]
+            for i, (t, b, r) in enumerate(zip(torque_Nm, branch, rotation_rad)))
+    return write_csv(path, header, rows)
 
 
 def hysteresis_plot(path: str | os.PathLike, torque_Nm: np.ndarray, branch: np.ndarray, rotation_rad: np.ndarray,
@@ -91,14 +87,9 @@ def shares_plot(path: str | os.PathLike, shares: dict, *, title: str = "") -> Pa
 def write_te_csv(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndarray, loaded_rad: np.ndarray
                  ) -> Path:
     """``te.csv``: crank angle (deg), the no-load (kinematic) and the loaded TE (arcsec)."""
-    path = Path(path)
     arcsec = ARCSEC_PER_RAD
-    with path.open("w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
-        w.writerow(["crank_angle_deg", "te_no_load_arcsec", "te_loaded_arcsec"])
-        for t, a, b in zip(theta_deg, no_load_rad, loaded_rad):
-            w.writerow([f"{t:.6g}", f"{a * arcsec:.9g}", f"{b * arcsec:.9g}"])
-    return path
+    rows = ([t, a * arcsec, b * arcsec] for t, a, b in zip(theta_deg, no_load_rad, loaded_rad))
+    return write_csv(path, ["crank_angle_deg", "te_no_load_arcsec", "te_loaded_arcsec"], rows)
 
 
 def te_plot(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndarray, loaded_rad: np.ndarray,

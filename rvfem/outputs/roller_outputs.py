@@ -7,12 +7,12 @@ describes the files.
 
 from __future__ import annotations
 
-import csv
 import os
 from pathlib import Path
 
 import numpy as np
 
+from rvfem.outputs.csvfile import write_csv
 from rvfem.outputs.plots import COLOURS, _figure, _save
 from rvfem.outputs.registry import register_writer
 
@@ -35,13 +35,9 @@ def write_roller_pressure_csv(analysis, folder: str | os.PathLike) -> list[Path]
     if not depths:
         return []
     path = Path(folder) / "roller_pressure.csv"
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(_COLUMNS)
-        for d in sorted(depths, key=lambda d: (d.bearing, d.model)):
-            for x, p in zip(d.x_mm, d.pressure_MPa):
-                writer.writerow([d.bearing + 1, d.model, d.raceway, f"{d.theta_deg:.6g}", d.roller + 1,
-                                 f"{d.roller_load_N:.6g}", f"{d.tilt_mrad:.6g}", f"{x:.6g}", f"{p:.6g}"])
+    rows = ([d.bearing + 1, d.model, d.raceway, d.theta_deg, d.roller + 1, d.roller_load_N, d.tilt_mrad, x, p]
+            for d in sorted(depths, key=lambda d: (d.bearing, d.model)) for x, p in zip(d.x_mm, d.pressure_MPa))
+    write_csv(path, _COLUMNS, rows)
     return [path]
 
 

@@ -24,7 +24,6 @@
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from pathlib import Path
@@ -32,26 +31,15 @@ from pathlib import Path
 import numpy as np
 
 from rvfem.evaluate import strength
+from rvfem.outputs.csvfile import write_csv
 from rvfem.units import arcmin_from_rad
 
 __all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
            "write_stress_history"]
 
 
-def _fmt(v) -> str:
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    return f"{float(v):.10g}"
-
-
 def _write(path: str | os.PathLike, header: list[str], rows) -> Path:
-    path = Path(path)
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        for row in rows:
-            w.writerow([_fmt(v) for v in row])
-    return path
+    return write_csv(path, header, rows)
 
 
 def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np.ndarray,
