@@ -185,7 +185,8 @@ class ChildProcess:
         """End the child process: at once if it is still running a call (whose future then fails)."""
         self._writer.shutdown(wait=False, cancel_futures=True)   # a write under way finishes
         try:
-            self._proc.stdin.close()
+            if self._proc.stdin is not None:   # always: the child is started with stdin=PIPE
+                self._proc.stdin.close()
         except OSError:
             pass
         try:
@@ -194,7 +195,8 @@ class ChildProcess:
             self._proc.kill()
             self._proc.wait()
         self._reader.join(timeout=10.0)
-        self._proc.stdout.close()
+        if self._proc.stdout is not None:      # always: stdout=PIPE
+            self._proc.stdout.close()
         self._stderr.close()
 
     def __enter__(self) -> ChildProcess:

@@ -471,7 +471,7 @@ def _sector_cut(geom: DiscGeometry) -> _Cut | None:
     rc = geom.central_hole.radius
     feats = geom.bores + geom.holes
     sizes = np.array([_feature_size(geom, f) for f in feats])
-    best = None
+    best: tuple[float, int, float, float] | None = None
     for j in range(spl.shape[0] // order):          # the tips of one sector
         tip = spl[j, 0]
         a = math.atan2(tip[1], tip[0])
@@ -481,14 +481,16 @@ def _sector_cut(geom: DiscGeometry) -> _Cut | None:
         margin = float(np.min(d / sizes))
         if best is None or margin > best[0] * (1 + 1e-9):
             best = (margin, j, a, float(d.min()))
+    assert best is not None   # a profile has tips
     margin, j, a, clearance = best
     if margin < CUT_CLEARANCE:
         log.info("meshing the whole disc: it is %d-fold symmetric, but the best sector cut (to tip %d "
                  "at %.3f°) passes %.3g mm from a feature, %.2f element sizes (needs %.2f)",
                  order, j, math.degrees(a), clearance, margin, CUT_CLEARANCE, extra=NOTICE)
         return None
-    return _Cut(order=order, tip=j, angle=a, clearance=clearance, margin=margin,
-                images=_feature_images(geom, order))
+    images = _feature_images(geom, order)
+    assert images is not None   # _symmetry_reason gave this order only if every feature has an image
+    return _Cut(order=order, tip=j, angle=a, clearance=clearance, margin=margin, images=images)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -507,9 +509,9 @@ def _add_outline(g, feature: Feature) -> list[int]:
     occ = g.model.occ
     prims = feature.outline()
     if len(prims) == 1 and isinstance(prims[0], Arc) and prims[0].sweep >= 2 * math.pi:
-        c = prims[0]
-        return [occ.addCircle(c.centre[0], c.centre[1], 0.0, c.radius,
-                              angle1=c.start_angle, angle2=c.start_angle + c.sweep)]
+        circle = prims[0]
+        return [occ.addCircle(circle.centre[0], circle.centre[1], 0.0, circle.radius,
+                              angle1=circle.start_angle, angle2=circle.start_angle + circle.sweep)]
     # shared end points: the start of every primitive (closed loop)
     starts = [_add_point(g, p.start) for p in prims]
     tags = []
@@ -699,7 +701,8 @@ def _mesh_arrays(g, surface: int, curves: dict[str, list[int]], where) -> tuple:
     """Points, counter-clockwise triangles (only the nodes they use, renumbered 0…n−1 in Gmsh's
     node order), triangle element tags and name → edges (unordered) of the given curves, read
     from the current Gmsh model."""
-    tri_tags, tri_nodes = [], []
+    tri_tags: list[np.ndarray] = []
+    tri_nodes: list[np.ndarray] = []
     types, etags, enodes = g.model.mesh.getElements(2, int(surface))
     for t, et, en in zip(types, etags, enodes):
         if t != 2:
@@ -708,7 +711,7 @@ def _mesh_arrays(g, surface: int, curves: dict[str, list[int]], where) -> tuple:
         tri_nodes.append(en)
     if not tri_tags:
         raise MeshError(f"{where}: the disc has no triangles")
-    tri_tags = np.concatenate(tri_tags)
+    tri_tag_array = np.concatenate(tri_tags)
     tri = np.concatenate(tri_nodes).astype(np.int64).reshape(-1, 3)
 
     node_tags, coords, _ = g.model.mesh.getNodes()
@@ -733,18 +736,18 @@ def _mesh_arrays(g, surface: int, curves: dict[str, list[int]], where) -> tuple:
 
     edges = {}
     for name, tags in curves.items():
-        e = []
+        parts: list[np.ndarray] = []
         for ent in tags:
             types, _, enodes = g.model.mesh.getElements(1, int(ent))
             for t, en in zip(types, enodes):
                 if t != 1:
                     raise MeshError(f"{where}: unexpected element type {t} on {name!r}")
-                e.append(en.astype(np.int64).reshape(-1, 2))
-        e = np.concatenate(e) if e else np.empty((0, 2), dtype=np.int64)
+                parts.append(en.astype(np.int64).reshape(-1, 2))
+        e = np.concatenate(parts) if parts else np.empty((0, 2), dtype=np.int64)
         if e.size and (e.max() >= len(index) or np.any(index[e] < 0)):
             raise MeshError(f"{where}: boundary {name!r} has nodes that belong to no triangle")
         edges[name] = index[e]
-    return points, triangles, tri_tags, edges
+    return points, triangles, tri_tag_array, edges
 
 
 def _extract(g, path: Path, from_cache: bool) -> DiscMesh:

@@ -73,7 +73,12 @@ from rvfem.solve.cycle import AngleLoads, build_system
 
 if TYPE_CHECKING:  # the heavier modules are imported where used
     from rvfem.evaluate.compare import Comparison
-    from rvfem.evaluate.postprocess import FieldSnapshot, PeakStress
+    from rvfem.evaluate.attribution import Attribution
+    from rvfem.evaluate.bearing_checks import BearingChecks
+    from rvfem.evaluate.postprocess import FieldSnapshot, HotSpotHistory, PeakStress, RecoveredPeak
+    from rvfem.evaluate.rigid import PinForces, References
+    from rvfem.evaluate.roller_life import BearingDepth, CrankBearingDepth
+    from rvfem.evaluate.validity import ResultWarning
     from rvfem.geometry import DiscGeometry
     from rvfem.mesh import DiscMesh
     from rvfem.solve.cycle import CycleResult, DiscSystem
@@ -432,7 +437,7 @@ class RigidBearing:
     hertz_inner: hertz.HertzLineContact
     hertz_outer: hertz.HertzLineContact
     max_roller_theta_deg: float = math.nan
-    depth: Any = None
+    depth: BearingDepth | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -483,9 +488,9 @@ class RigidAnalysis:
     exponent: float
     stribeck_factor: float
     duty_cycle: iso281.DutyCycleLife | None
-    references: rigid.References | None = None
-    warnings: tuple = ()
-    checks: Any = None
+    references: References | None = None
+    warnings: tuple[ResultWarning, ...] = ()
+    checks: BearingChecks | None = None
 
     @property
     def angle_step_deg(self) -> float:
@@ -558,7 +563,8 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None,
             max_roller_theta_deg=math.degrees(float(loads.theta[k])),
             depth=depths.get(s.bearing),
         ))
-    duty = iso281.case_duty_cycle_life(case, [b.loads.L10h for b in bearings])
+    # every L10h is set (rigid.with_rating_life)
+    duty = iso281.case_duty_cycle_life(case, [b.loads.L10h for b in bearings if b.loads.L10h is not None])
     c0 = bearing_checks.crank_bearing_static_rating(case.crank_bearing)
     checks = bearing_checks.BearingChecks(
         static={"rigid": bearing_checks.static_safety(c0, max(s.max_N for s in summaries))},
@@ -602,8 +608,8 @@ class StressResult:
     away_from_contacts: PeakStress | None
     band_mm: dict[str, float]
     snapshots: tuple[FieldSnapshot, ...]
-    recovered: Any = None
-    history: Any = None
+    recovered: RecoveredPeak | None = None
+    history: HotSpotHistory | None = None
 
     @property
     def structural(self) -> PeakStress | None:
@@ -792,7 +798,7 @@ class Analysis:
     system: DiscSystem
     theta: np.ndarray
     rigid: RigidAnalysis
-    classical: rigid.PinForces
+    classical: PinForces
     cycle: CycleResult
     comparison: Comparison
     stress: StressResult
@@ -800,12 +806,12 @@ class Analysis:
     torsional_stiffness_Nm_per_arcmin: float
     duty_cycle: DutyCycleResult | None = None
     timings: dict = field(default_factory=dict)
-    attribution: Any = None
-    references: rigid.References | None = None
-    warnings: tuple = ()
-    roller_depth: Any = None
+    attribution: Attribution | None = None
+    references: References | None = None
+    warnings: tuple[ResultWarning, ...] = ()
+    roller_depth: CrankBearingDepth | None = None
     accuracy: dict | None = None
-    bearing_checks: Any = None
+    bearing_checks: BearingChecks | None = None
 
     @property
     def max_load_index(self) -> tuple[int, int]:
@@ -1331,7 +1337,7 @@ def _bearing_checks(result: Analysis) -> bearing_checks.BearingChecks:
     bearings = result.comparison.bearings
     models_ = {"flexible": [b.flexible for b in bearings]}
     if result.rigid.defined and all(b.rigid is not None for b in bearings):
-        models_["rigid"] = [b.rigid for b in bearings]
+        models_["rigid"] = [b.rigid for b in bearings if b.rigid is not None]
     return bearing_checks.case_bearing_checks(
         result.case, result.theta, result.rigid.rating_N, result.rigid.bearing_speed_rpm,
         {m: max(s.max_N for s in v) for m, v in models_.items()},

@@ -314,6 +314,9 @@ class _Parser(argparse.ArgumentParser):
     rvfem: ``rvfem: error: MESSAGE (see rvfem COMMAND --help)``, exit code 2. (Sub-parsers are of
     the same class: argparse makes them of the main parser's.)"""
 
+    #: The parser of each subcommand, by name (set on the main parser by :func:`build_parser`).
+    subcommand_parsers: dict[str, argparse.ArgumentParser]
+
     def error(self, message: str):  # noqa: D102 - argparse's hook
         self.exit(EXIT_USER_ERROR, f"rvfem: error: {message} (see {self.prog} --help)\n")
 

@@ -20,6 +20,7 @@ from rvfem.app.commands import EXIT_OK, Subcommand
 from rvfem.app.optimise import load_problem, run_optimisation
 from rvfem.app.result_compare import (
     STATISTICS,
+    ResultFolder,
     compare_results,
     comparison_html,
     comparison_plot,
@@ -29,7 +30,7 @@ from rvfem.app.result_compare import (
     result_from_case,
 )
 from rvfem.app.study import MAX_ID_LENGTH, load_study, run_study, short_id
-from rvfem.case.definition import load_case
+from rvfem.case.definition import Case, load_case
 from rvfem.errors import CaseError
 from rvfem.outputs.summary import check_output_folder, prepare_output_folder
 
@@ -74,8 +75,9 @@ def _format_compare(c: dict, out) -> None:
     w(f"models: bearings {c['a']['bearing_model']} / {c['b']['bearing_model']}, pins {c['a']['pin_model']} / "
       f"{c['b']['pin_model']}, P{c['a']['element_order']} / P{c['b']['element_order']}, step "
       f"{c['a']['angle_step_deg']:g}° / {c['b']['angle_step_deg']:g}°\n\n")
-    if headline(c):
-        w(headline(c) + "\n\n")
+    title = headline(c)
+    if title:
+        w(title + "\n\n")
     head = f"{'bearing':>7} " + " ".join(f"{t + ' A':>10} {t + ' B':>10} {'B/A':>7}" for _, t in STATISTICS)
     w(head + "\n" + "-" * len(head) + "\n")
     for row in c["bearings"]:
@@ -103,16 +105,16 @@ def _run_compare(args: argparse.Namespace) -> int:
 
     if args.output:   # before running anything: rvfem writes only into a folder that is new, empty or its own
         check_output_folder(args.output, overwrite=True)
-    inputs = []  # validate both before running either
+    inputs: list[tuple[str, Case | ResultFolder]] = []  # validate both before running either
     for given in (args.a, args.b):
         if _is_case_file(given) and not Path(given).is_dir():
             inputs.append((given, load_case(given, args.overrides)))
         else:
             inputs.append((given, read_result(given)))
     with tempfile.TemporaryDirectory(prefix="rvfem-compare-") as tmp:
-        results = []
+        results: list[ResultFolder] = []
         for tag, (given, item) in zip("AB", inputs):
-            if hasattr(item, "summary"):
+            if isinstance(item, ResultFolder):
                 results.append(item)
             else:
                 print(f"rvfem compare: running {given} ({tag}) …", file=sys.stderr)

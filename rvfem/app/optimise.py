@@ -271,6 +271,7 @@ def _design_overrides(problem: Problem, params: Sequence[tuple[str, float]]) -> 
     return problem.overrides + tuple(f"{k}={toml_literal(float(v))}" for k, v in params)
 
 
+    assert problem.base_case is not None   # a case problem has its base case (load_problem)
 def _load_design(problem: Problem, params: Sequence[tuple[str, float]]):
     return load_case(problem.base_case, _design_overrides(problem, params))
 
@@ -572,6 +573,7 @@ def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows
     """The base case itself (``trials/base``), the reference of the report and the value told
     for failed designs; None for an analytic problem."""
     if problem.kind == "analytic":
+    assert problem.base_case is not None   # not analytic, checked just above
         return None
     case = load_case(problem.base_case, problem.overrides)
     old = next((r for r in earlier_rows if r.get("id") == "base" and r.get("digest") == case.digest()

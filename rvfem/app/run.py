@@ -398,8 +398,8 @@ def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[out
 
     written: list[Path] = []
     drawn = t_submit   # when the last writer waiting for the worker's drawings had them
-    for stage, group in itertools.groupby(registered, key=lambda w: w.stage):
-        group = list(group)
+    for stage, stage_writers in itertools.groupby(registered, key=lambda w: w.stage):
+        group = list(stage_writers)
         waits = any("pending" in w.options for w in group)
         if meanwhile is not None and waits:
             meanwhile()

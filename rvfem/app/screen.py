@@ -278,6 +278,7 @@ def stress_lines(stress: dict) -> list[str]:
     lines = []
     sp, away, cz = stress.get("structural_peak"), stress.get("away_from_contacts"), stress["contact_zone"]
     if sp:
+        assert away is not None   # a structural peak comes with the cycle's envelope
         at = sp["at"]
         lines += [
             f"  structural stress peak (away from contacts) {_sig(sp['von_mises_MPa'], '.0f')} MPa von Mises ± "

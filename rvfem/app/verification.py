@@ -564,6 +564,7 @@ def invariants_section(discs: _Discs) -> tuple[Section, Section]:
     fan = discs.system("rv40e_fanholes")
     stage = cycle.case_stage(fan)
     pair = cycle.load_cycle(fan, theta, saved_angles_deg=(), stage=stage)
+    assert pair.disc_torque_Nmm is not None   # a stage's cycle has the disc torques
     T = nmm_from_nm(fan.case.loads.torque_Nm)
     e_carrier = np.abs(pair.disc_torque_Nmm.sum(axis=1) / T - 1.0).max()
     eq = Section("5. Equilibrium", "Every solve: pins and bearings balance on each disc; the carrier "
@@ -757,6 +758,7 @@ def clearance_section(discs: _Discs) -> Section:
     pre_case = _case("rv40e_solid", "crank_bearing.radial_clearance=-0.005", "loads.torque_Nm=0.001")
     pre = dataclasses.replace(stiff, case=pre_case, bearings=models.bearing_model("rollers")(pre_case, 1.0))
     rollers = cycle.solve_angle(pre, 0.3).roller_loads
+    assert rollers is not None   # the 'rollers' bearing model
     b = pre_case.crank_bearing
     q = (0.0025 * b.roller_length**0.8 / (2 * contact.PALMGREN_COEFFICIENT)) ** (1 / 0.9)
     # a 20 µm clearance on the flexible disc: every angle carries the torque (rvfem 0.3 lost it)
@@ -870,7 +872,7 @@ def accuracy_section(discs: _Discs) -> Section:
                    "turns the eccentrics about the disc centre (docs/theory.md § 9b).", checks)
 
 
-def _loop_arrays(loop) -> tuple:
+def _loop_arrays(loop) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return loop.torque_Nm, loop.rotation_rad, loop.branch
 
 

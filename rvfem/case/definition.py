@@ -511,7 +511,7 @@ BUILTIN_HOLE_TABLES = ("fan_holes", "round_holes")
 """The hole tables that are fields of :class:`Case`, in the order their holes are numbered."""
 
 _BUILTIN_HOLE_CLASSES = {"fan_holes": FanHoles, "round_holes": RoundHoles}
-_HOLE_SHAPES: dict[str, type] = {}
+_HOLE_SHAPES: dict[str, type[Any]] = {}
 
 
 def register_hole_table(shape: type) -> None:
@@ -540,7 +540,7 @@ def register_hole_table(shape: type) -> None:
         raise ValueError(f"{name!r} is a table of the case format already")
     if _HOLE_SHAPES.get(name, shape) is not shape:
         raise ValueError(f"the hole table {name!r} is registered by {_HOLE_SHAPES[name].__qualname__} already")
-    if not (isinstance(table, type) and dataclasses.is_dataclass(table) and table.__dataclass_params__.frozen):
+    if not (isinstance(table, type) and dataclasses.is_dataclass(table) and getattr(table, "__dataclass_params__").frozen):
         raise TypeError(f"the table of hole shape {name!r} must be a frozen dataclass, got {table!r}")
     file_fields(table)     # every key declared with param (raises TypeError otherwise)
     if not hasattr(table, "outline_length"):
@@ -562,7 +562,7 @@ def hole_table_names() -> tuple[str, ...]:
     return tuple(dict.fromkeys([*BUILTIN_HOLE_TABLES, *_HOLE_SHAPES]))
 
 
-def registered_hole_shapes() -> tuple[type, ...]:
+def registered_hole_shapes() -> tuple[type[Any], ...]:
     """The registered hole shapes, in the order of :func:`hole_table_names`."""
     return tuple(_HOLE_SHAPES[name] for name in hole_table_names() if name in _HOLE_SHAPES)
 
@@ -888,7 +888,7 @@ class Case:
         builtin = tuple((name, getattr(self, name)) for name in BUILTIN_HOLE_TABLES if getattr(self, name) is not None)
         return builtin + self.other_holes
 
-    def hole_shapes(self) -> tuple[tuple[type, Any], ...]:
+    def hole_shapes(self) -> tuple[tuple[type[Any], Any], ...]:
         """``(hole shape, table)`` of every hole table the case has, in the order of
         :meth:`hole_tables` (the shapes are :class:`rvfem.geometry.holes.HoleShape` classes,
         registered when :mod:`rvfem.geometry` is imported).
@@ -1117,7 +1117,7 @@ def _check_mesh(case: Case) -> None:
         by_key = {k: v for k, v in parts.items() if k != "total"}
         if case.mesh.size_hole is None:   # the hole size follows size_bore
             by_key["mesh.size_bore"] += by_key.pop("mesh.size_hole")
-        worst = max(by_key, key=by_key.get)
+        worst = max(by_key, key=by_key.__getitem__)
         raise _error(case, worst,
                      f"asks for too fine a mesh: about {parts['total']:.3g} "
                      f"{'P2 ' if case.analysis.element_order == 2 else ''}nodes estimated "
@@ -1225,6 +1225,7 @@ def _check_crank_support(case: Case) -> None:
         if getattr(s, name) is None:
             raise _error(case, key + name, "is missing (required for the beam model; or give 'influence_mm_per_N')")
     positions = s.eccentric_positions
+    assert positions is not None and s.span is not None   # both checked just above
     if len(positions) != discs:
         raise _error(case, key + "eccentric_positions",
                      f"must list {discs} positions (loads.discs), got {len(positions)}")
@@ -1298,7 +1299,7 @@ def _check_lubricant(case: Case) -> None:
         raise _error(case, "lubricant.iso_vg", f"= {oil.iso_vg} and 'lubricant.nu40'/'lubricant.nu100' "
                      f"({oil.nu40:g}/{oil.nu100:g} mm²/s) are both given: give the grade or the two viscosities, "
                      "not both")
-    if oil.nu40 is not None and oil.nu100 >= oil.nu40:
+    if oil.nu40 is not None and oil.nu100 is not None and oil.nu100 >= oil.nu40:
         raise _error(case, "lubricant.nu100", f"({oil.nu100:g} mm²/s) must be below 'lubricant.nu40' "
                      f"({oil.nu40:g} mm²/s): an oil thins as it warms")
 

@@ -27,6 +27,7 @@ itself, in a class attribute ``requires``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 __all__ = [
     "ModelName",
@@ -66,12 +67,12 @@ BUILTIN_MODELS: dict[str, tuple[ModelName, ...]] = {
 """The built-in models of each kind (``"bearing"``, ``"pin"``), the one place their names are declared;
 their classes are in :mod:`rvfem.solve.models`."""
 
-_BEARINGS: dict[str, type] = {}
-_PINS: dict[str, type] = {}
+_BEARINGS: dict[str, type[Any]] = {}
+_PINS: dict[str, type[Any]] = {}
 _KINDS = {"bearing": _BEARINGS, "pin": _PINS}
 
 
-def _register(kind: str, cls: type) -> type:
+def _register(kind: str, cls: type[Any]) -> type[Any]:
     if cls.__module__.split(".")[0] == "rvfem" and cls.name not in builtin_model_names(kind):
         raise ValueError(f"{cls.__qualname__}: the {kind} model {cls.name!r} is rvfem's own but not declared in "
                          "rvfem.case.registry.BUILTIN_MODELS; declare its name (and the keys it requires) there")

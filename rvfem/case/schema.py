@@ -136,7 +136,14 @@ class FieldSpec:
     param: Param
     kind: str
     optional: bool
-    item: type | None = None
+    item: type[Any] | None = None
+
+    @property
+    def table(self) -> type[Any]:
+        """The dataclass of a table kind (``"table"``, ``"tables"``)."""
+        if self.item is None:
+            raise TypeError(f"the case-file key {self.name!r} is a {self.kind}, not a table")
+        return self.item
 
     @property
     def required(self) -> bool:
@@ -154,7 +161,7 @@ class FieldSpec:
         return None
 
 
-def _kind(hint: Any) -> tuple[str, bool, type | None]:
+def _kind(hint: Any) -> tuple[str, bool, Any]:
     optional = False
     args = typing.get_args(hint)
     if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union:
@@ -420,14 +427,14 @@ def read_table(cls: type, data: Any, prefix: str, source: str, values: dict[str,
                            else f"is missing ({what})")
             value = spec.default(values)
         elif spec.kind == "table":
-            value = read_table(spec.item, data[spec.name], key, source, values, explain=explain)
+            value = read_table(spec.table, data[spec.name], key, source, values, explain=explain)
         elif spec.kind == "tables":
             rows = data[spec.name]
             if not isinstance(rows, list):
                 raise fail(key, f"must be an array of tables ([[{key}]])")
             if spec.param.max_length is not None and len(rows) > spec.param.max_length:
                 raise fail(key, f"must have at most {spec.param.max_length} rows, got {len(rows)}")
-            value = tuple(read_table(spec.item, row, f"{key}[{i}]", source, values, explain=explain)
+            value = tuple(read_table(spec.table, row, f"{key}[{i}]", source, values, explain=explain)
                           for i, row in enumerate(rows))
         else:
             value = check_value(spec, data[spec.name], key, fail)
@@ -456,12 +463,12 @@ def check_fields(obj: Any, prefix: str, source: str) -> None:
         if spec.kind == "table":
             if value is None and spec.optional:
                 continue
-            if not isinstance(value, spec.item):
-                raise fail(key, f"must be a {spec.item.__name__}, got {_short(value)}")
+            if not isinstance(value, spec.table):
+                raise fail(key, f"must be a {spec.table.__name__}, got {_short(value)}")
             check_fields(value, key, source)
         elif spec.kind == "tables":
-            if not isinstance(value, (list, tuple)) or not all(isinstance(v, spec.item) for v in value):
-                raise fail(key, f"must be a sequence of {spec.item.__name__}, got {_short(value)}")
+            if not isinstance(value, (list, tuple)) or not all(isinstance(v, spec.table) for v in value):
+                raise fail(key, f"must be a sequence of {spec.table.__name__}, got {_short(value)}")
             if spec.param.max_length is not None and len(value) > spec.param.max_length:
                 raise fail(key, f"must have at most {spec.param.max_length} rows, got {len(value)}")
             for i, row in enumerate(value):

@@ -61,8 +61,8 @@ class AccuracyFigures:
     lost_motion_arcmin: float
     hysteresis_loss_arcmin: float
     backlash_arcmin: float
-    rigidity_points: tuple
-    lost_motion_points: tuple
+    rigidity_points: tuple[tuple[float, float], tuple[float, float]]
+    lost_motion_points: tuple[tuple[float, float], tuple[float, float]]
 
     def as_dict(self) -> dict:
         """The four figures under their summary keys."""

@@ -237,9 +237,9 @@ class BearingChecks:
         Why there are no support loads, or why there is no support life; "" when both are there.
     """
 
-    static: dict
-    minimum: dict
-    support: tuple | None
+    static: dict[str, StaticSafety]
+    minimum: dict[str, MinimumLoad]
+    support: tuple[SupportBearing, ...] | None
     support_note: str
 
 

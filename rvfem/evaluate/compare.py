@@ -141,6 +141,7 @@ def rigid_vs_flexible(case: Case, result: CycleResult) -> Comparison:
     bearings = []
     for i, (r, f, e) in enumerate(zip(rs, fs, es)):
         ref = r if refs.bearing_loads == "handbook" else e
+        assert ref is not None   # the handbook is the reference only where it is defined
         bearings.append(BearingComparison(
             bearing=i, rigid=r, flexible=f, equal_share=e,
             delta_max_percent=100.0 * (f.max_N / ref.max_N - 1.0),

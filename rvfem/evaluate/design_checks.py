@@ -11,9 +11,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from rvfem.evaluate import strength
 from rvfem.geometry.mass import MassProperties, disc_mass_properties
+
+if TYPE_CHECKING:   # for the annotations only: postprocess is a heavier module of the same layer
+    from rvfem.evaluate.postprocess import PeakStress
 
 __all__ = ["DesignChecks", "design_checks", "finite_or_none"]
 
@@ -39,8 +43,8 @@ class DesignChecks:
     mass: MassProperties
     static_safety_factor: float | None
     static_peak_MPa: float | None
-    static_peak: object
-    fatigue: tuple
+    static_peak: PeakStress | None
+    fatigue: tuple[strength.HotSpotFatigue, ...]
     yield_strength_MPa: float
 
     @property

@@ -459,13 +459,15 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     points = np.asarray(points, dtype=float)
     mask = _mask(points, boundaries, exclude)
     candidates = np.flatnonzero(mask)
-    best = None
+    best: tuple[float, int, int, np.ndarray] | None = None
     for k, u in zip(ks, displacements(system_p2, [cycle.solutions[k] for k in ks])):
         g = fem.displacement_gradients(model, u)
         vm = fem.stress_fields(model, u, gradients=g).nodal.von_mises
         v = int(candidates[first_max(vm[candidates])[0]])
         if best is None or vm[v] > best[0] * (1.0 + TIE_RTOL):   # the first of equal peaks
             best = (float(vm[v]), v, k, g)
+    if best is None:
+        raise ValueError("no crank angle to recover the peak at")
     value, vertex, k, g = best
     # the spread of the P2 element stresses at the peak vertex around their average
     g = g[:, :, :, :3]                                           # (2, 2, n_elements, 3 vertices)
@@ -477,6 +479,7 @@ def recover_peak(system_p2, cycle, angles, points: np.ndarray, boundaries: dict[
     envelope[vertex] = value
     peak = peak_von_mises(StressEnvelope(envelope, np.full(len(points), float(cycle.theta[k]))), points,
                           boundaries)
+    assert peak is not None   # the envelope is finite at the peak vertex
     p1_here = _p1_stress(system_p1, cycle, k, vertex) if system_p1 is not None else math.nan
     return RecoveredPeak(
         peak=peak,

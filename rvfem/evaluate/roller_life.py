@@ -446,7 +446,8 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
     slopes = eccentric_slopes(case, cycle)
     misalignment = 1e-3 * case.crank_bearing.profile.misalignment_mrad
     tilts = roller_tilts(slopes, cycle.roller_angles, cycle.bearing_forces, misalignment)
-    flexible, cache = [], {}
+    flexible: list[BearingDepth] = []
+    cache: dict = {}
     have_rigid = isinstance(rigid_forces, np.ndarray) and np.all(np.isfinite(rigid_forces))
     steps = len(comparison.bearings) + int(have_rigid and rigid_depths is None)
     for bc in comparison.bearings:

@@ -517,7 +517,7 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
                         reduced_radius_mm=reduced_radius_mm)
     g = (tilt_rad * x - drop)[None, :]
     widths = np.full(n, b_nom)
-    q = None
+    q: np.ndarray | None = None
     for _ in range(local_width_iterations + 1):
         c = rectangle_influence(x, dx, b_nom, composite_modulus_MPa, half_heights_mm=widths)
         p, delta = solve_slices(c, 2.0 * widths * dx, g, np.array([load_N]))
@@ -528,6 +528,7 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
             break
         _, b_local = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
         widths = np.maximum(b_local, 0.2 * b_nom)
+    assert q is not None   # the loop runs at least once
     ph, b = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
     nominal, _ = hertz_peak_from_line_load(load_N / length_mm, reduced_radius_mm, composite_modulus_MPa)
     k = int(np.argmax(ph))

@@ -35,8 +35,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:   # for the annotations only: postprocess is a heavier module of the same layer
+    from rvfem.evaluate.postprocess import PeakStress
 
 __all__ = [
     "signed_von_mises",
@@ -116,7 +120,7 @@ class HotSpotFatigue:
     """
 
     name: str
-    peak: object
+    peak: PeakStress
     amplitude_MPa: float
     mean_MPa: float
     max_MPa: float

@@ -91,8 +91,8 @@ def crankshaft_beam(cs) -> tuple[float, float | None, tuple[float, float]]:
             shear = kappa * E / (2.0 * (1.0 + nu)) * math.pi * d * d / 4.0
     ks = cs.support_stiffness_pair
     kc = cs.carrier_stiffness_pair
-    compliance = tuple((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
-    return EI, shear, compliance
+    c1, c2 = ((1.0 / ks[i] if ks[i] else 0.0) + (1.0 / kc[i] if kc[i] else 0.0) for i in range(2))
+    return EI, shear, (c1, c2)
 
 
 def crankshaft_influence(case) -> np.ndarray | None:

@@ -295,7 +295,7 @@ def _footprint_arcs(
         if (a >= 0.5 * length).any():
             raise ValueError("footprint half-width must be less than half the loop length")
         c = np.mod(c, length)
-        shifts = (-length, 0.0, length)
+        shifts: tuple[float, ...] = (-length, 0.0, length)
     else:
         if (c - a < -1e-12 * length).any() or (c + a > length * (1 + 1e-12)).any():
             raise ValueError("footprint runs off the end of an open boundary chain")

@@ -32,7 +32,7 @@ import logging
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Literal
 
 import numpy as np
 import scipy.sparse as sp
@@ -176,7 +176,7 @@ _C_ORDER = frozenset({"cholespy"})
 #: Right-hand sides per call, by backend (see :class:`Factorization`); 16 for the others.
 _SOLVE_BATCH = {"cholespy": 8}
 
-_FACTORIZERS = {"superlu": _factor_superlu, "cholmod": _factor_cholmod, "cholespy": _CholespyFactor,
+_FACTORIZERS: dict[str, Callable[[sp.csc_matrix], Callable[[np.ndarray], np.ndarray]]] = {"superlu": _factor_superlu, "cholmod": _factor_cholmod, "cholespy": _CholespyFactor,
                 "pardiso": _factor_pardiso}
 
 
@@ -230,7 +230,7 @@ class Factorization:
         numpy.ndarray
             Displacements, mm, shaped like ``rhs`` (dense).
         """
-        b = rhs.toarray() if sp.issparse(rhs) else np.asarray(rhs, dtype=np.float64)
+        b = rhs.toarray() if sp.issparse(rhs) else np.asarray(rhs, dtype=np.float64)  # type: ignore[union-attr]  # issparse narrows to a sparse matrix, unseen by mypy
         if b.shape[0] != self.n_dofs or b.ndim > 2:
             raise ValueError(f"rhs must have shape ({self.n_dofs},) or ({self.n_dofs}, m), got {b.shape}")
         u = np.zeros(b.shape)
@@ -239,7 +239,7 @@ class Factorization:
         # the free DOFs are a few contiguous runs between the support DOFs: copied run by run
         # (fancy indexing of a block of right-hand sides costs as much as a quarter of its solve)
         runs = self._free_runs
-        order = "C" if self.solver in _C_ORDER else "F"     # the backend's own layout: no copies
+        order: Literal["C", "F"] = "C" if self.solver in _C_ORDER else "F"     # the backend's own layout: no copies
         free = np.empty((len(self.free_dofs),) + b.shape[1:], order=order)
         for (lo, hi), at in runs:
             free[at:at + hi - lo] = b[lo:hi]
@@ -251,7 +251,7 @@ class Factorization:
     def solve_free(self, b_free: np.ndarray) -> np.ndarray:
         """``K_ff⁻¹ b_free`` on the free DOFs alone (``(len(free_dofs),)`` or ``(len(free_dofs), m)``),
         without the copies into and out of the whole DOF numbering that :meth:`solve` makes."""
-        order = "C" if self.solver in _C_ORDER else "F"
+        order: Literal["C", "F"] = "C" if self.solver in _C_ORDER else "F"
         b = np.asarray(b_free, dtype=np.float64, order=order)
         return np.asarray(self._solve(b)).reshape(b.shape)
 

@@ -20,6 +20,7 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -119,7 +120,7 @@ def _vertex_weights(model: FEModel) -> tuple[np.ndarray, np.ndarray]:
     return w, denom
 
 
-def nodal_stress_operator(model: FEModel, vertices: np.ndarray | None = None) -> sp.csr_matrix:
+def nodal_stress_operator(model: FEModel, vertices: np.ndarray | Sequence[int] | None = None) -> sp.csr_matrix:
     """The linear map from displacements to the vertex stresses of :func:`stress_fields`.
 
     ``S @ u`` stacks (σxx, σyy, σxy) at the mesh vertices — area-averaged element values, exactly
@@ -144,7 +145,7 @@ def nodal_stress_operator(model: FEModel, vertices: np.ndarray | None = None) ->
     t = model.mesh.t
     nv = model.n_vertices
     row_of = np.arange(nv)
-    elements = slice(None)
+    elements: slice | np.ndarray = slice(None)
     if vertices is not None:
         vertices = np.asarray(vertices, dtype=np.int64).ravel()
         distinct, which = np.unique(vertices, return_inverse=True)

@@ -193,7 +193,9 @@ class Feature(Protocol):
         ``"bore_0"``, ``"hole_2"``.
     """
 
-    name: str
+    @property
+    def name(self) -> str:   # read-only: a frozen dataclass's field satisfies it
+        """Name of the feature and of its mesh boundary."""
 
     def validate(self) -> None:
         """Raise :class:`~rvfem.errors.GeometryError` (naming the feature and the case key to
@@ -460,13 +462,14 @@ class HoleContext:
 def _wall(a, b) -> Wall:
     """Thinnest wall between features a and b: min over dense points on a's outline of b's exact
     signed distance (and the other way round)."""
-    best = None
+    best: tuple[float, tuple[float, float]] | None = None
     for f, g in ((a, b), (b, a)):
         pts = f.sample(max(WALL_SPACING, f.sampling_length / WALL_SAMPLES))
         d = g.signed_distance(pts)
         i = int(np.argmin(d))
         if best is None or d[i] < best[0]:
             best = (float(d[i]), (float(pts[i, 0]), float(pts[i, 1])))
+    assert best is not None   # the loop runs twice
     return Wall(a.name, b.name, best[0], best[1])
 
 

@@ -249,6 +249,7 @@ def _fan_holes(case: Case, fan: FanHoles, context: HoleContext) -> list[FanHole]
         _fan_hole(context.name(0), fan, angles[0], math.pi / fan.count).validate()   # raises the message
     # span from the ligament: the widest hole whose wall to every bore is ≥ ligament
     L = fan.ligament
+    assert L is not None   # the span is given by span_deg or by the ligament (checked with the case)
 
     def wall(half_span: float, angle: float) -> float:
         return _hole_bore_wall(_fan_hole("probe", fan, angle, half_span), bores)

@@ -191,7 +191,7 @@ def _base_curve(R: float, e: float, a: float, r: float, s: np.ndarray):
     return T + 1j * r * t, T1 + 1j * r * t1, T2 + 1j * r * t2
 
 
-def trochoid_curvature(R: float, e: float, a: float, s: np.ndarray) -> np.ndarray:
+def trochoid_curvature(R: float, e: float, a: float, s: float | np.ndarray) -> np.ndarray:
     """Signed curvature of the pin-centre trochoid T(s) = R·u(s) − e·u(a·s), 1/mm.
 
     κ_T = [1 + a·k² − (a + 1)·k·cos ψ] / (R·(1 + k² − 2k·cos ψ)^{3/2}),  k = a·e/R,  ψ = (a − 1)·s,

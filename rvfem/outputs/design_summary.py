@@ -11,16 +11,14 @@ import math
 from typing import Any
 
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
-from rvfem.evaluate.postprocess import feature_label, user_feature_label, user_feature_name
+from rvfem.evaluate.postprocess import PeakStress, feature_label, user_feature_label, user_feature_name
 from rvfem.evaluate.strength import FATIGUE_CRITERION, fatigue_field
 
 __all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
            "fatigue_point_data"]
 
 
-def _where(peak) -> dict | None:
-    if peak is None:
-        return None
+def _where(peak: PeakStress) -> dict[str, Any]:
     return {"x_mm": peak.x_mm, "y_mm": peak.y_mm, "theta_deg": peak.theta_deg,
             "feature": None if peak.feature is None else user_feature_name(peak.feature),
             "feature_label": None if peak.feature is None else feature_label(peak.feature)}
@@ -49,7 +47,7 @@ def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
             "ultimate_strength_MPa": material.ultimate_strength,
             "fatigue_limit_MPa": material.fatigue_limit,
             "static_peak_von_mises_MPa": checks.static_peak_MPa,
-            "static_peak_at": _where(checks.static_peak),
+            "static_peak_at": None if checks.static_peak is None else _where(checks.static_peak),
             "fatigue_criterion": FATIGUE_CRITERION,
             "fatigue_hot_spots": [{
                 "name": f.name, "at": _where(f.peak), "amplitude_MPa": f.amplitude_MPa, "mean_MPa": f.mean_MPa,

@@ -57,18 +57,19 @@ def key_field_angles(summary: dict, case: Case) -> list[float]:
     nearest kept field), the angle of the largest bearing load and the angles of the stress peaks.
     The images of further angles (``--field-step``) are linked: a report with every image of a
     10° step embedded weighs about 19 MB."""
-    fields = [f["theta_deg"] for f in summary.get("fields", [])]
+    fields: list[float] = [f["theta_deg"] for f in summary.get("fields", [])]
     wanted = [summary["max_bearing_load"]["theta_deg"]]
     st = summary["stress"]
     for entry in (st.get("structural_peak"), st.get("away_from_contacts"), st.get("contact_zone")):
         if entry:
             wanted.append(entry["at"]["theta_deg"])
-    key = set()
+    key: set[float] = set()
     for a in wanted:
         key.add(round(a, 6))
     for a in case.analysis.saved_angles_deg:
         if fields:
-            key.add(round(min(fields, key=lambda t: abs((t - a + 180.0) % 360.0 - 180.0)), 6))
+            nearest = min(fields, key=lambda t: abs((t - a + 180.0) % 360.0 - 180.0))
+            key.add(round(nearest, 6))
     return sorted(key)
 
 
@@ -228,7 +229,7 @@ def assumptions(summary: dict, case: Case) -> list[str | list]:
     m = summary["model"]
     handbook = summary["references"]["bearing_loads"] == "handbook"
     overrides = summary["case"].get("overrides") or {}
-    stated = ([f"Values set on top of the case file (overrides): "
+    stated: list[str | list] = ([f"Values set on top of the case file (overrides): "
                f"{', '.join(f'{k} = {toml_text(v)}' for k, v in overrides.items())}; case.json holds every "
                "value used."]
               if overrides else [])
@@ -317,12 +318,13 @@ def _stress_rows(stress: dict) -> list[list]:
     """The rows of the stress peaks: structural (P2 re-solve, with its convergence check), the P1
     envelope's, the contact zone's."""
     sp, away, cz = stress.get("structural_peak"), stress.get("away_from_contacts"), stress["contact_zone"]
-    rows = []
+    rows: list[list] = []
     if sp:
         a_ = sp["at"]
         rows += [
             [[_b("structural stress peak"), " (away from contacts, P2 re-solve)"],
              [_b(f"{sp['von_mises_MPa']:.1f} MPa"), f" ± {sp['estimated_error_MPa']:.1f} MPa estimated "
+        assert away is not None   # a structural peak comes with the cycle's envelope
               f"({sp['estimated_error_percent']:.1f} %), at ({a_['x_mm']:.2f}, {a_['y_mm']:.2f}) mm, {_where(a_)}, "
               f"θ = {a_['theta_deg']:g}°"]],
             ["convergence check of the structural peak",

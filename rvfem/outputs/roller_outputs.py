@@ -8,10 +8,12 @@ describes the files.
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
 
+from rvfem.evaluate.roller_life import BearingDepth
 from rvfem.outputs.csvfile import write_csv
 from rvfem.outputs.plots import COLOURS, _figure, _save
 from rvfem.outputs.registry import register_writer
@@ -52,11 +54,11 @@ def _same_curve(a, b) -> bool:
                 abs(a.roller_load_N - b.roller_load_N) <= 1e-6 * max(abs(a.roller_load_N), 1e-300))
 
 
-def roller_pressure_curves(depths) -> list[tuple[str, object]]:
+def roller_pressure_curves(depths: Iterable[BearingDepth]) -> list[tuple[str, BearingDepth]]:
     """The curves of ``roller_pressure.png``: (legend label, depth drawn) per model and run of
     bearings whose curves are the same (:func:`_same_curve`), which would be drawn over each
     other: one curve labelled ``bearings 1–3 (identical) …`` with the crank angle of each."""
-    curves: list[tuple[list, object]] = []
+    curves: list[tuple[list[BearingDepth], BearingDepth]] = []
     for d in sorted(depths, key=lambda d: (d.model, d.bearing)):
         if curves and curves[-1][1].model == d.model and _same_curve(curves[-1][1], d):
             curves[-1][0].append(d)
@@ -73,7 +75,7 @@ def roller_pressure_curves(depths) -> list[tuple[str, object]]:
     return out
 
 
-def roller_pressure_plot(path: str | os.PathLike, depths, profile: str) -> Path:
+def roller_pressure_plot(path: str | os.PathLike, depths: Iterable[BearingDepth], profile: str) -> Path:
     """Draw p(x) of the worst roller of every bearing and model (rigid dashed, flexible solid);
     bearings with the same curve share one, labelled so (:func:`roller_pressure_curves`)."""
     curves = roller_pressure_curves(depths)

@@ -477,7 +477,7 @@ def environment() -> dict:
     (:func:`command_line`), Python, the platform and the versions of
     :data:`VERSIONED_PACKAGES` (None if not installed)."""
 
-    versions = {}
+    versions: dict[str, str | None] = {}
     for name in VERSIONED_PACKAGES:
         try:
             versions[name] = metadata.version(name)
@@ -971,7 +971,7 @@ def _image_set(analysis, images: Path) -> _ImageSet:
                   f"×{magnification:g}   bearings '{case.crank_bearing.model}', P{model.order}",
         )
 
-    stress = []
+    stress: list[tuple[Path, Any, dict[str, Any]]] = []
     for snap in snapshots:
         label = "  (max. bearing load)" if snap.index == k_max else ""
         stress.append((images / _stress_image_name(snap.theta_deg), scene(snap, label), {}))
@@ -1178,7 +1178,7 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
     classical = None if a.classical is None else a.classical.magnitude
     handbook = a.comparison.reference == "handbook"
     label = "rigid (handbook)" if handbook else "equal share of the FE pin resultant"
-    calls = [(plots.bearing_loads_plot, dict(
+    calls: list[tuple[Callable, dict]] = [(plots.bearing_loads_plot, dict(
         path=folder / "bearing_loads.png", theta=th, flexible=cy.bearing_loads, rigid=a.reference_loads,
         reference_label=label,
         title=f"{case.name}: crank-bearing loads, flexible (FE, '{case.crank_bearing.model}') vs "

@@ -99,7 +99,7 @@ def _compressed(block, level: int, strategy: int) -> bytes:
 def _encoded(data: np.ndarray, level: int, strategy: int) -> str:
     """An array as the text of a binary, zlib-compressed ``DataArray`` (VTK's block header, UInt32,
     then the compressed blocks, each base64-encoded)."""
-    raw = memoryview(np.ascontiguousarray(data)).cast("B")
+    raw = memoryview(np.ascontiguousarray(data).data).cast("B")
     n = len(raw)
     blocks = [_compressed(raw[i:i + _BLOCK_BYTES], level, strategy) for i in range(0, n, _BLOCK_BYTES)]
     last = n - (len(blocks) - 1) * _BLOCK_BYTES if blocks else 0

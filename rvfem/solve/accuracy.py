@@ -30,6 +30,7 @@ import dataclasses
 import logging
 import math
 from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -147,8 +148,8 @@ def _slip(torque_from: float, torque_to: float) -> int:
     return 1 if torque_to >= torque_from else -1
 
 
-def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, friction: float,
-                    slips: np.ndarray | None = None, start: PairResult | None = None, start_torque=...,
+def loop_at_torques(stage: ReducerStage, theta: float, torques: Sequence[float] | np.ndarray, friction: float,
+                    slips: Sequence[int] | np.ndarray | None = None, start: PairResult | None = None, start_torque=...,
                     g_cache: dict | None = None) -> tuple[np.ndarray, np.ndarray, list[PairResult]]:
     """Solve the stage at crank angle θ (rad) at each torque in turn (N·m), each step started from
     the step before it (the first from ``start``, if given), with the pins' friction ``friction``
@@ -163,8 +164,9 @@ def loop_at_torques(stage: ReducerStage, theta: float, torques: np.ndarray, fric
     """
     torques = np.asarray(torques, dtype=float)
     if slips is None:
-        slips = [_slip(a, b) for a, b in zip(np.concatenate([[0.0], torques[:-1]]), torques)]
-        slips[0] = 1 if torques[0] >= 0 else -1
+        loading = [_slip(a, b) for a, b in zip(np.concatenate([[0.0], torques[:-1]]), torques)]
+        loading[0] = 1 if torques[0] >= 0 else -1
+        slips = loading
     cache = {} if g_cache is None else g_cache
     pairs: list[PairResult] = []
     before = None if start is None else (_pair_torque_Nm(stage, start) if start_torque is ... else start_torque)
@@ -204,8 +206,8 @@ def _step(stage: ReducerStage, theta: float, op: OperatingPoint, start: PairResu
     mid = math.copysign(math.sqrt(a * b), b) if a * b > 0 and max(a / b, b / a) > 4.0 else 0.5 * (a + b)
     half = dataclasses.replace(op, torque_Nm=mid)
     log.debug("load step to %.4g N·m halved at %.2f°", op.torque_Nm, math.degrees(theta))
-    mid = _step(stage, theta, half, start, before, cache, depth + 1)
-    return _step(stage, theta, op, mid, half.torque_Nm, cache, depth + 1)
+    mid_pair = _step(stage, theta, half, start, before, cache, depth + 1)
+    return _step(stage, theta, op, mid_pair, half.torque_Nm, cache, depth + 1)
 
 
 def hysteresis_loop(stage: ReducerStage, theta: float, torque_Nm: float, *, friction: float = 0.0,

@@ -183,7 +183,7 @@ def bearing_contacts_many(bearings: BearingModel, interface, centres: np.ndarray
     return [bearings.contacts(interface, centres, float(theta)) for theta in thetas]
 
 
-def roller_angles(case, theta: float) -> np.ndarray:
+def roller_angles(case, theta: float | np.ndarray) -> np.ndarray:
     """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad; for an
     array of angles (n,), (n, N, Z).
 
@@ -204,8 +204,8 @@ def roller_angles(case, theta: float) -> np.ndarray:
     shift = alpha - alpha[0]
     # the revolution starts 1e-9 rad before θ = Δ_i, so that crank angles that are Δ_i up to
     # round-off (θ = 120° as 12·10° or as 210° − 90°) all fall on the same side of it
-    theta = np.asarray(theta, dtype=float)[..., None]
-    cage = (np.mod(theta - shift + 1e-9, 2.0 * np.pi) - 1e-9) * (1.0 - gamma) / 2.0 + shift
+    theta_col = np.asarray(theta, dtype=float)[..., None]
+    cage = (np.mod(theta_col - shift + 1e-9, 2.0 * np.pi) - 1e-9) * (1.0 - gamma) / 2.0 + shift
     return cage[..., None] + 2.0 * np.pi * np.arange(b.rollers) / b.rollers
 
 
