@@ -156,10 +156,8 @@ def _role(pid: int) -> str:
         cmd = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
     except OSError:
         return "other"
-    if "rvfem.outputs.render import _serve" in cmd:
-        return "render worker"
-    if "rvfem._child import _serve" in cmd:
-        return "P2 model process"
+    if "rvfem._child import _serve" in cmd:   # the process's name is its program's argument
+        return "render worker" if cmd.rstrip().endswith(" render") else "P2 model process"
     return "other"
 
 

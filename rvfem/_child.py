@@ -1,11 +1,10 @@
 """A child Python process that runs functions for its parent: pickled calls over its standard input,
 pickled results over its standard output.
 
-It is started with ``python -c`` (as the render worker is, :class:`rvfem.outputs.render.RenderWorker`), not
-with :mod:`multiprocessing`, whose "spawn" start method imports the parent's main module again in
-the child: a user's script without an ``if __name__ == "__main__"`` guard would run a second time.
-The framing helpers (:func:`frame`, :func:`send`, :func:`receive`, :func:`picklable`,
-:func:`write_quietly`, :func:`claim_stdout`) are shared with the render worker.
+It is started with ``python -c``, not with :mod:`multiprocessing`, whose "spawn" start method
+imports the parent's main module again in the child: a user's script without an
+``if __name__ == "__main__"`` guard would run a second time. It serves the P2 model of an analysis
+and the render worker (:class:`rvfem.outputs.render.RenderWorker`).
 """
 
 from __future__ import annotations
@@ -87,12 +86,28 @@ _PROGRAM = r"""
 import sys
 sys.path.insert(0, {root!r})
 from rvfem._child import _serve
-_serve({niceness!r})
+_serve({niceness!r}, {forward_logs!r})
 """
 
 
 class ChildProcessEnded(RuntimeError):
-    """The child process of a :class:`ChildProcess` ended before it answered a call."""
+    """The child process of a :class:`ChildProcess` ended before it answered a call.
+
+    Attributes
+    ----------
+    returncode : int or None
+        The child's exit code (negative: the signal that ended it).
+    stderr : str
+        The end of the child's standard error (up to 20 000 characters).
+    """
+
+    def __init__(self, message: str, returncode: int | None = None, stderr: str = ""):
+        super().__init__(message)
+        self.returncode = returncode
+        self.stderr = stderr
+
+    def __reduce__(self):
+        return type(self), (str(self), self.returncode, self.stderr)
 
 
 class ChildProcess:
@@ -106,24 +121,33 @@ class ChildProcess:
     niceness : int
         Added to the child's niceness (Unix ``nice``) before it imports anything: background
         work that should leave the processor to this process where the two compete.
+    env : dict, optional
+        The child's environment (default: this process's), e.g. a variable a library reads when
+        it is imported.
+    forward_logs : bool
+        Log the child's records of the ``rvfem`` loggers (INFO and above) again in this process,
+        under their logger's name; else they go to the child's standard error (kept for the
+        message of :class:`ChildProcessEnded`).
 
     Notes
     -----
     The functions must be importable by name; their arguments and results are pickled. The calls
     are written to the child by a thread of their own, so that :meth:`call` returns at once even
-    while the child is still starting. An exception of a call is raised by its future's
+    while the child is still starting. A call made with ``background=True`` runs in a second
+    thread of the child, beside the others (the background calls one after the other). An exception of a call is raised by its future's
     ``result()``; once the child has ended, every call not answered raises
     :class:`ChildProcessEnded` with the end of its standard error.
     """
 
-    def __init__(self, name: str, niceness: int = 0):
+    def __init__(self, name: str, niceness: int = 0, *, env: dict[str, str] | None = None,
+                 forward_logs: bool = False):
         self.name = name
         self._stderr = tempfile.TemporaryFile()
         root = str(Path(__file__).resolve().parents[1])
-        program = _PROGRAM.format(root=root, niceness=int(niceness))
-        try:
-            self._proc = subprocess.Popen([sys.executable, "-c", program], stdin=subprocess.PIPE,
-                                          stdout=subprocess.PIPE, stderr=self._stderr)
+        program = _PROGRAM.format(root=root, niceness=int(niceness), forward_logs=bool(forward_logs))
+        try:   # the name as the program's argument: what the process is shows in its command line
+            self._proc = subprocess.Popen([sys.executable, "-c", program, name], stdin=subprocess.PIPE,
+                                          stdout=subprocess.PIPE, stderr=self._stderr, env=env)
         except BaseException:
             self._stderr.close()
             raise
@@ -135,12 +159,14 @@ class ChildProcess:
         self._reader = threading.Thread(target=self._read, name=f"rvfem-{name}", daemon=True)
         self._reader.start()
 
-    def call(self, function: Callable, *args) -> Future:
-        """Run ``function(*args)`` in the child process (after the calls before it)."""
+    def call(self, function: Callable, *args, background: bool = False) -> Future:
+        """Run ``function(*args)`` in the child process: after the calls before it, or with
+        ``background=True`` in the child's second thread (after the background calls before it,
+        meanwhile the others)."""
         future: Future = Future()
         with self._lock:
             number = self._count
-            data = frame((number, function, args))  # may raise
+            data = frame((number, function, args, bool(background)))  # may raise
             if self._ended is not None:
                 future.set_exception(self._ended)
                 return future
@@ -157,6 +183,10 @@ class ChildProcess:
         try:
             while (message := receive(stream)) is not None:
                 kind, number, value = message
+                if kind == "log":
+                    level, logger, text = value
+                    logging.getLogger(logger).log(level, "%s", text)
+                    continue
                 with self._lock:
                     future = self._pending.pop(number)
                 if kind == "ok":
@@ -172,9 +202,11 @@ class ChildProcess:
                 self._proc.kill()
                 self._proc.wait()
             self._stderr.seek(0)
-            tail = self._stderr.read().decode(errors="replace").strip().splitlines()[-5:]
+            text = self._stderr.read().decode(errors="replace").strip()
+            tail = text.splitlines()[-5:]
             ended = ChildProcessEnded(f"the {self.name} process ended (exit code {self._proc.returncode})"
-                                      + (": " + " | ".join(tail) if tail else ""))
+                                      + (": " + " | ".join(tail) if tail else ""),
+                                      self._proc.returncode, text[-20000:])
             with self._lock:
                 self._ended = ended
                 pending, self._pending = list(self._pending.values()), {}
@@ -206,20 +238,49 @@ class ChildProcess:
         self.close()
 
 
-def _serve(niceness: int = 0) -> None:
-    """The child's loop: run each call received, send its result or its exception, until the
-    parent closes the pipe."""
+class _ForwardLog(logging.Handler):
+    """In the child: sends its log records to the parent (:class:`ChildProcess` logs them again)."""
+
+    def __init__(self, stream, lock: threading.Lock):
+        super().__init__(logging.INFO)
+        self._stream, self._lock = stream, lock
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            send(self._stream, ("log", None, (record.levelno, record.name, record.getMessage())), self._lock)
+        except Exception:  # pragma: no cover - the parent is gone
+            pass
+
+
+def _serve(niceness: int = 0, forward_logs: bool = False) -> None:
+    """The child's loop: run each call received (a background one in a second thread), send its
+    result or its exception, until the parent closes the pipe."""
     if niceness and hasattr(os, "nice"):
         os.nice(niceness)
     out = claim_stdout()
+    lock = threading.Lock()
+    if forward_logs:
+        logger = logging.getLogger("rvfem")
+        logger.addHandler(_ForwardLog(out, lock))
+        logger.setLevel(logging.INFO)
     stream = sys.stdin.buffer
-    while (message := receive(stream)) is not None:
-        number, function, args = message
+    background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-child-background")
+
+    def run(number: int, function: Callable, args: tuple) -> None:
         try:
             reply = ("ok", number, function(*args))
         except BaseException as exc:  # noqa: BLE001 - every failure goes back to the parent
             reply = ("error", number, picklable(exc))
         try:
-            send(out, reply)
+            send(out, reply, lock)
         except Exception as exc:  # the result does not pickle
-            send(out, ("error", number, RuntimeError(f"the result of {function.__name__} cannot be sent: {exc}")))
+            send(out, ("error", number, RuntimeError(f"the result of {function.__name__} cannot be sent: {exc}")),
+                 lock)
+
+    while (message := receive(stream)) is not None:
+        number, function, args, in_background = message
+        if in_background:
+            background.submit(run, number, function, args)
+        else:
+            run(number, function, args)
+    background.shutdown(wait=True)

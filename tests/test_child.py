@@ -40,3 +40,34 @@ def test_a_call_that_cannot_be_sent_raises_at_once():
         with pytest.raises((pickle.PicklingError, AttributeError)):
             child.call(lambda: 1)                        # a lambda does not pickle
         assert child.call(math.floor, 2.5).result(timeout=30) == 2
+
+
+def test_a_background_call_runs_beside_the_calls_of_the_main_thread():
+    import time
+
+    with ChildProcess("test") as child:
+        sleeping = child.call(time.sleep, 3.0, background=True)
+        pid = child.call(os.getpid)                  # sent after it, answered while it sleeps
+        pid.result(timeout=30)
+        assert not sleeping.done()
+        assert sleeping.result(timeout=30) is None
+
+
+def test_the_environment_and_the_end_of_a_child_reach_the_parent():
+    with ChildProcess("test", env={**os.environ, "RVFEM_CHILD_PROBE": "42"}) as child:
+        assert child.call(os.getenv, "RVFEM_CHILD_PROBE").result(timeout=30) == "42"
+        ending = child.call(os.abort)
+        with pytest.raises(ChildProcessEnded) as info:
+            ending.result(timeout=30)
+    assert info.value.returncode < 0            # killed by SIGABRT
+    assert pickle.loads(pickle.dumps(info.value)).returncode == info.value.returncode
+
+
+def test_forwarded_log_records_are_logged_again_here(caplog):
+    import logging
+
+    with caplog.at_level(logging.INFO, logger="rvfem.test_child"):
+        with ChildProcess("test", forward_logs=True) as child:
+            child.call(logging.getLogger("rvfem.test_child").info, "from the child").result(timeout=30)
+            child.call(math.floor, 1.5).result(timeout=30)      # the record came before this answer
+    assert [(r.name, r.getMessage()) for r in caplog.records] == [("rvfem.test_child", "from the child")]

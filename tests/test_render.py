@@ -18,7 +18,7 @@ import pytest
 from conftest import structured_annulus
 
 from rvfem.errors import RenderError
-from rvfem.outputs import render
+from rvfem.outputs import render, render_check, render_scene
 
 pytestmark = pytest.mark.slow
 
@@ -114,7 +114,7 @@ def test_a_warm_up_leaves_nothing_in_the_images(scenes, tmp_path):
 
 def test_fxaa_that_does_not_render_falls_back_to_msaa(scenes, tmp_path, monkeypatch, caplog):
     full, _ = scenes[0]
-    monkeypatch.setattr(render, "_background_fraction", lambda image: 0.0)
+    monkeypatch.setattr(render_scene, "_background_fraction", lambda image: 0.0)
     with caplog.at_level(logging.WARNING, logger="rvfem.outputs.render"), \
             render.StressRenderer(SIZE, anti_aliasing="fxaa") as renderer:
         path = renderer.write(tmp_path / "fallback.png", full)
@@ -224,8 +224,8 @@ def test_a_render_worker_makes_other_calls_meanwhile(scenes, tmp_path):
 
 
 def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
-    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
-    monkeypatch.setattr(render, "_probe_result", None)
+    monkeypatch.setattr(render_check, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render_check, "_probe_result", None)
     with render.RenderWorker(SIZE) as worker:
         with pytest.raises(RenderError, match="off-screen rendering is not available.*crashed.*--no-images"):
             worker.check()
@@ -238,8 +238,8 @@ def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
 def test_a_failed_check_stops_a_run_before_the_load_cycle(monkeypatch, tmp_path):
     from rvfem.app import run
 
-    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
-    monkeypatch.setattr(render, "_probe_result", None)
+    monkeypatch.setattr(render_check, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render_check, "_probe_result", None)
     reached = []
 
     def analyse(case, *, progress, **kwargs):

@@ -29,7 +29,7 @@ from rvfem.case.definition import file_sha256, load_case
 from rvfem.errors import FolderNotEmptyError, OutputError, RenderError
 from rvfem.evaluate.compare import rigid_vs_flexible
 from rvfem.mesh import mesh_case
-from rvfem.outputs import render
+from rvfem.outputs import render, render_check
 from rvfem.outputs import summary as outputs
 from rvfem.outputs.vtkio import CELL_FIELDS, POINT_FIELDS
 from rvfem.solve.cycle import build_system, load_cycle
@@ -490,8 +490,8 @@ def test_existing_file_as_output_is_an_error(coarse_case_file, tmp_path):
 
 def test_impossible_rendering_is_a_clear_error(coarse_case_file, cache_dir, tmp_path, monkeypatch, capsys):
     # a renderer that crashes its process, as VTK does without any usable OpenGL context
-    monkeypatch.setattr(render, "_PROBE", "import os; os.abort()")
-    monkeypatch.setattr(render, "_probe_result", None)
+    monkeypatch.setattr(render_check, "_PROBE", "import os; os.abort()")
+    monkeypatch.setattr(render_check, "_probe_result", None)
     with pytest.raises(RenderError, match="off-screen rendering is not available.*--no-images"):
         render.check_rendering()
     out = tmp_path / "out"
