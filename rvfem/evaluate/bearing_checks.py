@@ -20,10 +20,12 @@ Sources
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem.case.definition import Case, CrankBearing
 from rvfem.evaluate import lubrication
 
 __all__ = [
@@ -51,7 +53,7 @@ STATIC_SAFETY_SHOCK = 2.0
 MINIMUM_LOAD_FRACTION = 0.02
 
 
-def crank_bearing_static_rating(bearing) -> float:
+def crank_bearing_static_rating(bearing: CrankBearing) -> float:
     """C0 of a case's crank bearing, N: ``static_load_rating_N`` if given, else ISO 76's C0r
     (:func:`rvfem.evaluate.lubrication.static_load_rating`)."""
     return bearing.static_load_rating_N or lubrication.static_load_rating(
@@ -132,7 +134,7 @@ def minimum_load(min_load_N: float, rating_N: float) -> MinimumLoad:
     return MinimumLoad(min_load_N=float(min_load_N), fraction_of_C=float(min_load_N) / rating_N)
 
 
-def support_reactions(span_mm: float, eccentric_positions_mm, eccentric_forces: np.ndarray) -> np.ndarray:
+def support_reactions(span_mm: float, eccentric_positions_mm: Sequence[float] | np.ndarray, eccentric_forces: np.ndarray) -> np.ndarray:
     """Forces of the two support bearings on a crankshaft beam carrying point loads, N.
 
     Beam statics of a shaft on two supports (the span's ends): with P_k the force on the eccentric at
@@ -243,8 +245,8 @@ class BearingChecks:
     support_note: str
 
 
-def case_bearing_checks(case, theta: np.ndarray, rating_N: float, speed_rpm: float, max_loads_N: dict,
-                        min_loads_N: dict, disc_bearing_forces: np.ndarray | None) -> BearingChecks:
+def case_bearing_checks(case: Case, theta: np.ndarray, rating_N: float, speed_rpm: float, max_loads_N: dict[str, float],
+                        min_loads_N: dict[str, float], disc_bearing_forces: np.ndarray | None) -> BearingChecks:
     """Static safety, minimum load and support bearings of a case's load cycle.
 
     Parameters

@@ -103,7 +103,8 @@ def equal_share_forces(case: Case, result: CycleResult) -> np.ndarray:
     return minus_p[:, None, :] / n + share[:, None, None] * t[None, :, :]
 
 
-def _stats(theta, magnitude, exponent, rating, speed) -> list[BearingLoadSummary]:
+def _stats(theta: np.ndarray, magnitude: np.ndarray, exponent: float, rating: float,
+           speed: float) -> list[BearingLoadSummary]:
     return [rigid.with_rating_life(s, rating, speed) for s in rigid.summarize_loads(theta, magnitude, exponent)]
 
 

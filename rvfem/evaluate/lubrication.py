@@ -22,6 +22,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from rvfem.case.definition import Lubricant
+
 __all__ = [
     "ISO_VG_NU100",
     "CLEANLINESS_EC",
@@ -87,13 +89,14 @@ def walther_viscosity(nu40: float, nu100: float, temperature_C: float) -> float:
     return 10.0 ** (10.0 ** y) - 0.7
 
 
-def lubricant_viscosity(lubricant) -> tuple[float, float, float]:
+def lubricant_viscosity(lubricant: Lubricant) -> tuple[float, float, float]:
     """(ν40, ν100, ν at the operating temperature) of a case's ``[lubricant]``, mm²/s."""
     if lubricant.nu40 is not None and lubricant.nu100 is not None:
         nu40, nu100 = lubricant.nu40, lubricant.nu100
     elif lubricant.nu40 is not None or lubricant.nu100 is not None:
         raise ValueError("lubricant: give both nu40 and nu100, or iso_vg alone")
     else:
+        assert lubricant.iso_vg is not None   # the case gives the grade or both viscosities
         nu40, nu100 = float(lubricant.iso_vg), ISO_VG_NU100[int(lubricant.iso_vg)]
     return nu40, nu100, walther_viscosity(nu40, nu100, lubricant.temperature_C)
 
@@ -215,7 +218,7 @@ def fatigue_load_limit(static_rating_N: float, pitch_diameter: float) -> float:
     return cu
 
 
-def contamination_factor(lubricant) -> float:
+def contamination_factor(lubricant: Lubricant) -> float:
     """e_C of a case's ``[lubricant]``: ``contamination_factor`` if given, else from ``cleanliness``
     (:data:`CLEANLINESS_EC`)."""
     if lubricant.contamination_factor is not None:

@@ -60,6 +60,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -253,7 +254,7 @@ def with_rating_life(summary: BearingLoadSummary, rating_N: float, bearing_speed
     return dataclasses.replace(summary, L10h=rating_life_hours(rating_N, summary.equivalent_N, bearing_speed_rpm))
 
 
-def _as_theta(theta) -> np.ndarray:
+def _as_theta(theta: float | Sequence[float] | np.ndarray) -> np.ndarray:
     th = np.atleast_1d(np.asarray(theta, dtype=float))
     if th.ndim != 1:
         raise ValueError(f"theta must be a scalar or a 1-D array, got shape {th.shape}")
@@ -483,7 +484,7 @@ def handbook_components(case: Case) -> HandbookComponents:
     return comp
 
 
-def handbook_bearing_loads(case: Case, theta=None) -> RigidLoads:
+def handbook_bearing_loads(case: Case, theta: float | Sequence[float] | np.ndarray | None = None) -> RigidLoads:
     """Force of every crank bearing on the disc over the crank angles ``theta`` (rigid model).
 
     Parameters
@@ -527,7 +528,7 @@ def handbook_bearing_loads(case: Case, theta=None) -> RigidLoads:
     )
 
 
-def undefined_loads(case: Case, theta=None) -> RigidLoads:
+def undefined_loads(case: Case, theta: float | Sequence[float] | np.ndarray | None = None) -> RigidLoads:
     """The handbook curves of a case outside the handbook model: every force NaN.
 
     Where :func:`handbook_applicable` says no (Zp − Zc ≠ 1), the rigid evaluation still has the
@@ -583,7 +584,7 @@ def handbook_load_extremes(components: HandbookComponents) -> tuple[float, float
     )
 
 
-def equivalent_load(load, exponent: float) -> np.ndarray | float:
+def equivalent_load(load: np.ndarray | Sequence[float], exponent: float) -> np.ndarray | float:
     """Equivalent (power-mean) load over a uniformly sampled full cycle.
 
     F_m = (mean F^p)^(1/p), the discrete form of ((1/2π)∫F(θ)^p dθ)^(1/p) (Gao et al., eq. 9,
@@ -669,7 +670,7 @@ def summarize_loads(theta: np.ndarray, magnitude: np.ndarray, exponent: float) -
 # --------------------------------------------------------------------------------------------
 
 
-def classical_pin_forces(case: Case, theta=None, *, exact_moment: bool = False) -> PinForces:
+def classical_pin_forces(case: Case, theta: float | Sequence[float] | np.ndarray | None = None, *, exact_moment: bool = False) -> PinForces:
     """Classical rigid pin-force distribution (zero clearance, unmodified profile).
 
     F_j = F_max·sin φ_j / √(1 + K1² − 2·K1·cos φ_j) for the pins with sin φ_j > 0, zero for the

@@ -35,12 +35,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
+from rvfem.case.definition import Material
+
 if TYPE_CHECKING:   # for the annotations only: postprocess is a heavier module of the same layer
-    from rvfem.evaluate.postprocess import PeakStress
+    from rvfem.evaluate.postprocess import HotSpotHistory, PeakStress
 
 __all__ = [
     "signed_von_mises",
@@ -72,7 +74,14 @@ def amplitude_mean(history: np.ndarray, axis: int = 0) -> tuple[np.ndarray, np.n
     return 0.5 * (hi - lo), 0.5 * (hi + lo)
 
 
-def goodman_safety_factor(amplitude, mean, fatigue_limit: float, ultimate_strength: float):
+@overload
+def goodman_safety_factor(amplitude: float, mean: float, fatigue_limit: float,
+                          ultimate_strength: float) -> float: ...
+@overload
+def goodman_safety_factor(amplitude: np.ndarray, mean: np.ndarray, fatigue_limit: float,
+                          ultimate_strength: float) -> np.ndarray: ...
+def goodman_safety_factor(amplitude: np.ndarray | float, mean: np.ndarray | float, fatigue_limit: float,
+                          ultimate_strength: float) -> np.ndarray | float:
     """Fatigue safety factor on the Goodman line (module docstring): 1/(σ_a/σ_W + σ_m/R_m) for
     σ_m ≥ 0, σ_W/σ_a for σ_m < 0; inf where nothing alternates and the mean is not tensile.
 
@@ -129,7 +138,7 @@ class HotSpotFatigue:
     p2_factor: float
 
 
-def hot_spot_fatigue(history, material) -> tuple[HotSpotFatigue, ...]:
+def hot_spot_fatigue(history: HotSpotHistory, material: Material) -> tuple[HotSpotFatigue, ...]:
     """The fatigue check of every hot spot of a :class:`rvfem.evaluate.postprocess.HotSpotHistory`
     with the strength of ``material`` (:class:`rvfem.case.definition.Material`)."""
     out = []
@@ -146,7 +155,7 @@ def hot_spot_fatigue(history, material) -> tuple[HotSpotFatigue, ...]:
     return tuple(out)
 
 
-def fatigue_field(sv_max: np.ndarray, sv_min: np.ndarray, material) -> np.ndarray:
+def fatigue_field(sv_max: np.ndarray, sv_min: np.ndarray, material: Material) -> np.ndarray:
     """Fatigue safety factor of every vertex from the largest and smallest signed von Mises
     stress over the cycle (P1 vertex stresses), capped at 1e3 for plotting."""
     a, m = 0.5 * (sv_max - sv_min), 0.5 * (sv_max + sv_min)
