@@ -12,9 +12,11 @@ import dataclasses
 import logging
 import math
 import os
+from collections.abc import Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -162,7 +164,7 @@ class _Shapes:
         tiled[np.tile(is_id, k)] += np.repeat(np.arange(k, dtype=np.int64) * n, int(is_id.sum()))
         return self._pv.PolyData(points.reshape(-1, 3), tiled)
 
-    def discs(self, centres: np.ndarray, z: float, inner: float, outer: float, c_res: int):
+    def discs(self, centres: np.ndarray | Sequence[tuple[float, float]], z: float, inner: float, outer: float, c_res: int):
         """Filled discs (rings if ``inner`` > 0) in the plane ``z`` (as ``pv.Disc``), or None."""
         centres = np.asarray(centres, dtype=float).reshape(-1, 2)
         if len(centres) == 0:
@@ -305,9 +307,10 @@ class StressRenderer:
         self.window_size = (int(window_size[0]), int(window_size[1]))
         self.compress_level = int(compress_level)
         self.frames = 0
-        self._pl = None
-        self._disc = None
-        self._disc_actor = None
+        # pyvista's plotter, the disc's mesh and its actor once set up (pyvista is imported lazily)
+        self._pl: Any = None
+        self._disc: Any = None
+        self._disc_actor: Any = None
         self._mesh: tuple | None = None
         self._writer = ThreadPoolExecutor(max_workers=1, thread_name_prefix="rvfem-png")
         self._pending: list[Future] = []
