@@ -72,4 +72,4 @@ def test_submodules_still_import_from_the_package():
     assert _python("from rvfem.solve import cycle; from rvfem.app import study; print(cycle.__name__, study.__name__)") == \
         "rvfem.solve.cycle rvfem.app.study"
     assert _python("from rvfem import *; print(load_study.__module__, OperatingPoint.__module__)") \
-        == "rvfem.app.study rvfem.solve.cycle"
+        == "rvfem.app.study_definition rvfem.solve.cycle"

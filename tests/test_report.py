@@ -186,7 +186,7 @@ def test_the_template_ships_with_the_package():
     assert any(d.replace(" ", "").startswith("jinja2>=3.1") for d in config["project"]["dependencies"])
     template = resources.files("rvfem.outputs") / "templates" / report.TEMPLATE
     assert template.is_file()
-    env = report._environment()
+    env = report.template_environment()
     assert isinstance(env.loader, jinja2.PackageLoader) and env.autoescape is True
     assert env.loader.get_source(env, report.TEMPLATE)[0] == template.read_text(encoding="utf-8")
 

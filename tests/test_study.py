@@ -294,7 +294,7 @@ def test_a_second_study_into_the_same_folder_is_refused(tmp_path):
     assert lock.exists()
     # a lock left by a process that no longer runs is taken over (here: nothing to compute is not
     # reachable without a cluster, so only the lock logic is checked)
-    from rvfem.app.study import _acquire_lock
+    from rvfem.app.study_run import _acquire_lock
 
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
@@ -448,8 +448,8 @@ def test_rows_and_plots_of_a_sensitivity_study(tmp_path, monkeypatch):
     """Deltas against the handbook and the base from known numbers; the tornado and bar charts,
     written as a whole folder (rvfem.outputs.summary.result_folder): no stale plot, an interrupted run
     leaves the earlier plots."""
-    from rvfem.app import study as study_module
-    from rvfem.app.study import _plots, study_rows
+    from rvfem.app import study_outputs
+    from rvfem.app.study_outputs import study_rows, write_plots
 
     path = _write(tmp_path / "s.toml", _study_text("sensitivity", """
 [[parameter]]
@@ -483,7 +483,7 @@ high = "rigid_bore"
     (tmp_path / "plots").mkdir()
     mark_folder(tmp_path / "plots", "study plots")   # the plots of an earlier run
     (tmp_path / "plots" / "response_old.png").write_bytes(b"stale")
-    files = _plots(study, list(rows.values()), tmp_path / "plots")
+    files = write_plots(study, list(rows.values()), tmp_path / "plots")
     assert set(files) == {"tornado", "variants"}
     assert all(p.stat().st_size > 5000 for p in files.values())
     assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [RESULT_MARKER, "tornado.png", "variants.png"]
@@ -492,9 +492,9 @@ high = "rigid_bore"
     def interrupted(*args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(study_module, "study_figures", interrupted)
+    monkeypatch.setattr(study_outputs, "study_figures", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        _plots(study, list(rows.values()), tmp_path / "plots")
+        write_plots(study, list(rows.values()), tmp_path / "plots")
     assert {p.name: p.read_bytes() for p in (tmp_path / "plots").iterdir() if p.name != RESULT_MARKER} == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plots", "s.toml"]   # no temporary folder left
 
@@ -513,7 +513,8 @@ import sys
 import matplotlib
 matplotlib.use("svg")     # stands for a notebook's inline backend
 from matplotlib.figure import Figure
-from rvfem.app.study import load_study, study_figures, _plots
+from rvfem.app.study import load_study, study_figures
+from rvfem.app.study_outputs import write_plots
 study = load_study({str(study_file)!r})
 rows = []
 for v in study.variants:
@@ -523,7 +524,7 @@ for v in study.variants:
                  "max_vs_base_percent": float(len(rows)), "life_ratio_vs_base": 1.0 - 0.01 * len(rows)}})
 figures = study_figures(study, rows)
 assert set(figures) == {{"tornado", "variants"}} and all(isinstance(f, Figure) for f in figures.values())
-files = _plots(study, rows, __import__("pathlib").Path({str(tmp_path / "plots")!r}))
+files = write_plots(study, rows, __import__("pathlib").Path({str(tmp_path / "plots")!r}))
 assert sorted(p.name for p in files.values()) == ["tornado.png", "variants.png"]
 assert matplotlib.get_backend() == "svg", matplotlib.get_backend()
 assert "matplotlib.pyplot" not in sys.modules
@@ -579,7 +580,7 @@ values = [1.0, 3.0]
 
 
 def test_compute_time_counts_every_case_once():
-    from rvfem.app.study import _compute_time
+    from rvfem.app.study_run import _compute_time
 
     records = {"base": {"wall_time_s": 10.0}, "a": {"wall_time_s": 5.0},
                "same": {"wall_time_s": 10.0, "same_as": "base"}, "cancelled": {"wall_time_s": float("nan")},

@@ -54,10 +54,8 @@ finds a known optimum.
 
 from __future__ import annotations
 
-import base64
 import contextlib
 import csv
-import html
 import json
 import logging
 import math
@@ -70,7 +68,7 @@ from pathlib import Path
 from typing import Any, Callable, Sequence
 
 from rvfem._files import write_text_atomic
-from rvfem.app.study import (
+from rvfem.app.study_run import (
     ClusterError,
     SingleThreadedBlas,
     VariantTask,
@@ -86,6 +84,7 @@ from rvfem.case.definition import case_to_dict, load_case, parse_override
 from rvfem.case.schema import toml_literal
 from rvfem.errors import CaseError, OutputError, RvfemError
 from rvfem.outputs.csvfile import csv_text
+from rvfem.outputs.report import png_data_uri, template_environment
 from rvfem.outputs.summary import prepare_output_folder
 
 log = logging.getLogger(__name__)
@@ -271,8 +270,8 @@ def _design_overrides(problem: Problem, params: Sequence[tuple[str, float]]) -> 
     return problem.overrides + tuple(f"{k}={toml_literal(float(v))}" for k, v in params)
 
 
-    assert problem.base_case is not None   # a case problem has its base case (load_problem)
 def _load_design(problem: Problem, params: Sequence[tuple[str, float]]):
+    assert problem.base_case is not None   # a case problem has its base case (load_problem)
     return load_case(problem.base_case, _design_overrides(problem, params))
 
 
@@ -573,8 +572,8 @@ def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows
     """The base case itself (``trials/base``), the reference of the report and the value told
     for failed designs; None for an analytic problem."""
     if problem.kind == "analytic":
-    assert problem.base_case is not None   # not analytic, checked just above
         return None
+    assert problem.base_case is not None   # not analytic, checked just above
     case = load_case(problem.base_case, problem.overrides)
     old = next((r for r in earlier_rows if r.get("id") == "base" and r.get("digest") == case.digest()
                 and r.get("status") == "ok"), None)
@@ -709,33 +708,35 @@ def _fmt(v: Any, spec: str) -> str:
     return "–" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
 
 
+OPTIMISE_TEMPLATE = "optimise.html.j2"
+"""The optimisation report's template, in the templates of :mod:`rvfem.outputs`."""
+
+
+def _report_context(problem: Problem, rows: Sequence[dict], base: dict | None, best: dict | None,
+                    png: Path | None, wall_s: float) -> dict:
+    """The context of ``optimise.html.j2``: texts, the base and best designs, the Pareto plot as a
+    data URI and the table of designs, numbers formatted ("–" where missing)."""
+    keys = [p.key for p in problem.parameters] + list(_response_keys(problem))
+    return {
+        "name": problem.name, "description": problem.description, "objective": problem.objective,
+        "parameters": [p.key for p in problem.parameters],
+        "budgets": [f"{n} {'≤' if BUDGETS[n][1] == 'max' else '≥'} {v:g}" for n, v in problem.budgets],
+        "designs": len(rows), "seed": problem.seed, "wall_s": f"{wall_s:.0f}",
+        "highlights": [{"title": title, "values": [(k, _fmt(r.get(k), ".4g")) for k in keys]}
+                       for title, r in (("Base case", base), ("Best feasible design", best)) if r is not None],
+        "pareto": png_data_uri(png) if png is not None else None,
+        "keys": keys,
+        "rows": [{"id": r["id"], "status": r["status"], "feasible": bool(r["feasible"]),
+                  "objective": _fmt(r["objective"], ".5g"), "values": [_fmt(r.get(k), ".4g") for k in keys],
+                  "error": r.get("error") or ""} for r in rows],
+    }
+
+
 def _report(problem: Problem, rows: Sequence[dict], base: dict | None, best: dict | None, png: Path | None,
             wall_s: float) -> str:
-    e = html.escape
-    keys = [p.key for p in problem.parameters] + list(_response_keys(problem))
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>", f"<title>rvfem optimise {e(problem.name)}</title>",
-             "<style>body{font-family:sans-serif;margin:2em;max-width:1300px}table{border-collapse:collapse}"
-             "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right;font-size:90%}.no{color:#999}</style>"
-             "</head><body>", f"<h1>{e(problem.name)}</h1><p>{e(problem.description)}</p>",
-             f"<p>Minimise <b>{e(problem.objective)}</b> over {', '.join(e(p.key) for p in problem.parameters)}; "
-             "budgets: " + (", ".join(f"{e(n)} {'≤' if BUDGETS[n][1] == 'max' else '≥'} {v:g}"
-                                      for n, v in problem.budgets) or "none")
-             + f". {len(rows)} designs (seed {problem.seed}), wall time {wall_s:.0f} s.</p>"]
-    for title, r in (("Base case", base), ("Best feasible design", best)):
-        if r is not None:
-            parts.append(f"<h2>{title}</h2><p>" + ", ".join(f"{e(k)} = {_fmt(r.get(k), '.4g')}" for k in keys) + "</p>")
-    if png is not None:
-        data = base64.b64encode(png.read_bytes()).decode()
-        parts.append(f"<h2>Mass against life ratio</h2><img src='data:image/png;base64,{data}' alt='Pareto'>")
-    parts.append("<h2>Designs</h2><table><tr><th>id</th><th>status</th><th>feasible</th><th>objective</th>"
-                 + "".join(f"<th>{e(k)}</th>" for k in keys) + "<th>error</th></tr>")
-    for r in rows:
-        cls = "" if r["feasible"] else " class='no'"
-        parts.append(f"<tr{cls}><td>{e(r['id'])}</td><td>{e(r['status'])}</td><td>{'yes' if r['feasible'] else 'no'}</td>"
-                     f"<td>{_fmt(r['objective'], '.5g')}</td>" + "".join(f"<td>{_fmt(r.get(k), '.4g')}</td>" for k in keys)
-                     + f"<td style='text-align:left'>{e(r.get('error') or '')}</td></tr>")
-    parts.append("</table></body></html>")
-    return "\n".join(parts)
+    """The optimisation's ``report.html``, rendered by ``optimise.html.j2``."""
+    return template_environment().get_template(OPTIMISE_TEMPLATE).render(
+        _report_context(problem, rows, base, best, png, wall_s))
 
 
 def _write_outputs(problem: Problem, out_dir: Path, rows: list[dict], base: dict | None, best: dict | None,

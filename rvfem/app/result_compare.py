@@ -17,9 +17,7 @@ Example::
 
 from __future__ import annotations
 
-import base64
 import csv
-import html
 import json
 import math
 import os
@@ -32,6 +30,7 @@ import numpy as np
 from rvfem.app.run import run_case
 from rvfem.case.definition import Case, load_case
 from rvfem.errors import OutputError
+from rvfem.outputs.report import png_data_uri, template_environment
 
 __all__ = ["ResultFolder", "STATISTICS", "read_result", "result_from_case", "compare_results",
            "overall_titles", "comparison_figure", "comparison_plot", "comparison_html", "headline"]
@@ -296,42 +295,41 @@ def _f(value, spec: str) -> str:
     return "–" if value is None else format(value, spec)
 
 
-def comparison_html(comparison: dict, plot: str | os.PathLike | None, path: str | os.PathLike) -> Path:
-    """A self-contained HTML page of a :func:`compare_results` result (plot embedded)."""
-    e = html.escape
+COMPARE_TEMPLATE = "compare.html.j2"
+"""The comparison page's template, in the templates of :mod:`rvfem.outputs`."""
+
+
+def comparison_context(comparison: dict, plot: str | os.PathLike | None) -> dict:
+    """The context of ``compare.html.j2`` for a :func:`compare_results` result: what was compared,
+    the headline and notes, the bearing and whole-disc tables with their numbers formatted ("–"
+    where missing), the load curves as a data URI."""
     a, b = comparison["a"], comparison["b"]
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
-             f"<title>rvfem compare {e(a['label'])} / {e(b['label'])}</title>",
-             "<style>body{font-family:sans-serif;margin:2em;max-width:1100px}table{border-collapse:collapse}"
-             "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}td.l,th.l{text-align:left}"
-             "img{max-width:100%}.w{color:#a00}</style></head><body>",
-             f"<h1>B / A: {e(b['label'])} / {e(a['label'])}</h1>",
-             f"<p>A: <code>{e(a['path'])}</code> ({e(str(a['bearing_model']))} bearings, step {a['angle_step_deg']}°)"
-             f"<br>B: <code>{e(b['path'])}</code> ({e(str(b['bearing_model']))} bearings, step {b['angle_step_deg']}°)</p>"]
-    if headline(comparison):
-        parts.append(f"<p><b>{e(headline(comparison))}</b></p>")
-    for w in comparison["warnings"]:
-        parts.append(f"<p class='w'>Note: {e(w)}</p>")
-    parts.append("<table><tr><th>bearing</th>" + "".join(
-        f"<th>{e(t)} A</th><th>{e(t)} B</th><th>B/A</th>" for _, t in STATISTICS) + "</tr>")
-    for row in comparison["bearings"]:
-        parts.append(f"<tr><td>{row['bearing']}</td>" + "".join(
-            f"<td>{_f(row['a'][k], '.1f')}</td><td>{_f(row['b'][k], '.1f')}</td><td>{_f(row['ratio'][k], '.4f')}</td>"
-            for k, _ in STATISTICS) + "</tr>")
-    parts.append("</table><h2>Whole disc</h2><table><tr><th class='l'>quantity</th><th>A</th><th>B</th><th>B/A</th></tr>")
     o = comparison["overall"]
     titles = overall_titles(comparison)
-    for key in o["a"]:
-        spec = ".4g" if key in ("disc_mass_kg", "static_safety_factor", "fatigue_safety_factor") else ".1f"
-        parts.append(f"<tr><td class='l'>{e(titles.get(key, key))}</td><td>{_f(o['a'][key], spec)}</td><td>{_f(o['b'][key], spec)}</td>"
-                     f"<td>{_f(o['ratio'][key], '.4f')}</td></tr>")
-    parts.append("</table>")
-    if plot is not None:
-        data = base64.b64encode(Path(plot).read_bytes()).decode()
-        parts.append(f"<h2>Load curves</h2><img src='data:image/png;base64,{data}' alt='bearing loads'>")
-    parts.append("<p>Flexible (finite-element) loads of each result; L10h per ISO 281 from F_m. "
-                 "A life ratio B/A below 1 is the life the change costs.</p></body></html>")
+
+    def spec(key: str) -> str:
+        return ".4g" if key in ("disc_mass_kg", "static_safety_factor", "fatigue_safety_factor") else ".1f"
+
+    return {
+        "a": {**a, "bearing_model": str(a["bearing_model"])}, "b": {**b, "bearing_model": str(b["bearing_model"])},
+        "headline": headline(comparison), "warnings": comparison["warnings"],
+        "statistics": [t for _, t in STATISTICS],
+        "bearings": [{"bearing": row["bearing"],
+                      "cells": [c for k, _ in STATISTICS for c in (_f(row["a"][k], ".1f"), _f(row["b"][k], ".1f"),
+                                                                   _f(row["ratio"][k], ".4f"))]}
+                     for row in comparison["bearings"]],
+        "overall": [{"title": titles.get(key, key),
+                     "cells": [_f(o["a"][key], spec(key)), _f(o["b"][key], spec(key)), _f(o["ratio"][key], ".4f")]}
+                    for key in o["a"]],
+        "plot": png_data_uri(plot) if plot is not None else None,
+    }
+
+
+def comparison_html(comparison: dict, plot: str | os.PathLike | None, path: str | os.PathLike) -> Path:
+    """A self-contained HTML page of a :func:`compare_results` result (plot embedded), rendered by
+    ``compare.html.j2``."""
+    page = template_environment().get_template(COMPARE_TEMPLATE).render(comparison_context(comparison, plot))
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(parts), encoding="utf-8")
+    path.write_text(page, encoding="utf-8")
     return path

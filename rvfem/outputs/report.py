@@ -34,8 +34,8 @@ from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_repo
 from rvfem.solve.models import bearing_model, pin_model
 from rvfem.units import nm_from_nmm
 
-__all__ = ["TEMPLATE", "assumptions", "key_field_angles", "render_report", "report_context", "toml_text",
-           "write_report"]
+__all__ = ["TEMPLATE", "assumptions", "key_field_angles", "png_data_uri", "render_report", "report_context",
+           "template_environment", "toml_text", "write_report"]
 
 TEMPLATE = "report.html.j2"
 """The report's template, in the folder ``templates`` of this package (shipped as package data)."""
@@ -125,8 +125,12 @@ def _figure(root: Path, rel: str | None, caption: str) -> dict | None:
     """The PNG file ``root/rel`` as a data URI with its caption; None if there is none."""
     if not rel or not (root / rel).is_file():
         return None
-    data = base64.b64encode((root / rel).read_bytes()).decode("ascii")
-    return {"src": f"data:image/png;base64,{data}", "caption": caption}
+    return {"src": png_data_uri(root / rel), "caption": caption}
+
+
+def png_data_uri(path: str | os.PathLike) -> str:
+    """The PNG file ``path`` as a ``data:`` URI, to embed it in a self-contained page."""
+    return "data:image/png;base64," + base64.b64encode(Path(path).read_bytes()).decode("ascii")
 
 
 def _where(at: dict) -> str:
@@ -320,11 +324,11 @@ def _stress_rows(stress: dict) -> list[list]:
     sp, away, cz = stress.get("structural_peak"), stress.get("away_from_contacts"), stress["contact_zone"]
     rows: list[list] = []
     if sp:
+        assert away is not None   # a structural peak comes with the cycle's envelope
         a_ = sp["at"]
         rows += [
             [[_b("structural stress peak"), " (away from contacts, P2 re-solve)"],
              [_b(f"{sp['von_mises_MPa']:.1f} MPa"), f" ± {sp['estimated_error_MPa']:.1f} MPa estimated "
-        assert away is not None   # a structural peak comes with the cycle's envelope
               f"({sp['estimated_error_percent']:.1f} %), at ({a_['x_mm']:.2f}, {a_['y_mm']:.2f}) mm, {_where(a_)}, "
               f"θ = {a_['theta_deg']:g}°"]],
             ["convergence check of the structural peak",
@@ -630,9 +634,10 @@ def report_context(summary: dict, case: Case, root: str | os.PathLike) -> dict:
 
 
 @functools.lru_cache(maxsize=1)
-def _environment() -> jinja2.Environment:
-    """The templates of this package (found in an installed package as in a source checkout),
-    every value escaped."""
+def template_environment() -> jinja2.Environment:
+    """The one Jinja environment of rvfem's HTML pages: the templates of this package (found in an
+    installed package as in a source checkout) — the run's report and the pages of a study, an
+    optimisation and a comparison — every value escaped."""
     return jinja2.Environment(loader=jinja2.PackageLoader("rvfem.outputs", "templates"), autoescape=True,
                               undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
                               keep_trailing_newline=True)
@@ -640,7 +645,7 @@ def _environment() -> jinja2.Environment:
 
 def render_report(context: dict) -> str:
     """The HTML of the report for a :func:`report_context`."""
-    return _environment().get_template(TEMPLATE).render(context)
+    return template_environment().get_template(TEMPLATE).render(context)
 
 
 def write_report(path: str | os.PathLike, summary: dict, case: Case, root: str | os.PathLike) -> Path:
