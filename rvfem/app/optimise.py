@@ -315,7 +315,7 @@ def evaluate_design(task: DesignTask) -> dict:
     with ``status`` ``"failed"`` or ``"error"`` and its message."""
     started = time.perf_counter()
     if task.variant is None:
-        record = {"status": "ok", "error": "", "computed": True, "responses": analytic_responses(dict(task.params))}
+        record: dict[str, Any] = {"status": "ok", "error": "", "computed": True, "responses": analytic_responses(dict(task.params))}
     else:
         record = run_variant(task.variant)
         summary = record.pop("summary", None)
