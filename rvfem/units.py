@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["ARCMIN_PER_RAD", "ARCSEC_PER_RAD", "NMM_PER_NM", "arcmin_from_rad", "nm_from_nmm", "nmm_from_nm"]
+__all__ = ["ARCMIN_PER_RAD", "ARCSEC_PER_RAD", "NMM_PER_NM", "arcmin_from_rad", "crank_angle_deg", "nm_from_nmm",
+           "nmm_from_nm"]
 
 NMM_PER_NM = 1000.0
 """N·mm per N·m."""
@@ -34,3 +35,10 @@ def nm_from_nmm(torque_Nmm):
 def arcmin_from_rad(angle_rad):
     """An angle in arc minutes from rad (float or ndarray)."""
     return angle_rad * ARCMIN_PER_RAD
+
+
+def crank_angle_deg(angle_rad: float) -> float:
+    """A crank (or roller) angle in degrees from rad, rounded to 1e-9° for the tables: the cycle's
+    angles are k·step in rad, and their degrees read 3.0, not 3.0000000000000004 (1e-9° is far
+    below the smallest step of a case, 0.05°)."""
+    return round(math.degrees(float(angle_rad)), 9)

@@ -31,6 +31,7 @@ from rvfem.evaluate.bearing_checks import crank_bearing_static_rating
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
 from rvfem.evaluate.iso281 import ROLLER_LIFE_EXPONENT
 from rvfem.fem.crankshaft import crankshaft_beam
+from rvfem.units import crank_angle_deg
 
 __all__ = [
     "beam_slope_influence",
@@ -382,14 +383,14 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     k_max, j_max = np.unravel_index(int(np.argmax(roller_loads)), roller_loads.shape)
     return BearingDepth(
         bearing=bearing, model=model, roller_peak_pressure_MPa=worst.peak_pressure_MPa,
-        roller_edge_factor=worst.edge_factor, raceway=g.name, theta_deg=math.degrees(float(theta[k])), roller=j,
+        roller_edge_factor=worst.edge_factor, raceway=g.name, theta_deg=crank_angle_deg(theta[k]), roller=j,
         roller_load_N=q_roller, tilt_mrad=1e3 * tilt, x_mm=x, pressure_MPa=worst.pressure_MPa,
         max_shear_MPa=worst.max_shear_MPa, max_shear_depth_mm=worst.max_shear_depth_mm,
         film_thickness_min_um=film.minimum_um, film_thickness_central_um=film.central_um,
         film_parameter=film.minimum_um / lubrication.composite_roughness_um(lub.roughness_Ra_um),
         kappa=kappa, a_iso=a_iso, L10h=l10h, L_nm_h=a_iso * l10h,
         L10r_h=math.inf if damage == 0 else to_hours / damage, max_roller_load_N=float(roller_loads[k_max, j_max]),
-        max_roller_theta_deg=math.degrees(float(theta[k_max])), max_roller=int(j_max))
+        max_roller_theta_deg=crank_angle_deg(theta[k_max]), max_roller=int(j_max))
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,6 @@
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
@@ -32,7 +31,7 @@ import numpy as np
 
 from rvfem.evaluate import strength
 from rvfem.outputs.csvfile import write_csv
-from rvfem.units import arcmin_from_rad
+from rvfem.units import arcmin_from_rad, crank_angle_deg
 
 __all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
            "write_stress_history"]
@@ -72,7 +71,7 @@ def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np
 
     def rows():
         for k, th in enumerate(theta):
-            row = [math.degrees(th)]
+            row = [crank_angle_deg(th)]
             for group in (models[:2], models[2:]):
                 for i in range(n_b):
                     for name, f in group:
@@ -100,10 +99,10 @@ def write_roller_loads(path: str | os.PathLike, theta: np.ndarray, roller_angles
 
     def rows():
         for k in range(n):
-            deg = math.degrees(theta[k])
+            deg = crank_angle_deg(theta[k])
             for i in range(n_b):
                 for j in range(z):
-                    yield [deg, i + 1, j + 1, math.degrees(roller_angles[k, i, j]) % 360.0, roller_loads[k, i, j]]
+                    yield [deg, i + 1, j + 1, crank_angle_deg(roller_angles[k, i, j]) % 360.0, roller_loads[k, i, j]]
 
     return _write(path, ["theta_deg", "bearing", "roller", "roller_angle_deg", "load_N"], rows())
 
@@ -128,7 +127,7 @@ def write_pin_forces(path: str | os.PathLike, theta: np.ndarray, pin_xy: np.ndar
 
     def rows():
         for k in range(n):
-            deg = math.degrees(theta[k])
+            deg = crank_angle_deg(theta[k])
             for j in range(zp):
                 yield [deg, j + 1, pin_xy[k, j, 0], pin_xy[k, j, 1], flexible[k, j], classical[k, j]]
 
@@ -140,7 +139,7 @@ def write_cycle_table(path: str | os.PathLike, theta: np.ndarray, pins_in_contac
     """Write ``cycle.csv`` (per-angle solver quantities; carrier rotation given in rad, written in
     arcmin)."""
     arcmin = arcmin_from_rad(np.asarray(carrier_rotation))
-    rows = ([math.degrees(t), int(p), a, r, int(i)]
+    rows = ([crank_angle_deg(t), int(p), a, r, int(i)]
             for t, p, a, r, i in zip(theta, pins_in_contact, arcmin, residual, iterations))
     return _write(path, ["theta_deg", "pins_in_contact", "carrier_rotation_arcmin", "equilibrium_residual",
                          "active_set_iterations"], rows)
@@ -170,7 +169,7 @@ def write_stress_history(path: str | os.PathLike, history) -> Path:
     signed = strength.signed_von_mises(factors * history.s1, factors * history.s2)
     rows = []
     for k, theta in enumerate(history.theta):
-        row = [math.degrees(float(theta))]
+        row = [crank_angle_deg(theta)]
         for j, f in enumerate(factors):
             row += [history.von_mises[k, j], history.s1[k, j], history.s2[k, j], dominant[k, j], f,
                     f * history.von_mises[k, j], f * history.s1[k, j], f * history.s2[k, j], f * dominant[k, j],
