@@ -1,0 +1,458 @@
+"""The reducer stage: one disc, or two discs on one carrier and crankshafts, and its cycle.
+
+A two-disc RV reducer is not one disc on rigid eccentrics with half the torque. Disc B runs 180°
+behind disc A and the two discs share
+
+1. the **carrier**: one rotation φ, so the output torque divides between the discs by their
+   stiffness at each crank angle (T_A + T_B = T_out, not T_out/2 each), and
+2. every **crankshaft**: a beam on two support bearings in the carrier's end plates carrying both
+   discs' eccentrics. The eccentric of crank i under disc k moves by
+   w_k,i = −Σ_k' f_kk' · F_k',i (F the bearing force on disc k', so −F acts on the eccentric),
+   the same 2×2 influence matrix f (mm/N) in x and y (a round shaft on radially isotropic
+   bearings). The part of the two discs' forces that is common on a crank (the torque-carrying
+   tangential force) sees the soft path through the support bearings; the part that is opposite
+   (the rotating pin-force components, ≈ 180° apart) sees the much stiffer bending between them.
+
+Both couplings enter the condensed contact problem of :func:`rvfem.solve.contact.solve_bodies`: the
+discs are two bodies with their own contacts and rigid motions, one carrier unknown, and the
+crankshafts add the compliance H[c, c'] = f_kk' · (d_c · d_c') between bearing contacts c, c' of
+the same crank (d the unit force direction on the disc, in the carrier frame).
+
+**Disc B.** Disc B is the same part and mesh as disc A, but it cannot sit in the same orientation:
+seen from disc B the pin ring is the one disc A would see at θ + 180° turned by half a pin pitch,
+which is disc A's view at θ + 180° − β turned as a whole by β = π/Zc (for a one-tooth difference;
+β = (2π − π·(Zp − Zc))/Zc in general, 0 for an even tooth difference). So disc B's teeth sit half a
+tooth pitch from disc A's against the bores and holes. Two ways to model it:
+
+* ``"same_as_first"`` (default): disc B is disc A at θ + 180° (same mesh, same compliance). This
+  misplaces disc B's teeth by β against its bores and holes; in exchange one pair solve gives
+  both discs' states (disc A at θ and at θ + 180°), so 180° of pair solves make the full cycle.
+* ``"half_pitch"``: disc B is a second model whose bores and holes are turned by −β against the
+  teeth, solved at θ + 180° − β and turned back by β: the exact geometry, at the price of a second
+  mesh, factorisation and compliance and 360° of pair solves.
+
+The difference between the two on the shipped RV-40E pair is measured in
+``benchmarks/bench_reducer.py`` (see docs/theory.md).
+
+**Torque convention.** As for one disc (docs/theory.md), each disc's torque is the moment of its
+pin forces about its own centre, and the carrier rotation turns each disc's eccentric centres about
+the disc centre; the handbook's ΣP_x·e·Zc = T/2 per disc is the equal split of this total.
+
+The crankshaft influence matrix comes from :func:`rvfem.fem.crankshaft.crankshaft_influence`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from rvfem.errors import CaseError
+from rvfem.fem.crankshaft import crankshaft_influence
+from rvfem.solve import contact
+from rvfem.solve.contact import ContactSet
+from rvfem.solve.cycle_angle import angle_result, solve_from_last
+from rvfem.solve.cycle_contacts import contact_set, contact_sets
+from rvfem.solve.cycle_symmetry import symmetry_plan, turn_result
+from rvfem.solve.cycle_system import DiscSystem, OperatingPoint
+from rvfem.units import nmm_from_nm
+
+log = logging.getLogger(__name__)
+
+
+SECOND_DISC_MODELS = ("same_as_first", "half_pitch")
+
+
+def second_disc_phase(case) -> float:
+    """β, rad: disc B seen from its bores is disc A at θ + π − β turned by β (module docstring).
+
+    From Rp·u(2πj/Zp + θ·d/Zp) − e·u(θ) (d = Zp − Zc): disc B at crank angle θ sees the pins of
+    crank angle θ + π with the ring turned back by π·d/Zp; a rotation β of the whole picture with
+    β·Zc ≡ −π·d (mod 2π) absorbs it. The smallest non-negative solution is returned.
+    """
+    zp, zc = case.pins.count, case.cycloid.teeth
+    d = zp - zc
+    return float(np.mod((2.0 * math.pi - math.pi * d) / zc, 2.0 * math.pi / zc))
+
+
+# ------------------------------------------------------------------------------------------------
+# The stage and one pair of discs
+# ------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReducerStage:
+    """Everything of a reducer stage that does not change with the crank angle.
+
+    Attributes
+    ----------
+    first : rvfem.solve.cycle.DiscSystem
+        Disc A.
+    second : rvfem.solve.cycle.DiscSystem or None
+        Disc B's model; None for a single disc, ``first`` itself for ``"same_as_first"``.
+    second_phase : float
+        β, rad: disc B is solved at θ + π − β and its results turned by β (0 for
+        ``"same_as_first"``).
+    influence : ndarray (discs, discs) or None
+        Crankshaft influence matrix, mm/N (None: rigid eccentrics).
+    """
+
+    first: object
+    second: object | None
+    second_phase: float
+    influence: np.ndarray | None
+
+    @property
+    def discs(self) -> int:
+        return 1 if self.second is None else 2
+
+    def carrier_torque_Nmm(self, op: OperatingPoint) -> float:
+        """Torque on the carrier from the discs modelled here at the operating point, N·mm: T_out
+        for two discs, T_out/discs for one disc (the handbook's equal share)."""
+        return nmm_from_nm(op.torque_Nm) * self.discs / self.first.case.loads.discs
+
+    @property
+    def mirrored_pairs(self) -> bool:
+        """True when the pair at θ + π is the pair at θ with the discs swapped (disc B is disc A
+        at θ + π and the crankshaft is symmetric), so that 180° of pairs make a cycle."""
+        if self.second is not self.first or self.second_phase != 0.0:
+            return False
+        f = self.influence
+        return f is None or bool(np.isclose(f[0, 0], f[1, 1], rtol=1e-12, atol=0.0))
+
+    def describe(self) -> str:
+        """What the stage model is, for the report and the screen."""
+        if self.discs == 1:
+            disc = "one disc carrying T/discs (the handbook's equal share)"
+        else:
+            disc = ("two discs sharing one carrier (the torque divides by their stiffness); disc B "
+                    + ("modelled as disc A at θ + 180°" if self.second is self.first and self.second_phase == 0
+                       else "with its teeth half a pitch from disc A's against the bores and holes"))
+        crank = ("crank support rigid: upper bound of the flexibility effect" if self.influence is None
+                 else "crankshafts as beams on elastic support bearings")
+        return f"{disc}; {crank}"
+
+
+def _rotation(beta: float) -> np.ndarray:
+    c, s = math.cos(beta), math.sin(beta)
+    return np.array([[c, -s], [s, c]])
+
+
+def build_stage(system, *, discs: int, influence: np.ndarray | None, second=None,
+                second_disc: str = "same_as_first") -> ReducerStage:
+    """A reducer stage of a disc model (:func:`case_stage` builds the one the case asks for).
+
+    Parameters
+    ----------
+    system : DiscSystem
+        Disc A.
+    discs : {1, 2}
+        1: one disc with the equal torque share T_out/discs; 2: both discs on one carrier.
+    influence : ndarray or None
+        Crankshaft influence matrix (mm/N, :func:`rvfem.fem.crankshaft.crankshaft_influence`); None for
+        rigid eccentrics.
+    second : DiscSystem, optional
+        Disc B's model for ``second_disc = "half_pitch"``: the case with its cranks and holes turned
+        by −β (:func:`half_pitch_case`), meshed and built like disc A.
+    second_disc : {"same_as_first", "half_pitch"}
+    """
+    case = system.case
+    if discs == 1:
+        f = None if influence is None else np.asarray(influence, dtype=float)[:1, :1]
+        return ReducerStage(first=system, second=None, second_phase=0.0, influence=f)
+    if discs != 2:
+        raise CaseError(f"a reducer stage has one or two discs, got {discs}")
+    if case.loads.discs != 2:
+        raise CaseError("two discs sharing the carrier need loads.discs = 2")
+    if second_disc not in SECOND_DISC_MODELS:
+        raise CaseError(f"second disc model must be one of {', '.join(SECOND_DISC_MODELS)}, got {second_disc!r}")
+    f = None if influence is None else np.asarray(influence, dtype=float)
+    if f is not None and f.shape != (2, 2):
+        raise CaseError("the crankshaft influence matrix of two discs must be 2×2")
+    if second_disc == "same_as_first":
+        return ReducerStage(first=system, second=system, second_phase=0.0, influence=f)
+    if second is None:
+        raise CaseError("second_disc = 'half_pitch' needs the second disc's model (see half_pitch_case)")
+    return ReducerStage(first=system, second=second, second_phase=second_disc_phase(case), influence=f)
+
+
+def single_disc_stage(system) -> ReducerStage:
+    """One disc carrying T_out/discs on rigid eccentrics: the handbook's model and rvfem 0.1's."""
+    return build_stage(system, discs=1, influence=None)
+
+
+def case_stage(system, second=None, second_disc: str = "same_as_first") -> ReducerStage:
+    """The reducer stage the case asks for: both discs on one carrier for ``loads.discs = 2`` with
+    the crankshafts of ``[crank_support]`` (rigid eccentrics without it), or, with
+    ``loads.torque_split = "equal"`` or one disc, one disc carrying T_out/discs. The equal split is
+    rvfem 0.1's and the handbook's model, on rigid eccentrics ([crank_support] belongs to the
+    two-disc stage). ``second``, ``second_disc`` as in :func:`build_stage`."""
+    case = system.case
+    equal_split = case.loads.discs > 1 and case.loads.torque_split == "equal"
+    discs = 1 if equal_split or case.loads.discs == 1 else 2
+    influence = None if (discs == 1 and equal_split) else crankshaft_influence(case)
+    return build_stage(system, discs=discs, influence=influence, second=second, second_disc=second_disc)
+
+
+def half_pitch_case(case):
+    """Disc B's case for the exact model: cranks (and the holes that follow them) turned by −β.
+
+    Every hole table is turned by its hole shape (:meth:`rvfem.geometry.HoleShape.turned`: holes
+    placed by an explicit ``angle_offset_deg`` are turned too); everything else is unchanged.
+    Solved at θ + π − β and turned back by β, this is disc B with its teeth half a tooth pitch from
+    disc A's against the bores and holes.
+    """
+    beta = math.degrees(second_disc_phase(case))
+    cranks = dataclasses.replace(case.cranks, angles_deg=tuple(a - beta for a in case.cranks.angles_deg))
+    changes = {"cranks": cranks}
+    for shape, table in case.hole_shapes():
+        changes[shape.name] = shape.turned(table, beta)
+    return case.replace(**changes)
+
+
+@dataclass(frozen=True)
+class PairResult:
+    """One crank angle of the stage.
+
+    Attributes
+    ----------
+    results : tuple of rvfem.solve.cycle.AngleResult
+        Disc A at θ (and disc B, in its own model's frame and crank angle).
+    bearing_forces : ndarray (discs, N, 2)
+        Bearing forces on each disc in the carrier frame, N.
+    torque_Nmm : ndarray (discs,)
+        Each disc's share of the carrier torque, N·mm.
+    eccentric_displacement : ndarray (discs, N, 2)
+        Displacement of each eccentric relative to the carrier (crankshaft deflection), mm.
+    """
+
+    results: tuple
+    bearing_forces: np.ndarray
+    torque_Nmm: np.ndarray
+    eccentric_displacement: np.ndarray
+
+
+def _disc_angles(stage: ReducerStage, theta: float) -> list[float]:
+    """The crank angle of each disc's own frame at the stage's crank angle θ (rad): disc A at θ,
+    disc B at θ + π − its phase."""
+    return [theta] if stage.second is None else [theta, theta + math.pi - stage.second_phase]
+
+
+def _bodies(stage: ReducerStage, theta: float, op: OperatingPoint):
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    thetas = _disc_angles(stage, theta)
+    phases = [0.0, stage.second_phase][:len(systems)]
+    sets = [contact_set(s, th, op) for s, th in zip(systems, thetas)]
+    return systems, thetas, phases, sets
+
+
+def _directions(system, cset) -> np.ndarray:
+    """Unit force on the disc per unit λ of each contact, (n_contacts, 2), disc frame."""
+    WL = cset.load_weights
+    return np.asarray(WL.T @ system.interface.resultants[:, :2])
+
+
+def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | None:
+    """H[c, c'] = f_kk' · (d_c · d_c') for the bearing contacts c (disc k), c' (disc k') of the
+    same crank, d in the carrier frame (mm/N); None for rigid eccentrics."""
+    if stage.influence is None:
+        return None
+    zp = stage.first.case.pins.count
+    dirs, crank, disc = [], [], []
+    for k, (s, beta, (cset, names)) in enumerate(zip(systems, phases, sets)):
+        d = _directions(s, cset) @ _rotation(beta).T
+        b = np.full(len(names), -1)
+        b[zp:] = cset.bearing[zp:]
+        dirs.append(d)
+        crank.append(b)
+        disc.append(np.full(len(names), k))
+    d = np.vstack(dirs)
+    crank = np.concatenate(crank)
+    disc = np.concatenate(disc)
+    same = (crank[:, None] == crank[None, :]) & (crank[:, None] >= 0)
+    f = stage.influence[disc[:, None], disc[None, :]]
+    return np.where(same, f * (d @ d.T), 0.0)
+
+
+def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None, *,
+               op: OperatingPoint | None = None, g_cache: dict | None = None) -> PairResult:
+    """Solve the stage at crank angle θ (rad) and the operating point ``op`` (default the case's):
+    disc A at θ with disc B at θ + 180°. ``g_cache`` keeps the contact compliance between solves
+    of the same crank angle (:func:`rvfem.solve.contact.solve_bodies`)."""
+    op = OperatingPoint.of(stage.first.case) if op is None else op
+    systems, thetas, phases, sets = _bodies(stage, theta, op)
+    case = stage.first.case
+    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
+    H = coupling_matrix(stage, systems, phases, sets)
+    sols = contact.solve_bodies(
+        [contact.Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.carrier_torque_Nmm(op),
+        coupling=H, start=None if start is None else [r.solution for r in start.results],
+        max_iterations=case.analysis.max_active_set_iterations,
+        label=f"at crank angle {math.degrees(theta):.2f}° ", names=names, g_cache=g_cache)
+    return _pair(stage, tuple(angle_result(s, th, sol, c)
+                              for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)))
+
+
+def _pair(stage: ReducerStage, results: tuple) -> PairResult:
+    """A PairResult from each disc's solution (disc A first)."""
+    return PairResult(results, *_stage_loads(stage, [r.bearing_forces for r in results],
+                                             [r.solution.residual["torque_Nmm"] for r in results]))
+
+
+def _stage_loads(stage: ReducerStage, bearing_forces: list, torques: list):
+    """The bearing forces of each disc in the carrier frame (discs, N, 2), the discs' torques and
+    the eccentric displacements, from each disc's bearing forces in its own frame (disc A first)."""
+    phases = [0.0, stage.second_phase][:len(bearing_forces)]
+    forces = np.stack([f @ _rotation(beta).T for f, beta in zip(bearing_forces, phases)])
+    w = np.zeros_like(forces)
+    if stage.influence is not None:
+        w = -np.einsum("kl,lnj->knj", stage.influence, forces)
+    return forces, np.array(torques), w
+
+
+def _first_and_loads(pair: PairResult) -> tuple:
+    """Disc A's result and (bearing forces, torques, eccentric displacements) of a pair."""
+    return pair.results[0], (pair.bearing_forces, pair.torque_Nmm, pair.eccentric_displacement)
+
+
+def _turned_bearing_forces(result, k: int, order: int) -> np.ndarray:
+    """The bearing forces (N, 2) of ``result`` turned by k·2π/N: bearing i's force, turned, is
+    bearing i + k's (the same as :func:`rvfem.solve.cycle.turn_result` gives, to round-off)."""
+    return np.roll(result.bearing_forces @ _rotation(2.0 * math.pi * k / order).T, k, axis=0)
+
+
+# ------------------------------------------------------------------------------------------------
+# A full cycle
+# ------------------------------------------------------------------------------------------------
+
+
+def _prefetch_stage(stage: ReducerStage, systems: list, thetas: np.ndarray, solve_at, source, step: float,
+                    op: OperatingPoint) -> None:
+    """Build the contacts of every angle a disc is solved at and of every angle disc A is turned to,
+    in one sweep per system, and compute the compliance columns the cycle will likely need
+    (:func:`likely_columns`) in one parallel sweep per system."""
+    wanted = [[] for _ in systems]
+    for i, swap, k in source:
+        own = _disc_angles(stage, float(thetas[i]))
+        if (swap, k) == (0, 0):
+            for d in range(len(systems)):
+                wanted[d].append(own[d])
+        else:
+            wanted[0].append(own[swap] + k * step)
+    for d, s in enumerate(systems):
+        contact_sets(s, wanted[d], op)           # the solved angles are among them (source[i] = i)
+    for s in {id(s): s for s in systems}.values():
+        ks = [k for k, t in enumerate(systems) if t is s]
+        sets = [contact_set(systems[k], _disc_angles(stage, float(thetas[i]))[k], op)[0]
+                for i in solve_at for k in ks]
+        s.compliance.ensure(likely_columns(s, sets, stage.carrier_torque_Nmm(op)))
+
+
+def _stage_angle(stage: ReducerStage, pair: PairResult, swap: int, k: int, theta: float, order: int,
+                 op: OperatingPoint) -> tuple:
+    """Disc A's result at θ and (bearing forces, torques, eccentric displacements) of the stage,
+    from the solved ``pair`` that symmetry maps onto θ: itself, its discs swapped (``swap``: the
+    mirrored pair at θ + π) and/or turned by ``k`` steps of 2π/N."""
+    src = pair.results[::-1] if swap else pair.results      # mirrored pair: disc B is disc A at θ + π
+    if (swap, k) == (0, 0):
+        return _first_and_loads(pair)
+    # disc A's solution turned by k steps (its contacts checked against the turned ones); disc B,
+    # which may land at θ + π − 2π when the discs are swapped (the same state, the cycle being
+    # 2π-periodic: roller_angles), enters only through its bearing forces and torque, turned and
+    # unchanged
+    system = stage.first
+    try:
+        step = 2.0 * math.pi / order
+        turned_theta = src[0].theta + k * step
+        first = turn_result(system, src[0], k, contact_set(system, turned_theta, op)[0], op)
+        loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
+                             [r.solution.residual["torque_Nmm"] for r in src])     # turning keeps torques
+    except ValueError as exc:
+        log.warning("%s; solving the pair at %.2f° directly", exc, math.degrees(theta))
+        first, loads = _first_and_loads(solve_pair(stage, theta, pair, op=op))
+    if abs(first.theta - theta) > 1e-9:
+        raise RuntimeError(f"symmetry plan lands at {first.theta} instead of {theta}")
+    return first, loads
+
+
+def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoint, progress=None):
+    """Solve the stage at every crank angle at the operating point ``op``, each pair started from
+    the ones before it (:func:`rvfem.solve.cycle_angle.solve_from_last`). One disc is a stage with one body.
+
+    Only the angles that symmetry does not give are solved (:func:`rvfem.solve.cycle.symmetry_plan`):
+    with :attr:`ReducerStage.mirrored_pairs` the pair at θ + 180° is the pair at θ with the discs
+    swapped; with N-fold symmetric discs the pair at θ + 360°/N is the pair at θ turned
+    (:func:`rvfem.solve.cycle.turn_result`). ``progress(done, n)`` counts the crank angles of disc A
+    obtained so far.
+
+    Returns
+    -------
+    results : list of rvfem.solve.cycle.AngleResult
+        Disc A at every θ.
+    extras : dict
+        ``disc_torque_Nmm`` (n, discs), ``disc_bearing_forces`` (n, discs, N, 2) in the carrier
+        frame, ``eccentric_displacement`` (n, discs, N, 2), ``pair_solves`` (int), ``stage`` (the
+        stage's description), ``prefetch_seconds`` (the compliance columns computed before).
+    """
+    thetas = np.asarray(thetas, dtype=float)
+    n = len(thetas)
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    order = min(s.symmetry for s in systems)
+    mirrored = stage.discs == 2 and stage.mirrored_pairs
+    solve_at, source = symmetry_plan(thetas, order, mirrored)
+    step = 2.0 * math.pi / order
+
+    t0 = time.perf_counter()
+    _prefetch_stage(stage, systems, thetas, solve_at, source, step, op)
+    t_prefetch = time.perf_counter() - t0
+    log.info("stage compliance prefetch %.2f s", t_prefetch)
+    pairs: list[PairResult] = []
+    for i in solve_at:
+        pairs.append(solve_from_last(lambda start: solve_pair(stage, float(thetas[i]), start, op=op), pairs[-2:]))
+        if progress is not None:
+            progress(len(pairs) * n // len(solve_at), n)
+    results, torque, forces, w = [], [], [], []
+    for j, (i, swap, k) in enumerate(source):
+        first, loads = _stage_angle(stage, pairs[i], swap, k, float(thetas[j]), order, op)
+        results.append(first)
+        forces.append(loads[0])
+        torque.append(loads[1])
+        w.append(loads[2])
+    extras = {
+        "disc_torque_Nmm": np.array(torque),
+        "disc_bearing_forces": np.array(forces),
+        "eccentric_displacement": np.array(w),
+        "pair_solves": len(solve_at),
+        "stage": stage.describe(),
+        "crankshaft_influence": stage.influence,
+        "prefetch_seconds": t_prefetch,
+    }
+    return results, extras
+
+
+def likely_columns(system: DiscSystem, sets: list[ContactSet], torque: float) -> np.ndarray:
+    """Interface columns the load cycle will need, to compute them in one parallel sweep.
+
+    Every roller and bearing column, and those of the pins that touch (gap ≤ 1 µm) on the side
+    that resists the torque (its sign; N·mm) with a margin. Columns missed here are computed
+    when first needed, at a higher cost per column (small batches, one thread).
+    """
+    T = torque
+    zp = system.case.pins.count
+    cols = []
+    for cset in sets:
+        W = cset.W.tocsc()
+        moment = np.asarray(W.T @ system.interface.resultants[:, 2])[:zp]
+        gap = np.where(cset.signorini[:zp], cset.gap0[:zp], -cset.offset[:zp])
+        likely = np.ones(W.shape[1], dtype=bool)
+        # a flexible disc also loads pins past the ends of the classical loaded arc, whose lever
+        # arms are small or of the other sign (default fan-hole case: loaded pins up to 0.68 of
+        # the largest arm on that side): keep those within half the largest arm, which leaves
+        # about 8 % of the columns to be computed when first needed
+        likely[:zp] = (gap <= 1e-3) & (moment * np.sign(T) <= 0.5 * np.abs(moment).max())
+        cols.append(W[:, np.flatnonzero(likely)].indices)
+    return np.unique(np.concatenate(cols))
