@@ -31,6 +31,7 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
@@ -543,7 +544,7 @@ def footprint_weights(
     return _footprint_matrix(model, chain, cols, eidx, v_start, le, vq, wt, len(c))
 
 
-def load_operator(model: FEModel, weights: sp.spmatrix, directions: np.ndarray) -> sp.csc_matrix:
+def load_operator(model: FEModel, weights: sp.spmatrix, directions: npt.ArrayLike) -> sp.csc_matrix:
     """Global load operator B from scalar nodal weights and one direction per column.
 
     Column j of ``B`` is the load vector of a unit force along ``directions[j]`` distributed with

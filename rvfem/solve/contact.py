@@ -97,7 +97,7 @@ __all__ = [
 ]
 
 
-def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, torque: float, *,
+def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, torque: float | None, *,
                   start: AngleSolution | None = None, max_iterations: int = 50, label: str = "",
                   tol_gap: float = 1e-9, names: list[str] | None = None,
                   rigid_dofs: tuple[int, ...] = (0, 1, 2)) -> AngleSolution:

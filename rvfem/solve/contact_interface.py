@@ -43,7 +43,7 @@ class FootprintGrid:
 
     name: str
     offset: int
-    chain: object
+    chain: fem.BoundaryChain
     centre: np.ndarray | None = None
     stride: int = 1
 

@@ -9,7 +9,7 @@ primal–dual active set for the rigid pins) on this small dense system (:class:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
@@ -101,7 +101,7 @@ class ContactProblem:
         self.scale_f = max(abs(self.torque) / self.r_typ, 1.0)
         self.G = np.zeros((nc, nc)) if coupling is None else np.array(coupling, dtype=float)
         self.filled = np.zeros(nc, dtype=bool)
-        self._open_tangent = None
+        self._open_tangent: np.ndarray | None = None
         if g_cache is not None:
             self._share_G(g_cache, csets, coupling)
 
@@ -115,7 +115,7 @@ class ContactProblem:
         same = (entry is not None and all(a is b for a, b in zip(entry[0], csets))
                 and ((entry[1] is None and coupling is None)
                      or (entry[1] is not None and coupling is not None and np.array_equal(entry[1], coupling))))
-        if same:
+        if same and entry is not None:
             self.G, self.filled = entry[2], entry[3]
         else:
             cache[key] = (list(csets), None if coupling is None else np.array(coupling), self.G, self.filled)
@@ -224,10 +224,11 @@ class NewtonIterate:
     a: np.ndarray
     phi: float
     active: np.ndarray
-    v: np.ndarray = None
-    delta: np.ndarray = None
-    q: np.ndarray = None
-    dq: np.ndarray = None
+    # set by update() (ContactProblem.state): v, δ, q(δ) and dq/dδ at these unknowns
+    v: np.ndarray = field(init=False, repr=False)
+    delta: np.ndarray = field(init=False, repr=False)
+    q: np.ndarray = field(init=False, repr=False)
+    dq: np.ndarray = field(init=False, repr=False)
 
     def update(self, problem: ContactProblem) -> "NewtonIterate":
         self.v, self.delta, self.q, self.dq = problem.state(self.lam, self.a, self.phi)
@@ -386,7 +387,7 @@ def _not_settled(problem: ContactProblem, it: NewtonIterate, history: list, spri
     for states in (history, spring_history):
         for h0, h1 in zip(states[:-1], states[1:]):
             changes += h0 != h1
-    flipping = [options.name(i) for i in np.flatnonzero(changes)]
+    flipping = [options.name(int(i)) for i in np.flatnonzero(changes)]
     spring, lam, q = problem.spring, it.lam, it.q
     worst = np.argsort(-np.abs(lam - q) * spring)[:5]
     unsettled = [options.name(i) for i in worst if spring[i] and abs(lam[i] - q[i]) > 1e-8 * problem.scale_f]

@@ -42,7 +42,7 @@ def column_rotation(iface: Interface, order: int, tol: float = 1e-9) -> sp.csr_m
     dist, image = cKDTree(sites).query(sites @ Rot.T)
     if dist.max() > tol * scale:
         return None
-    cols_of = [[] for _ in range(len(sites))]
+    cols_of: list[list[int]] = [[] for _ in range(len(sites))]
     for c, s in enumerate(site_of):
         cols_of[s].append(c)
     rows, cols, vals = [], [], []
@@ -76,10 +76,10 @@ def column_orbits(Q: sp.csr_matrix, order: int):
         powers.append((Q @ powers[-1]).tocsr())
     pattern = abs(Q)
     _, site = connected_components(pattern.T @ pattern, directed=False)
-    members = [[] for _ in range(site.max() + 1)]
+    site_columns: list[list[int]] = [[] for _ in range(site.max() + 1)]
     for c, s in enumerate(site):
-        members[s].append(c)
-    members = [np.asarray(m) for m in members]
+        site_columns[s].append(c)
+    members = [np.asarray(m) for m in site_columns]
     Qc = Q.tocsc()
     image = np.empty(len(members), dtype=int)
     image[site] = site[Qc.indices[Qc.indptr[:-1]]]      # grid point each point turns into

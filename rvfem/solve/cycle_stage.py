@@ -101,8 +101,8 @@ class ReducerStage:
         Crankshaft influence matrix, mm/N (None: rigid eccentrics).
     """
 
-    first: object
-    second: object | None
+    first: DiscSystem
+    second: DiscSystem | None
     second_phase: float
     influence: np.ndarray | None
 
@@ -271,10 +271,10 @@ def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | 
         crank.append(b)
         disc.append(np.full(len(names), k))
     d = np.vstack(dirs)
-    crank = np.concatenate(crank)
-    disc = np.concatenate(disc)
-    same = (crank[:, None] == crank[None, :]) & (crank[:, None] >= 0)
-    f = stage.influence[disc[:, None], disc[None, :]]
+    crank_of = np.concatenate(crank)
+    disc_of = np.concatenate(disc)
+    same = (crank_of[:, None] == crank_of[None, :]) & (crank_of[:, None] >= 0)
+    f = stage.influence[disc_of[:, None], disc_of[None, :]]
     return np.where(same, f * (d @ d.T), 0.0)
 
 
@@ -335,7 +335,7 @@ def _prefetch_stage(stage: ReducerStage, systems: list, thetas: np.ndarray, solv
     """Build the contacts of every angle a disc is solved at and of every angle disc A is turned to,
     in one sweep per system, and compute the compliance columns the cycle will likely need
     (:func:`likely_columns`) in one parallel sweep per system."""
-    wanted = [[] for _ in systems]
+    wanted: list[list[float]] = [[] for _ in systems]
     for i, swap, k in source:
         own = _disc_angles(stage, float(thetas[i]))
         if (swap, k) == (0, 0):

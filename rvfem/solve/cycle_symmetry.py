@@ -152,6 +152,8 @@ def _permutation_map(Qk: sp.spmatrix, *pairs: tuple[sp.spmatrix, sp.spmatrix],
                 return None
         if np.abs(direct[sigma] - mapped).max() > tol:
             return None
+    if sigma is None:                                         # no pairs given: nothing to map
+        return None
     M = np.zeros((len(sigma), len(sigma)))
     M[sigma, np.arange(len(sigma))] = 1.0
     return M

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,10 +19,11 @@ import numpy as np
 from rvfem import fem
 from rvfem.case.definition import FOOTPRINT_ELEMENTS, Case
 from rvfem.errors import CaseError, MeshError
-from rvfem.geometry import crank_centres, disc_geometry
-from rvfem.mesh import rotation_permutation
+from rvfem.geometry import DiscGeometry, crank_centres, disc_geometry
+from rvfem.mesh import DiscMesh, rotation_permutation
 from rvfem.solve import contact, models
 from rvfem.solve.contact import Compliance, Interface
+from rvfem.solve.models import BearingModel, PinModel
 from rvfem.units import nmm_from_nm
 
 log = logging.getLogger(__name__)
@@ -71,16 +73,22 @@ class DiscSystem:
     Attributes
     ----------
     case : Case
-    mesh : mesh object with ``points``, ``triangles``, ``boundaries``
-    model : the FE model (:mod:`rvfem.fem`)
+    mesh : rvfem.mesh.DiscMesh
+        The disc's mesh (``points``, ``triangles``, ``boundaries``).
+    model : rvfem.fem.FEModel
+        The FE model.
     interface : contact.Interface
     compliance : contact.Compliance
         Cache of the column compliance (filled lazily; the only mutable part).
     solve : callable
-        K_s⁻¹ applied to a right-hand side.
+        K_s⁻¹ applied to a right-hand side (:meth:`rvfem.fem.Factorization.solve`).
     rigid_modes : ndarray (n_dofs, 3)
     bearing_model, pin_model : str
         Names of the crank-bearing and pin models (:mod:`rvfem.case.registry`).
+    stiffness_scale : float
+        Factor on the disc's Young's modulus.
+    geometry : rvfem.geometry.DiscGeometry
+        The case's checked geometry.
     bearings, pins : rvfem.solve.models.BearingModel, rvfem.solve.models.PinModel
         The model objects.
     setup_seconds : dict
@@ -99,21 +107,21 @@ class DiscSystem:
     """
 
     case: Case
-    mesh: object
-    model: object
+    mesh: DiscMesh
+    model: fem.FEModel
     interface: Interface
     compliance: Compliance
-    solve: object
+    solve: Callable[[np.ndarray], np.ndarray]
     rigid_modes: np.ndarray
     bearing_model: str
     stiffness_scale: float
     pin_model: str
-    geometry: object
+    geometry: DiscGeometry
+    bearings: BearingModel
+    pins: PinModel
     bearing_stiffness_scale: float = 1.0
     pin_stiffness_N_per_mm: float | None = None
     setup_seconds: dict = field(default_factory=dict)
-    bearings: object = None
-    pins: object = None
     symmetry: int = 1
     node_rotation: np.ndarray | None = field(default=None, repr=False)
     contact_sets: dict = field(default_factory=dict, repr=False, compare=False)

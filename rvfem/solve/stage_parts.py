@@ -110,8 +110,9 @@ def _beam_support(stage: ReducerStage, name: str):
 
 def _with_support(stage: ReducerStage, cs) -> ReducerStage:
     # the influence of the changed beam alone (E × 10³ is outside a case's bounds on purpose)
-    influence = crankshaft_influence(SimpleNamespace(crank_support=cs))[:stage.discs, :stage.discs]
-    return dataclasses.replace(stage, influence=influence)
+    influence = crankshaft_influence(SimpleNamespace(crank_support=cs))
+    assert influence is not None        # the beam keys are there (_beam_support)
+    return dataclasses.replace(stage, influence=influence[:stage.discs, :stage.discs])
 
 
 def _stiff_crankshaft(stage: ReducerStage) -> ReducerStage:
