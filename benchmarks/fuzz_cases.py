@@ -32,7 +32,7 @@ profile modifications, rigid or linear pins and rollers).
 
 Run: ``python benchmarks/fuzz_cases.py --count 5000 --seed 1`` (prints the counts per outcome and
 the first failing inputs); ``python benchmarks/fuzz_cases.py --run 30 --seed 1`` runs 30 valid
-inputs through ``mesh`` and ``run`` as well (about 15 s each). ``tests/test_fuzz.py`` draws its inputs from the same generator.
+inputs through ``mesh`` and ``run`` as well (about 15 s each). ``tests/end_to_end/test_fuzz.py`` draws its inputs from the same generator.
 """
 
 from __future__ import annotations

@@ -1,9 +1,20 @@
-"""Shared test utilities: paths of the shipped cases, a small TOML line editor, and the
-``slow`` marker of the end-to-end modules."""
+"""Shared test utilities: paths of the shipped cases, a small TOML line editor, the registries
+saved and restored around a test that registers a plug-in, and the ``slow`` marker of the
+end-to-end tests.
+
+The tests mirror the package: ``tests/<layer>/test_*.py`` tests ``rvfem/<layer>`` (case, geometry,
+mesh, fem, solve, evaluate, outputs, app), ``tests/end_to_end/`` runs the whole job, and the test
+modules directly in ``tests/`` check the package as a whole or its top-level modules. This file
+applies to every folder below it, and ``tests/`` is on ``sys.path`` (``pythonpath`` in
+pyproject.toml), so a test module anywhere imports these helpers as ``from conftest import …``.
+Test folders are not packages: every test module's file name is unique across the folders.
+"""
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +22,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES_DIR = ROOT / "cases"
+TESTS_DIR = Path(__file__).resolve().parent
+REGRESSIONS_DIR = TESTS_DIR / "regressions"
+"""Case files an earlier rvfem refused (tests/solve/test_regressions.py runs each of them)."""
 
 
 def documented_keys(after: str | None = None) -> set[str]:
@@ -136,18 +150,50 @@ def case_text() -> CaseText:
     return CaseText.shipped("rv40e")
 
 
-END_TO_END_MODULES = ("test_run.py", "test_notebooks.py", "test_study.py", "test_result_compare.py",
-                      "test_fuzz.py")
-"""Test modules that run the whole job (result folders, images, notebooks, Dask studies, the fuzzed
-command line) rather than one stage of the science core: every test in them counts as ``slow``."""
+END_TO_END_DIR = TESTS_DIR / "end_to_end"
+"""The test modules that run the whole job (result folders, images, notebooks, Dask studies, the
+fuzzed command line) rather than one stage of the science core: every test in them counts as
+``slow``."""
 
 
 def pytest_collection_modifyitems(config, items):
-    """Mark the tests of :data:`END_TO_END_MODULES` ``slow`` (tests elsewhere carry the marker
+    """Mark the tests under :data:`END_TO_END_DIR` ``slow`` (tests elsewhere carry the marker
     themselves), so that ``pytest -m "not slow"`` runs the science core only."""
     for item in items:
-        if item.path.name in END_TO_END_MODULES:
+        if END_TO_END_DIR in item.path.resolve().parents:
             item.add_marker(pytest.mark.slow)
+
+
+def _registry_tables() -> tuple[dict, ...]:
+    """The tables a plug-in registers itself in: the crank-bearing and pin models
+    (:mod:`rvfem.case.registry`) and the writers of a result folder (:mod:`rvfem.outputs.registry`)."""
+    from rvfem.case import registry as models
+    from rvfem.outputs import registry as writers
+
+    return models._BEARINGS, models._PINS, writers._WRITERS
+
+
+@contextmanager
+def saved_registries() -> Iterator[None]:
+    """The model and writer registries as they were before the block, whatever it registered or
+    removed (restored in place: every module holding a table sees it restored). For fixtures wider
+    than a test; a test asks for the :func:`registries` fixture."""
+    tables = _registry_tables()
+    saved = [dict(table) for table in tables]
+    try:
+        yield
+    finally:
+        for table, before in zip(tables, saved):
+            table.clear()
+            table.update(before)
+
+
+@pytest.fixture
+def registries() -> Iterator[None]:
+    """The model and writer registries saved before the test and restored after it: a test that
+    registers a plug-in (a bearing or pin model, a writer) leaves no trace in the next one."""
+    with saved_registries():
+        yield
 
 
 def structured_annulus(r_in=8.0, r_out=30.0, n_r=6, n_t=72):

@@ -722,7 +722,7 @@ def reducer_section(discs: _Discs) -> Section:
     return Section("8. The reducer stage: crankshaft beams, support springs, limits, reverse torque",
                    "Beam closed forms on a 40 mm span, EI = 2e9 N·mm², κGA = 3e7 N; the crankshaft "
                    f"limits on the coarse fan-hole pair (first six {STEP_DEG:g}° steps); the reverse-torque "
-                   "mirror of the handbook model (the FE mirror, on a mirrored mesh, is tests/test_contact.py).",
+                   "mirror of the handbook model (the FE mirror, on a mirrored mesh, is tests/solve/test_contact.py).",
                    tuple(checks))
 
 
@@ -824,7 +824,7 @@ def roller_depth_section() -> Section:
     return Section("11. The crank bearing in depth",
                    "The slice model of a roller on an elastic half-space, the ISO/TS 16281 lamina life, the EHL film "
                    "and the crankshaft's slope at the eccentrics (docs/theory.md § 12). The slice model against a "
-                   "two-dimensional half-space solve is in tests/test_roller_slices.py.", checks)
+                   "two-dimensional half-space solve is in tests/evaluate/test_roller_slices.py.", checks)
 
 
 def _stiff_accuracy_stage(discs: _Discs, *overrides: str):

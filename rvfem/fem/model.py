@@ -187,7 +187,7 @@ def plane_stress_stiffness(scalar_basis: Any, vector_element_dofs: np.ndarray, l
     This is scikit-fem's ``linear_elasticity(λ, μ)`` on the vector basis term by term: three
     scalar forms of 6×6 (P1: 3×3) cheap local products per triangle instead of one vector form of
     12×12 (P1: 6×6) tensor products, half of whose components are zero; the two agree to
-    round-off (tests/test_fem.py).
+    round-off (tests/fem/test_fem.py).
 
     Parameters
     ----------

@@ -290,7 +290,7 @@ def _submatrix(stiffness: sp.spmatrix, keep: np.ndarray, lower: bool = False) ->
     entries (fancy indexing copies the whole matrix twice; for the P2 disc that is 100 MB).
 
     The whole matrix comes as CSC: the rows of the CSR form taken as the columns, which gives the
-    transpose, the same matrix as the stiffness is symmetric (tests/test_fem.py). With ``lower``
+    transpose, the same matrix as the stiffness is symmetric (tests/fem/test_fem.py). With ``lower``
     only its lower triangle comes, as CSR.
     """
     k = sp.csr_matrix(stiffness)

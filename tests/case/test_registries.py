@@ -64,9 +64,7 @@ def test_every_model_of_the_package_is_declared_and_every_declared_name_has_its_
         assert own == set(registry.builtin_model_names(kind))
 
 
-def test_a_model_of_the_package_with_an_undeclared_name_is_refused_when_registered(monkeypatch):
-    monkeypatch.setattr(registry, "_PINS", dict(registry._PINS))
-    monkeypatch.setitem(registry._KINDS, "pin", registry._PINS)
+def test_a_model_of_the_package_with_an_undeclared_name_is_refused_when_registered(registries):
     stray = type("StrayPins", (), {"name": "stray", "__module__": "rvfem.solve.stray"})
     with pytest.raises(ValueError, match="'stray' is rvfem's own but not declared in rvfem.case.registry.BUILTIN_MODELS"):
         registry.register_pin_model(stray)

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import jinja2
 import pytest
-from conftest import CASES_DIR, ROOT
+from conftest import CASES_DIR, ROOT, saved_registries
 
 from rvfem.app import cli, screen
 from rvfem.case.definition import case_from_dict, case_to_dict, load_case
@@ -57,8 +57,7 @@ def _write_extra(analysis, folder, *, tick=None) -> list[Path]:
 def run_folder(tmp_path_factory) -> Path:
     work = tmp_path_factory.mktemp("report")
     out = work / "run"
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(registry, "_WRITERS", dict(registry._WRITERS))    # the registry as it was, afterwards
+    with saved_registries():                  # the registry as it was, afterwards
         registry.register_writer("extra", order=25, stage="tables", options=("tick",), files=(EXTRA,))(_write_extra)
         code = cli.main(["run", str(CASES_DIR / "rv40e_fanholes.toml"), "-o", str(out),
                          "--cache-dir", str(work / "meshes"), *COARSE])
@@ -146,7 +145,7 @@ def test_the_writers_are_registered_in_the_order_a_run_calls_them():
     assert writers[-1].stage is None and all(w.stage for w in writers[:-1])
 
 
-def test_register_writer_refuses_a_taken_name_or_order_and_unknown_options():
+def test_register_writer_refuses_a_taken_name_or_order_and_unknown_options(registries):
     before = dict(registry._WRITERS)
     with pytest.raises(ValueError, match="order 10 is taken by the writer 'tables'"):
         registry.register_writer("other", order=10, stage="tables")(_write_extra)

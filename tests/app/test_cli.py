@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 from conftest import CASES_DIR, documented_keys, written_keys
@@ -266,7 +265,7 @@ def test_rigid_json_has_versions_digest_and_documented_keys(tmp_path, capsys):
     from rvfem.case.definition import file_sha256, load_case
     from rvfem.outputs.summary import RIGID_SCHEMA_VERSION
 
-    duty = str(Path(__file__).resolve().parents[1] / "cases" / "crv80e_duty.toml")
+    duty = str(CASES_DIR / "crv80e_duty.toml")
     written = set()
     for path in (CRV80E, duty, str(CASES_DIR / "rv40e_two_teeth.toml")):
         assert cli.main(["rigid", path, "--json"]) == 0

@@ -4,7 +4,7 @@ and JupyterLab do. Only the parameters are changed (a coarser crank-angle step, 
 cache) to stay fast; what the notebooks compute is then checked against physics.
 
 ``notebooks/design_study.ipynb`` and ``notebooks/what_drives_the_flexibility_effect.ipynb`` have
-their own test files (tests/test_study.py, tests/test_verification.py). Every notebook's figures
+their own test files (tests/end_to_end/test_study.py, tests/app/test_verification.py). Every notebook's figures
 must be in its executed outputs (``conftest.assert_figures_shown``): rvfem draws its own figures
 without pyplot, so a notebook's inline backend stays on.
 """

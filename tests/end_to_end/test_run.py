@@ -19,7 +19,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 import pytest
-from conftest import CaseText, documented_keys, written_keys
+from conftest import ROOT, CaseText, documented_keys, written_keys
 
 from rvfem import __version__
 from rvfem.app import cli, screen
@@ -852,7 +852,7 @@ def test_repository_files_are_found_from_any_folder(tmp_path, monkeypatch):
     from rvfem.app.analysis import default_cache_dir, repository_path
     from rvfem.errors import CaseError
 
-    root = Path(__file__).resolve().parents[1]
+    root = ROOT
     monkeypatch.chdir(root / "notebooks")
     assert repository_path("cases/rv40e_fanholes.toml") == root / "cases" / "rv40e_fanholes.toml"
     assert repository_path("cases/rv40e_fanholes.toml", start=root / "rvfem" / "fem") == \

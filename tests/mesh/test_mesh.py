@@ -16,6 +16,7 @@ from pathlib import Path
 import gmsh
 import numpy as np
 import pytest
+from conftest import CASES_DIR, ROOT
 from scipy.integrate import quad
 
 from rvfem.case.definition import load_case
@@ -24,7 +25,7 @@ from rvfem.geometry import closest_points, disc_geometry
 from rvfem.mesh import gmsh_session, mesh_case, mesh_key, mesh_path, read_msh
 from rvfem.outputs.plots import mesh_preview
 
-CASES = Path(__file__).resolve().parents[1] / "cases"
+CASES = CASES_DIR
 
 MIN_QUALITY = 0.6
 """Accepted smallest minSICN (1 = equilateral). Measured: 0.684 (coarse fan-hole mesh), 0.660
@@ -331,7 +332,7 @@ def test_two_processes_building_the_same_mesh_share_one_complete_file(tmp_path):
         "m = mesh_case(case, sys.argv[2])\n"
         "print(m.n_nodes, m.from_cache)\n"
     )
-    root = Path(__file__).resolve().parents[1]
+    root = ROOT
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")]))
     cache, go = tmp_path / "cache", tmp_path / "go"
     args = [sys.executable, "-c", script, str(CASES / "rv40e_solid.toml"), str(cache), str(go)]

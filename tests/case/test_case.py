@@ -553,11 +553,11 @@ def test_bad_element_order_lists_the_orders(case_text, tmp_path):
 # --------------------------------------------------------------------------------------------
 
 
-def test_a_model_registered_at_run_time_is_accepted(case_text, tmp_path, monkeypatch):
+def test_a_model_registered_at_run_time_is_accepted(case_text, tmp_path, registries):
     class SoftBearing:
         name = "soft_test_bearing"
 
-    monkeypatch.setitem(registry._BEARINGS, SoftBearing.name, SoftBearing)
+    registry.register_bearing_model(SoftBearing)
     case_text.set("crank_bearing", "model", '"soft_test_bearing"')
     assert load_case(case_text.write(tmp_path)).crank_bearing.model == "soft_test_bearing"
 

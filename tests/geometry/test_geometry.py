@@ -12,10 +12,10 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import CASES_DIR
 from scipy.integrate import quad
 from scipy.optimize import brentq, minimize_scalar
 from scipy.spatial import cKDTree
@@ -32,7 +32,7 @@ from rvfem.geometry import (
     pitch_errors,
 )
 
-CASES = Path(__file__).resolve().parents[1] / "cases"
+CASES = CASES_DIR
 
 
 @pytest.fixture(scope="module")

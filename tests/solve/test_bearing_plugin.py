@@ -62,9 +62,10 @@ class LinearBoreSpring:
 
 
 @pytest.fixture
-def plugin(monkeypatch):
-    monkeypatch.setitem(registry._BEARINGS, LinearBoreSpring.name, LinearBoreSpring)
-    return LinearBoreSpring
+def plugin(registries):
+    """The bore spring registered as a crank-bearing model for one test (the registries fixture
+    removes it afterwards)."""
+    return registry.register_bearing_model(LinearBoreSpring)
 
 
 def _run(tmp_path, model: str) -> dict:

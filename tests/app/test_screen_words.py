@@ -12,11 +12,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from conftest import ROOT
 
 from rvfem.app.cli import main
 from rvfem.case.definition import load_case
 
-ROOT = Path(__file__).resolve().parents[1]
 CASE = str(ROOT / "cases" / "rv40e.toml")
 
 

@@ -14,12 +14,11 @@
 from __future__ import annotations
 
 import types
-from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from conftest import CASES_DIR
+from conftest import CASES_DIR, REGRESSIONS_DIR
 
 from rvfem.app import cli
 from rvfem.case.definition import load_case
@@ -28,7 +27,7 @@ from rvfem.evaluate import attribution as attribution_module
 from rvfem.evaluate.rigid import handbook_bearing_loads, load_cycle_angles
 from rvfem.solve import contact
 
-REGRESSIONS = Path(__file__).resolve().parent / "regressions"
+REGRESSIONS = REGRESSIONS_DIR
 CASE_FILES = sorted(REGRESSIONS.glob("*.toml"))
 
 
