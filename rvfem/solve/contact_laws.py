@@ -8,8 +8,13 @@ approach δ (mm) to the force q (N) and its slope dq/dδ (N/mm).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 from scipy.special import lambertw
+
+ForceLaw = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
+"""A force law of spring contacts, vectorised: approach δ (mm) → (force q (N), slope dq/dδ (N/mm))."""
 
 
 PALMGREN_COEFFICIENT = 3.84e-5

@@ -87,7 +87,7 @@ def pin_contacts_many(system: DiscSystem, pcs, friction: float, slip: int = 0) -
             W=Ws[a], signorini=np.full(zp, rigid),
             gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
             offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
-            laws=[] if rigid else [(np.arange(zp), law)], names=names,
+            laws=[] if law is None else [(np.arange(zp), law)], names=names,
             bearing=np.full(zp, -1), W_load=W_load))
     return out
 

@@ -16,14 +16,15 @@ force (N) and its derivative (N/mm), see :func:`rvfem.solve.contact.palmgren_law
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import ClassVar, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 import scipy.sparse as sp
 
 from rvfem._arrays import readonly as _readonly
-from rvfem.case.definition import FOOTPRINT_ELEMENTS
+from rvfem.case.definition import FOOTPRINT_ELEMENTS, Case
 from rvfem.case.registry import (
     builtin_model_names,
     register_bearing_model,
@@ -31,7 +32,10 @@ from rvfem.case.registry import (
     registered_models,
 )
 from rvfem.errors import CaseError
+from rvfem.geometry import PinContacts
 from rvfem.solve import contact
+from rvfem.solve.contact_interface import Interface
+from rvfem.solve.contact_laws import ForceLaw
 
 __all__ = [
     "ContactGroup",
@@ -79,8 +83,8 @@ class ContactGroup:
     signorini: np.ndarray
     gap0: np.ndarray
     offset: np.ndarray
-    laws: list
-    names: list
+    laws: list[tuple[np.ndarray, ForceLaw]]
+    names: list[str]
     bearing: np.ndarray
     W_load: sp.csc_matrix | None = None
 
@@ -89,7 +93,8 @@ class ContactGroup:
         return self.W.shape[1]
 
 
-def _group(n_columns: int, rows, cols, vals, m: int, **kw) -> ContactGroup:
+def _group(n_columns: int, rows: list[np.ndarray], cols: list[np.ndarray], vals: list[np.ndarray], m: int,
+           **kw: Any) -> ContactGroup:
     W = sp.csc_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n_columns, m))
     return ContactGroup(W=W, **kw)
 
@@ -134,12 +139,12 @@ class BearingModel(Protocol):
 
     name: ClassVar[str]
 
-    def __init__(self, case, stiffness_scale: float = 1.0) -> None: ...
+    def __init__(self, case: Case, stiffness_scale: float = 1.0) -> None: ...
 
     def describe(self) -> str:
         """One sentence for the report's assumptions."""
 
-    def contacts(self, interface, centres: np.ndarray, theta: float) -> ContactGroup:
+    def contacts(self, interface: Interface, centres: np.ndarray, theta: float) -> ContactGroup:
         """The bearing contacts at crank angle θ (rad); ``centres`` are the bore centres (N, 2).
 
         A model may also provide ``contacts_many(interface, centres, thetas)``, the list of the
@@ -158,12 +163,12 @@ class PinModel(Protocol):
     name: ClassVar[str]
     rigid: ClassVar[bool]
 
-    def __init__(self, case, stiffness_N_per_mm: float | None = None) -> None: ...
+    def __init__(self, case: Case, stiffness_N_per_mm: float | None = None) -> None: ...
 
     def describe(self) -> str:
         """One sentence for the report's assumptions."""
 
-    def law(self, contacts=None, curvature=None):
+    def law(self, contacts: PinContacts | None = None, curvature: np.ndarray | None = None) -> ForceLaw | None:
         """The pins' force–approach law at one crank angle (None for rigid pins).
 
         ``contacts`` is the angle's :class:`rvfem.geometry.PinContacts` and ``curvature`` (Zp,)
@@ -173,7 +178,7 @@ class PinModel(Protocol):
         """
 
 
-def bearing_contacts_many(bearings: BearingModel, interface, centres: np.ndarray, thetas
+def bearing_contacts_many(bearings: BearingModel, interface: Interface, centres: np.ndarray, thetas: Sequence[float] | np.ndarray
                           ) -> list[ContactGroup]:
     """The contacts of a bearing model at many crank angles: its ``contacts_many`` where it has
     one, else its ``contacts`` angle by angle."""
@@ -183,7 +188,7 @@ def bearing_contacts_many(bearings: BearingModel, interface, centres: np.ndarray
     return [bearings.contacts(interface, centres, float(theta)) for theta in thetas]
 
 
-def roller_angles(case, theta: float | np.ndarray) -> np.ndarray:
+def roller_angles(case: Case, theta: float | np.ndarray) -> np.ndarray:
     """Angular positions of the rollers of every bearing at crank angle θ, (N, Z), rad; for an
     array of angles (n,), (n, N, Z).
 
@@ -221,12 +226,13 @@ class RollerBearing:
 
     name = "rollers"
 
-    def __init__(self, case, stiffness_scale: float = 1.0):
+    def __init__(self, case: Case, stiffness_scale: float = 1.0) -> None:
         self.case = case
         b = case.crank_bearing
         if b.stiffness_law == "palmgren":
             self._law = contact.palmgren_law(b.roller_length, contacts=2)
         else:
+            assert b.linear_stiffness_N_per_mm is not None      # the case requires it with the linear law
             self._law = contact.linear_law(b.linear_stiffness_N_per_mm)
 
     def describe(self) -> str:
@@ -236,23 +242,23 @@ class RollerBearing:
         return (f"crank bearings: {b.rollers} discrete rollers per bearing at their cage positions, "
                 f"each a compression-only spring ({law}), radial clearance {b.radial_clearance:g} mm")
 
-    def contacts(self, interface, centres, theta):
+    def contacts(self, interface: Interface, centres: np.ndarray, theta: float) -> ContactGroup:
         return self.contacts_many(interface, centres, [theta])[0]
 
-    def contacts_many(self, interface, centres, thetas):
+    def contacts_many(self, interface: Interface, centres: np.ndarray, thetas: Sequence[float] | np.ndarray) -> list[ContactGroup]:
         """:meth:`contacts` of many crank angles: the rollers of all of them located on each bore
         at once."""
         b = self.case.crank_bearing
         psi = roller_angles(self.case, np.asarray(thetas, dtype=float))       # (n, N, Z)
         n_angles, n_bearings, z = psi.shape
-        cols, wts = [], []
+        bore_cols, bore_wts = [], []
         for i, c in enumerate(centres):
             grid = interface.grids[f"bore_{i}"]
             pts = c + b.bore_radius * np.stack([np.cos(psi[:, i]), np.sin(psi[:, i])], axis=-1)
             cc, ww = grid.columns_at(grid.arc_of(pts.reshape(-1, 2)))
-            cols.append(cc.reshape(n_angles, z, 2))
-            wts.append(ww.reshape(n_angles, z, 2))
-        cols, wts = np.concatenate(cols, axis=1), np.concatenate(wts, axis=1)   # bearing after bearing
+            bore_cols.append(cc.reshape(n_angles, z, 2))
+            bore_wts.append(ww.reshape(n_angles, z, 2))
+        cols, wts = np.concatenate(bore_cols, axis=1), np.concatenate(bore_wts, axis=1)   # bearing after bearing
         n = n_bearings * z
         names = [f"bearing {i + 1} roller {k + 1}" for i in range(n_bearings) for k in range(z)]
         bearing = np.repeat(np.arange(n_bearings), z)
@@ -264,7 +270,8 @@ class RollerBearing:
                              bearing=bearing)
                 for W in contact_columns_many(interface.n_columns, cols, wts)]
 
-    def bearing_forces(self, vectors, forces, theta):
+    def bearing_forces(self, vectors: np.ndarray, forces: np.ndarray, theta: float
+                       ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
         n, z = self.case.cranks.count, self.case.crank_bearing.rollers
         return (vectors.reshape(n, z, 2).sum(axis=1), forces.reshape(n, z),
                 roller_angles(self.case, theta))
@@ -282,7 +289,7 @@ class RigidBoreBearing:
 
     name = "rigid_bore"
 
-    def __init__(self, case, stiffness_scale: float = 1.0):
+    def __init__(self, case: Case, stiffness_scale: float = 1.0) -> None:
         self.case = case
         self.stiffness = case.crank_bearing.rigid_bore_stiffness_N_per_mm * stiffness_scale
 
@@ -290,8 +297,12 @@ class RigidBoreBearing:
         return ("crank bearings: each bore tied to a rigid ring by a radial pressure ∝ cos, with one "
                 f"isotropic bearing spring of {self.stiffness:.3g} N/mm")
 
-    def contacts(self, interface, centres, theta):
-        rows, cols, vals, names, bearing = [], [], [], [], []
+    def contacts(self, interface: Interface, centres: np.ndarray, theta: float) -> ContactGroup:
+        rows: list[np.ndarray] = []
+        cols: list[np.ndarray] = []
+        vals: list[np.ndarray] = []
+        names: list[str] = []
+        bearing: list[int] = []
         n = 0
         for i, c in enumerate(centres):
             grid = interface.grids[f"bore_{i}"]
@@ -309,7 +320,8 @@ class RigidBoreBearing:
                       laws=[(np.arange(n), contact.linear_law(self.stiffness, bilateral=True))],
                       names=names, bearing=np.asarray(bearing))
 
-    def bearing_forces(self, vectors, forces, theta):
+    def bearing_forces(self, vectors: np.ndarray, forces: np.ndarray, theta: float
+                       ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
         n = self.case.cranks.count
         return vectors.reshape(n, 2, 2).sum(axis=1), None, None
 
@@ -326,17 +338,17 @@ class RigidPins:
     name = "rigid"
     rigid = True
 
-    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+    def __init__(self, case: Case, stiffness_N_per_mm: float | None = None) -> None:
         self.case = case
 
     def describe(self) -> str:
         return "rigid pins (Signorini contact: gap ≥ 0, force ≥ 0)"
 
-    def law(self, contacts=None, curvature=None):
+    def law(self, contacts: PinContacts | None = None, curvature: np.ndarray | None = None) -> ForceLaw | None:
         return None
 
 
-def _footprint_half_width(case) -> float:
+def _footprint_half_width(case: Case) -> float:
     """Half-width of the FE pin-load footprint, mm (``FOOTPRINT_ELEMENTS`` element sizes)."""
 
     return FOOTPRINT_ELEMENTS * case.mesh.size_flank
@@ -356,7 +368,7 @@ class HertzPins:
     name = "hertz"
     rigid = False
 
-    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+    def __init__(self, case: Case, stiffness_N_per_mm: float | None = None) -> None:
         self.case = case
 
     def describe(self) -> str:
@@ -366,7 +378,7 @@ class HertzPins:
                 f"curvature (disc E = {m.youngs_modulus:g} MPa, ν = {m.poissons_ratio:g}), over the "
                 f"disc width {self.case.cycloid.thickness:g} mm")
 
-    def law(self, contacts=None, curvature=None):
+    def law(self, contacts: PinContacts | None = None, curvature: np.ndarray | None = None) -> ForceLaw | None:
         """The law of the pins of one crank angle; ``curvature`` (Zp,) is the flank curvature at
         each pin's contact point, 1/mm (:func:`rvfem.geometry.profile_curvature`)."""
         if curvature is None:
@@ -392,14 +404,14 @@ class PalmgrenPins:
     name = "palmgren"
     rigid = False
 
-    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+    def __init__(self, case: Case, stiffness_N_per_mm: float | None = None) -> None:
         self.case = case
 
     def describe(self) -> str:
         return ("compliant pins: Palmgren's steel line-contact approach of each pin–flank contact "
                 "(independent of pin radius, flank curvature and materials)")
 
-    def law(self, contacts=None, curvature=None):
+    def law(self, contacts: PinContacts | None = None, curvature: np.ndarray | None = None) -> ForceLaw | None:
         return contact.palmgren_law(self.case.cycloid.thickness, contacts=1)
 
 
@@ -417,7 +429,7 @@ class LinearPins:
     name = "linear"
     rigid = False
 
-    def __init__(self, case, stiffness_N_per_mm: float | None = None):
+    def __init__(self, case: Case, stiffness_N_per_mm: float | None = None) -> None:
         if stiffness_N_per_mm is None:
             stiffness_N_per_mm = getattr(case.pins, "linear_stiffness_N_per_mm", None)
         if not (stiffness_N_per_mm and stiffness_N_per_mm > 0):
@@ -429,7 +441,7 @@ class LinearPins:
     def describe(self) -> str:
         return f"linear pin springs of {self.stiffness:g} N/mm (the classical pin-force assumption)"
 
-    def law(self, contacts=None, curvature=None):
+    def law(self, contacts: PinContacts | None = None, curvature: np.ndarray | None = None) -> ForceLaw | None:
         return contact.linear_law(self.stiffness)
 
 

@@ -20,9 +20,10 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from rvfem.case.definition import CrankSupport
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import models
-from rvfem.solve.cycle import OperatingPoint, ReducerStage, build_system, solve_pair
+from rvfem.solve.cycle import DiscSystem, OperatingPoint, ReducerStage, build_system, solve_pair
 
 __all__ = ["COMPONENTS", "STAGE_PARTS", "STIFFEN", "StagePart", "held_in_words", "stage_part", "stiffened_stage"]
 
@@ -61,7 +62,7 @@ class StagePart:
     crank: bool = False
 
 
-def _with_disc_system(stage: ReducerStage, system) -> ReducerStage:
+def _with_disc_system(stage: ReducerStage, system: DiscSystem) -> ReducerStage:
     """The stage with disc A's model replaced (and disc B's, which is disc A's)."""
     if stage.second is not None and stage.second is not stage.first:
         raise ValueError("stiffening a disc's part needs disc B modelled as disc A (second_disc = 'same_as_first')")
@@ -101,14 +102,14 @@ def _stiff_rollers(stage: ReducerStage) -> ReducerStage:
                                                         contact_sets={}))
 
 
-def _beam_support(stage: ReducerStage, name: str):
+def _beam_support(stage: ReducerStage, name: str) -> CrankSupport:
     cs = stage.first.case.crank_support
     if cs is None or cs.influence_mm_per_N is not None or stage.influence is None:
         raise ValueError(f"the {name} share needs the beam keys of [crank_support]")
     return cs
 
 
-def _with_support(stage: ReducerStage, cs) -> ReducerStage:
+def _with_support(stage: ReducerStage, cs: CrankSupport) -> ReducerStage:
     # the influence of the changed beam alone (E × 10³ is outside a case's bounds on purpose)
     influence = crankshaft_influence(SimpleNamespace(crank_support=cs))
     assert influence is not None        # the beam keys are there (_beam_support)
@@ -126,8 +127,8 @@ def _stiff_support(stage: ReducerStage) -> ReducerStage:
     """The support bearings' (and the carrier's) stiffness × STIFFEN."""
     cs = _beam_support(stage, "support bearings")
 
-    def scale(v):
-        return None if v is None else (v * STIFFEN if np.isscalar(v) else tuple(x * STIFFEN for x in v))
+    def scale(v: float | tuple[float, ...] | None) -> float | tuple[float, ...] | None:
+        return None if v is None else (tuple(x * STIFFEN for x in v) if isinstance(v, tuple) else v * STIFFEN)
 
     return _with_support(stage, dataclasses.replace(cs, support_stiffness_N_per_mm=scale(cs.support_stiffness_N_per_mm),
                                                     carrier_stiffness_N_per_mm=scale(cs.carrier_stiffness_N_per_mm)))
@@ -175,7 +176,7 @@ def held_in_words() -> str:
     return ", ".join(phrases[:-1]) + " and " + phrases[-1]
 
 
-def _secant_stiffness(system, which: str, stage: ReducerStage) -> float:
+def _secant_stiffness(system: DiscSystem, which: str, stage: ReducerStage) -> float:
     """Secant stiffness (N/mm) of the pins' or the rollers' law at their mean load at the rated torque:
     a stand-in scale for 'STIFFEN times stiffer'."""
     op = OperatingPoint.of(system.case)
