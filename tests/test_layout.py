@@ -1,5 +1,5 @@
 """The tests mirror the package: a test module lies in the folder of the package layer it mainly
-tests (``tests/solve/`` for ``rvfem/solve``, ``tests/mesh/`` for ``rvfem/mesh.py``), the whole-job
+tests (``tests/solve/`` for ``rvfem/solve``, ``tests/mesh/`` for ``rvfem/mesh``), the whole-job
 tests in ``tests/end_to_end/``, and only the checks of the package as a whole or of one of its
 top-level modules directly in ``tests/``."""
 
