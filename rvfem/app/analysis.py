@@ -1100,7 +1100,7 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
         stage is skipped.
     recover_stress : bool
         Re-solve the disc on P2 at the structural peak's crank angles with the cycle's forces
-        (:func:`rvfem.evaluate.postprocess.recover_peak`; stage ``stress``, about 2 s on the default case).
+        (:func:`rvfem.evaluate.postprocess.recover_peak`; stage ``stress``).
     duty_fe : bool
         With a duty cycle: also solve the flexible load cycle at every other duty-cycle torque and
         give the service life from those loads (:func:`duty_cycle_fe`; stage ``duty_cycle``, one

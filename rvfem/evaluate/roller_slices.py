@@ -318,9 +318,9 @@ _BLAS: ThreadpoolController | None = None
 
 def _single_threaded_blas():
     """A context with BLAS single-threaded. The systems are small (n ≤ 400) and many: threaded
-    BLAS only contends for the cores there (the same 100-slice evaluation took 7 s single-threaded
-    and 84 s with two threads on two loaded cores). The libraries are found once (reading the
-    process's memory map takes about 2 ms, as long as a 30-slice group's solve)."""
+    BLAS only contends for the cores there (benchmarks/README.md, "Roller slices"). The libraries
+    are found once: reading the process's memory map costs about as much as a 30-slice group's
+    solve."""
     global _BLAS
     if _BLAS is None:
         _BLAS = ThreadpoolController()

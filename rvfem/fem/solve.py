@@ -55,13 +55,8 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 
-#: Order in which ``solver="auto"`` tries the backends, by measurement
-#: (``benchmarks/bench_factorization.py``, numbers in its docstring): on a 15k-vertex annulus
-#: CHOLMOD back-substitutes 1000 columns in 3.8 s (P1) / 24 s (P2), PARDISO in 5.1 s / 29 s,
-#: SuperLU (symmetric mode, MMD on AᵀA+A) in 7.1 s / 65 s; factorisation 0.2–2.6 s for all.
-#: cholespy's CHOLMOD (reference BLAS, one thread) on the default fan-hole disc: 0.79 ms a P1
-#: column (38k DOFs) against SuperLU's 2.0 ms, P1 factorisation 0.12 s (SuperLU 0.10 s), P2
-#: (147k DOFs) 0.89 s (0.72 s), and a P2 factor of 89 MB resident against SuperLU's 147 MB.
+#: Order in which ``solver="auto"`` tries the backends, by measurement: fastest first at
+#: back-substituting many columns (benchmarks/README.md, "Sparse solvers").
 SOLVER_PREFERENCE: tuple[str, ...] = ("cholmod", "cholespy", "pardiso", "superlu")
 
 
@@ -87,10 +82,9 @@ def available_solvers() -> tuple[str, ...]:
 
 #: SuperLU's supernode relaxation and panel size (``relax``, ``panel_size`` of
 #: :func:`scipy.sparse.linalg.splu`; SuperLU user guide § 2.11.1, ``sp_ienv``). SciPy's defaults are
-#: 10 and 20; on the default fan-hole disc (two cores) 2 and 8 factorise the P1 stiffness
-#: (38k DOFs) in 0.09 s instead of 0.14 s and the P2 one (147k DOFs) in 0.65 s instead of
-#: 0.87 s, and back-substitute 16 P1 columns in 0.028 s instead of 0.035 s (best of 15); the
-#: factor has the same nonzeros, the solutions differ by round-off (≤ 2e-12 relative). Keep both
+#: 10 and 20; on the default fan-hole disc 2 and 8 factorise and back-substitute faster
+#: (benchmarks/README.md, "Sparse solvers"); the factor has the same nonzeros, the solutions
+#: differ by round-off (≤ 2e-12 relative). Keep both
 #: small: SciPy 1.17's SuperLU corrupts its heap with a panel size of 24.
 SUPERLU_RELAX = 2
 SUPERLU_PANEL_SIZE = 8
@@ -201,8 +195,8 @@ class Factorization:
     batch : int
         Right-hand sides per back-substitution call that cost least per column (measured on the
         default fan-hole disc, 38k DOFs: SuperLU 16; cholespy 8, whose reference-BLAS
-        solve slows down once the block of right-hand sides leaves the cache, 0.79 ms a column
-        at 8 against 1.08 ms at 16 and 1.52 ms at 128).
+        solve slows down once the block of right-hand sides leaves the cache; benchmarks/README.md,
+        "Sparse solvers").
     """
 
     solver: str

@@ -185,7 +185,7 @@ class Compliance:
         """Make sure ``C[:, columns]`` is available.
 
         Missing columns are back-substituted in batches of :attr:`batch` right-hand sides, on
-        :attr:`workers` threads (SciPy's SuperLU releases the GIL: 1.6× on two cores, measured;
+        :attr:`workers` threads (SciPy's SuperLU releases the GIL, benchmarks/README.md, "Load cycle";
         cholespy holds it, and its systems use one thread); with a rotation map only those of one
         sector, the rest are rotated copies.
         """

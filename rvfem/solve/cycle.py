@@ -298,7 +298,7 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, op: Oper
     stress_envelope : bool
         Also track the largest vertex von Mises stress of every vertex over all angles: the
         fields of the distinct solved angles, back-substituted FIELD_BATCH at a time, and one
-        sparse product per batch (0.5 s on the default case); turned angles reuse them.
+        sparse product per batch; turned angles reuse them.
     """
     case = system.case
     thetas = cycle_angles(case) if thetas is None else np.asarray(thetas, dtype=float)
@@ -306,7 +306,7 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, op: Oper
     stage = case_stage(system) if stage is None else stage
     t0 = time.perf_counter()
     # the per-angle systems are small (~100 unknowns): threaded BLAS only adds overhead there
-    # (measured 7x slower on two cores), so the cycle runs BLAS single-threaded
+    # (benchmarks/README.md, "Load cycle"), so the cycle runs BLAS single-threaded
     with threadpool_limits(limits=1, user_api="blas"):
         results, extras = solve_stage_cycle(stage, thetas, op, progress)
         t_prefetch = extras.pop("prefetch_seconds")

@@ -156,7 +156,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
         Stiffness of the ``"linear"`` pin model, N/mm (overrides the case's).
     column_stride : int
         Interface columns at every stride-th boundary vertex. 1 (default) is the accurate
-        choice; 2 halves the back-substitutions (default fan-hole case: cycle 8.5 → 6.0 s) at the
+        choice; 2 halves the back-substitutions (benchmarks/README.md, "Load cycle") at the
         price of 0.6 % of the maximum bearing load and 5 % on single pin forces.
     geometry : rvfem.geometry.DiscGeometry, optional
         The case's checked geometry (:func:`rvfem.geometry.disc_geometry`) if already built.
