@@ -84,6 +84,7 @@ from rvfem.case.definition import case_to_dict, load_case, parse_override
 from rvfem.case.schema import toml_literal
 from rvfem.errors import CaseError, OutputError, RvfemError
 from rvfem.outputs.csvfile import csv_text
+from rvfem.outputs.figures import new_figure, save_figure
 from rvfem.outputs.report import png_data_uri, template_environment
 from rvfem.outputs.summary import prepare_output_folder
 
@@ -662,15 +663,7 @@ def pareto_front(rows: Sequence[dict], x: str = "disc_mass_kg", y: str = "life_r
 
 
 def _pareto_png(problem: Problem, rows: Sequence[dict], base: dict | None, best: dict | None, path: Path) -> Path:
-    from matplotlib.backends.backend_agg import (
-        FigureCanvasAgg,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-    from matplotlib.figure import (
-        Figure,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-
-    fig = Figure(figsize=(8, 5.5))
-    FigureCanvasAgg(fig)
+    fig = new_figure((8, 5.5))
     ax = fig.subplots()
     ok = [r for r in rows if r.get("disc_mass_kg") is not None and r.get("life_ratio") is not None]
     sf = [min(r.get("fatigue_safety_factor") or 0.0, 50.0) for r in ok]
@@ -700,8 +693,7 @@ def _pareto_png(problem: Problem, rows: Sequence[dict], base: dict | None, best:
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
     ax.set_title(f"{problem.name}: {len(rows)} designs; budgets: {budgets}", fontsize=10)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    return path
+    return save_figure(fig, path)
 
 
 def _fmt(v: Any, spec: str) -> str:

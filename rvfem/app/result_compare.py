@@ -30,6 +30,7 @@ import numpy as np
 from rvfem.app.run import run_case
 from rvfem.case.definition import Case, load_case
 from rvfem.errors import OutputError
+from rvfem.outputs.figures import new_figure, save_figure
 from rvfem.outputs.report import png_data_uri, template_environment
 
 __all__ = ["ResultFolder", "STATISTICS", "read_result", "result_from_case", "compare_results",
@@ -252,15 +253,8 @@ def comparison_figure(a: ResultFolder, b: ResultFolder):
     from matplotlib import (
         rcParams,  # drawing only: matplotlib is a heavy import the solver never needs
     )
-    from matplotlib.backends.backend_agg import (
-        FigureCanvasAgg,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-    from matplotlib.figure import (
-        Figure,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
 
-    fig = Figure(figsize=(8, 5.5))
-    FigureCanvasAgg(fig)
+    fig = new_figure((8, 5.5))
     ax = fig.subplots()
     colours = rcParams["axes.prop_cycle"].by_key()["color"]
     for i in range(a.flexible_N.shape[1]):
@@ -285,10 +279,7 @@ def comparison_figure(a: ResultFolder, b: ResultFolder):
 
 def comparison_plot(a: ResultFolder, b: ResultFolder, path: str | os.PathLike) -> Path:
     """Write :func:`comparison_figure` as a PNG and return its path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    comparison_figure(a, b).savefig(path, dpi=110)
-    return path
+    return save_figure(comparison_figure(a, b), path)
 
 
 def _f(value, spec: str) -> str:

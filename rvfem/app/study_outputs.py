@@ -13,6 +13,7 @@ from typing import Any, Sequence
 from rvfem.app.study_definition import _SAFE, Parameter, Study, _value_text
 from rvfem.case.schema import toml_literal
 from rvfem.outputs.csvfile import csv_text
+from rvfem.outputs.figures import new_figure, save_figure
 from rvfem.outputs.report import png_data_uri, template_environment
 from rvfem.outputs.summary import result_folder
 
@@ -170,26 +171,12 @@ def _numeric(values: Sequence[Any]) -> bool:
     return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
 
 
-def _figure(size: tuple[float, float], **subplots):
-    """A figure on an Agg canvas (never :mod:`matplotlib.pyplot`: the caller's backend, e.g. a
-    notebook's inline backend, is left alone) and its axes."""
-    from matplotlib.backends.backend_agg import (
-        FigureCanvasAgg,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-    from matplotlib.figure import (
-        Figure,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-
-    fig = Figure(figsize=size)
-    FigureCanvasAgg(fig)
-    return fig, fig.subplots(**subplots)
-
-
 def _response_figure(study: Study, p: Parameter, ok: Sequence[dict]):
     """Grid: the largest bearing load against parameter ``p``, one curve per combination of the
     other parameters, the handbook dotted."""
     others = [q for q in study.parameters if q is not p]
-    fig, ax = _figure((6.4, 4.2))
+    fig = new_figure((6.4, 4.2))
+    ax = fig.subplots()
     groups: dict[tuple, list[dict]] = {}
     for r in ok:
         if r["role"] == "grid":
@@ -237,7 +224,8 @@ def _tornado_figure(study: Study, ok: Sequence[dict], base: dict):
     """Sensitivity: change of the largest load, of L10h, of the structural stress peak and of the
     disc mass against the base, per parameter."""
     bars = _tornado_bars(study, ok, base)
-    fig, axes = _figure((16, 1.2 + 0.55 * len(bars)), nrows=1, ncols=4, sharey=True)
+    fig = new_figure((16, 1.2 + 0.55 * len(bars)))
+    axes = fig.subplots(nrows=1, ncols=4, sharey=True)
     y = range(len(bars))
     for ax, idx, title in ((axes[0], 2, "largest bearing load vs base, %"),
                            (axes[1], 3, "L10h vs base, %"),
@@ -261,7 +249,8 @@ def _tornado_figure(study: Study, ok: Sequence[dict], base: dict):
 
 def _variants_figure(study: Study, rows: Sequence[dict]):
     """Every variant: flexible largest load and F_m as bars, the handbook maximum as a tick."""
-    fig, ax = _figure((max(6.4, 0.45 * len(rows) + 2) + 1.8, 4.2))   # + the legend's column
+    fig = new_figure((max(6.4, 0.45 * len(rows) + 2) + 1.8, 4.2))   # + the legend's column
+    ax = fig.subplots()
     x = range(len(rows))
     ax.bar([i - 0.2 for i in x], [r["max_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, largest load")
     ax.bar([i + 0.2 for i in x], [r["equivalent_load_N"] or 0.0 for r in rows], width=0.4, label="flexible, F_m")
@@ -313,7 +302,7 @@ def write_plots(study: Study, rows: list[dict], folder: Path) -> dict:
     files: dict[str, Path] = {}
     with result_folder(folder, overwrite=True, what="study plots") as tmp:
         for name, fig in study_figures(study, rows).items():
-            fig.savefig(tmp / _plot_file_name(name), dpi=110)
+            save_figure(fig, tmp / _plot_file_name(name))
             files[name] = folder / _plot_file_name(name)
     return files
 

@@ -1,7 +1,7 @@
 """Files of ``rvfem hysteresis``: the loop's table and picture, the compliance shares' bar chart,
 the transmission error's table and picture, and the short markdown report.
 
-Matplotlib is imported only inside the plotting functions (:func:`rvfem.outputs.plots._figure`).
+Matplotlib is imported only inside the figure factory (:func:`rvfem.outputs.figures.new_figure`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 
 from rvfem.evaluate.accuracy import ARCMIN_PER_RAD, LOST_MOTION_FRACTION
 from rvfem.outputs.csvfile import write_csv
-from rvfem.outputs.plots import _figure, _save
+from rvfem.outputs.figures import new_figure, save_figure
 from rvfem.units import ARCSEC_PER_RAD
 
 __all__ = ["accuracy_report", "hysteresis_plot", "shares_plot", "te_plot", "write_loop_csv", "write_te_csv"]
@@ -38,7 +38,7 @@ def hysteresis_plot(path: str | os.PathLike, torque_Nm: np.ndarray, branch: np.n
     """The loop (rotation in arcmin across, torque up) with the catalogue's constructions: the
     rigidity's b/a secant on the loading branch between 3 % and 100 % of the torque, the
     centreline points at ±3 % whose distance is the lost motion, and the width at zero torque."""
-    fig = _figure((7.0, 5.0))
+    fig = new_figure((7.0, 5.0))
     ax = fig.add_subplot(111)
     phi = np.asarray(rotation_rad) * ARCMIN_PER_RAD
     for k, style in enumerate(("-", "--", "-", "--")):
@@ -65,12 +65,12 @@ def hysteresis_plot(path: str | os.PathLike, torque_Nm: np.ndarray, branch: np.n
     ax.legend(loc="lower right", fontsize=8)
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def shares_plot(path: str | os.PathLike, shares: dict, *, title: str = "") -> Path:
     """Bar chart of the compliance shares (fractions of the loop's elastic rotation)."""
-    fig = _figure((7.0, 3.6))
+    fig = new_figure((7.0, 3.6))
     ax = fig.add_subplot(111)
     names = list(shares)
     values = [100.0 * shares[n] for n in names]
@@ -81,7 +81,7 @@ def shares_plot(path: str | os.PathLike, shares: dict, *, title: str = "") -> Pa
     ax.set_title(title or "where the compliance sits (each component stiffened ×1000 in turn)")
     ax.set_xlim(0, max(values + [1.0]) * 1.2)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def write_te_csv(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndarray, loaded_rad: np.ndarray
@@ -95,7 +95,7 @@ def write_te_csv(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np
 def te_plot(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndarray, loaded_rad: np.ndarray,
             torque_Nm: float, *, title: str = "") -> Path:
     """TE over one crank revolution (one output pin pitch), each about its mean, arcsec."""
-    fig = _figure((7.0, 4.0))
+    fig = new_figure((7.0, 4.0))
     ax = fig.add_subplot(111)
     arcsec = ARCSEC_PER_RAD
     for te, label in ((no_load_rad, "no load (kinematic)"), (loaded_rad, f"at {torque_Nm:g} N·m")):
@@ -110,7 +110,7 @@ def te_plot(path: str | os.PathLike, theta_deg: np.ndarray, no_load_rad: np.ndar
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)  # below: not over the curves
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _fmt(v, digits: int = 4) -> str:

@@ -1,8 +1,9 @@
 """Plots of a load cycle and the picture of the mesh (matplotlib, Agg canvas: no display needed).
 
-Each function draws one figure into a PNG file and returns its path. Matplotlib is imported only
-inside the functions (``Figure`` with an Agg canvas, never :mod:`matplotlib.pyplot`, so no global
-backend is touched).
+Each function draws one figure into a PNG file and returns its path. The figures come from the
+one factory, :func:`rvfem.outputs.figures.new_figure` (``Figure`` with an Agg canvas, never
+:mod:`matplotlib.pyplot`, so no global backend is touched; matplotlib imported only there), and are
+written by :func:`rvfem.outputs.figures.save_figure`.
 """
 
 from __future__ import annotations
@@ -14,30 +15,11 @@ from pathlib import Path
 import numpy as np
 
 from rvfem.evaluate.postprocess import feature_label
+from rvfem.outputs.figures import new_figure, save_figure
 
 __all__ = ["mesh_plot", "mesh_preview", "rim_closeup", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
 
-DPI = 120
 COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
-
-
-def _figure(size: tuple[float, float]):
-    from matplotlib.backends.backend_agg import (
-        FigureCanvasAgg,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-    from matplotlib.figure import (
-        Figure,  # drawing only: matplotlib is a heavy import the solver never needs
-    )
-
-    fig = Figure(figsize=size)
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _save(fig, path: str | os.PathLike) -> Path:
-    path = Path(path)
-    fig.savefig(path, dpi=DPI)
-    return path
 
 
 def _degree_axis(ax) -> None:
@@ -64,7 +46,7 @@ def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.
     reference_label : str
         The reference in the legend.
     """
-    fig = _figure((10.0, 5.2))
+    fig = new_figure((10.0, 5.2))
     ax = fig.subplots()
     deg = np.degrees(theta)
     order = np.argsort(deg)
@@ -80,7 +62,7 @@ def bearing_loads_plot(path: str | os.PathLike, theta: np.ndarray, flexible: np.
     ax.legend(ncol=flexible.shape[1], fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13),
               frameon=False)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def roller_loads_plot(path: str | os.PathLike, roller_angles: np.ndarray, roller_loads: np.ndarray,
@@ -101,7 +83,7 @@ def roller_loads_plot(path: str | os.PathLike, roller_angles: np.ndarray, roller
     title : str
     """
     n = roller_loads.shape[0]
-    fig = _figure((4.2 * n, 4.8))
+    fig = new_figure((4.2 * n, 4.8))
     axes = fig.subplots(1, n, subplot_kw={"projection": "polar"}, squeeze=False)[0]
     qmax = float(np.max(roller_loads)) or 1.0
     for i, ax in enumerate(axes):
@@ -119,7 +101,7 @@ def roller_loads_plot(path: str | os.PathLike, roller_angles: np.ndarray, roller
     fig.suptitle(title or f"Roller loads [N] at θ = {theta_deg:.1f}° (arrow: load of the bore on the rollers)",
                  fontsize=10)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarray, classical: np.ndarray | None, *,
@@ -137,7 +119,7 @@ def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarr
     theta_deg : float
     title : str
     """
-    fig = _figure((10.0, 4.8))
+    fig = new_figure((10.0, 4.8))
     ax = fig.subplots()
     ax.bar(pin_index, fe, width=0.7, color="tab:blue", label="FE (flexible disc)")
     if classical is not None:
@@ -154,7 +136,7 @@ def pin_forces_plot(path: str | os.PathLike, pin_index: np.ndarray, fe: np.ndarr
                           f"contact, {other})")
     ax.legend(fontsize=9)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def pins_in_contact_plot(path: str | os.PathLike, theta: np.ndarray, count: np.ndarray, total: int, *,
@@ -174,7 +156,7 @@ def pins_in_contact_plot(path: str | os.PathLike, theta: np.ndarray, count: np.n
         Loaded pins of the classical rigid distribution.
     title : str
     """
-    fig = _figure((10.0, 3.8))
+    fig = new_figure((10.0, 3.8))
     ax = fig.subplots()
     deg = np.degrees(theta)
     order = np.argsort(deg)
@@ -191,7 +173,7 @@ def pins_in_contact_plot(path: str | os.PathLike, theta: np.ndarray, count: np.n
     # below the axes: inside it would hide the curves (the count spans the whole height)
     ax.legend(fontsize=9, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray, boundaries: dict, *,
@@ -225,9 +207,7 @@ def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
     -------
     Path
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig = _figure((13.0, 6.5))
+    fig = new_figure((13.0, 6.5))
     axes = fig.subplots(1, 2)
     pts = np.asarray(points, dtype=float)
     x, y = pts[:, 0], pts[:, 1]
@@ -261,8 +241,7 @@ def mesh_plot(path: str | os.PathLike, points: np.ndarray, triangles: np.ndarray
     if subtitle:
         fig.suptitle(subtitle)
     fig.tight_layout(rect=(0, 0.07, 1, 0.94 if subtitle else 0.97))
-    fig.savefig(path, dpi=dpi)
-    return path
+    return save_figure(fig, path, dpi=dpi)
 
 
 def rim_closeup(points: np.ndarray, boundaries: dict, bore: str = "bore_0",

@@ -15,7 +15,8 @@ import numpy as np
 
 from rvfem.evaluate.roller_life import BearingDepth
 from rvfem.outputs.csvfile import write_csv
-from rvfem.outputs.plots import COLOURS, _figure, _save
+from rvfem.outputs.figures import new_figure, save_figure
+from rvfem.outputs.plots import COLOURS
 from rvfem.outputs.registry import register_writer
 
 __all__ = ["write_roller_pressure_csv", "roller_pressure_calls", "roller_pressure_curves", "roller_pressure_plot"]
@@ -79,7 +80,7 @@ def roller_pressure_plot(path: str | os.PathLike, depths: Iterable[BearingDepth]
     """Draw p(x) of the worst roller of every bearing and model (rigid dashed, flexible solid);
     bearings with the same curve share one, labelled so (:func:`roller_pressure_curves`)."""
     curves = roller_pressure_curves(depths)
-    fig = _figure((7.0, 4.6 + 0.22 * len(curves)))
+    fig = new_figure((7.0, 4.6 + 0.22 * len(curves)))
     ax = fig.add_subplot(1, 1, 1)
     for label, d in curves:
         ax.plot(d.x_mm, d.pressure_MPa, ls="--" if d.model == "rigid" else "-", color=COLOURS[d.bearing % len(COLOURS)],
@@ -91,7 +92,7 @@ def roller_pressure_plot(path: str | os.PathLike, depths: Iterable[BearingDepth]
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=1,   # below: the curves fill the axes
               title="dashed: rigid loads, solid: flexible (FE) loads", title_fontsize=7)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def roller_pressure_calls(analysis, plots_folder: str | os.PathLike) -> list[tuple]:
