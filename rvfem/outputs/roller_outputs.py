@@ -87,7 +87,7 @@ def roller_pressure_plot(path: str | os.PathLike, depths: Iterable[BearingDepth]
                 label=label)
     ax.set_xlabel("x along the roller (mm)")
     ax.set_ylabel("contact pressure (MPa)")
-    ax.set_title(f"Pressure along the roller of the highest pressure ({profile} profile, slice model)")
+    ax.set_title(f"Pressure along the roller of the highest pressure\n({profile} profile, slice model)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=1,   # below: the curves fill the axes
               title="dashed: rigid loads, solid: flexible (FE) loads", title_fontsize=7)
