@@ -51,6 +51,7 @@ from rvfem.app.verification_check import (
     noise_bound,
 )
 from rvfem.app.verification_closed_form import (
+    bearing_checks_section,
     contact_section,
     fe_core_section,
     hertz_cylinder,
@@ -78,7 +79,7 @@ __all__ = [
     "roller_depth_section",
     "contact_section", "fe_core_section", "hertz_cylinder", "kirsch_concentration", "kirsch_stress",
     "lame_dirichlet_errors", "lame_pressure_displacement_error", "lame_solution", "quads_to_triangles",
-    "seed_section", "squeezed_cylinder_mesh", "structured_annulus", "structured_plate_with_hole",
+    "bearing_checks_section", "seed_section", "squeezed_cylinder_mesh", "structured_annulus", "structured_plate_with_hole",
     "traction_load",
 ]
 
@@ -96,6 +97,7 @@ def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
         sections.append(accuracy_section(discs))
         sections.append(roller_depth_section())
         sections.append(mass_strength_section(discs))
+        sections.append(bearing_checks_section())
     return sections
 
 

@@ -17,7 +17,8 @@ from skfem import Basis, ElementVector, FacetBasis, Functional, LinearForm, asm
 from rvfem import fem
 from rvfem.app.verification_check import CASES, Check, Section
 from rvfem.case.definition import load_case
-from rvfem.evaluate.hertz import hertz_peak_pressure
+from rvfem.evaluate import bearing_checks, roller_slices
+from rvfem.evaluate.hertz import hertz_peak_pressure, rigid_ring_factor
 from rvfem.evaluate.iso281 import (
     bearing_speed_rpm,
     crank_bearing_rating,
@@ -340,3 +341,37 @@ def seed_section() -> Section:
     )
     return Section("3. Seed numbers", "Published values reproduced from the papers' own inputs; "
                    "absolute tolerances are half a unit of the last printed digit.", checks)
+
+
+def bearing_checks_section() -> Section:
+    """13. The checks next to L10h: the rigid most loaded roller against Stribeck's closed form, its
+    limit for many rollers, ISO 76's C0 by hand and the support-bearing reactions by beam statics."""
+    z, force = 14, 3000.0
+    q = roller_slices.rigid_ring_roller_loads(np.array([force, 0.0]), 2.0 * np.pi * np.arange(z) / z)
+    cosines = np.clip(np.cos(2.0 * np.pi * np.arange(z) / z), 0.0, None)
+    q_closed = force / float(np.sum(cosines ** (19.0 / 9.0)))
+    # Z/Σcos^(19/9) → 1/((1/2π)∫cos^(19/9)ψ dψ over the loaded half) for many rollers
+    limit = 2.0 * math.pi * math.gamma(19.0 / 18.0 + 1.0) / (math.gamma(0.5) * math.gamma((19.0 / 9.0 + 1.0) / 2.0))
+    k_many = rigid_ring_factor(2000)
+    bearing = load_case(CASES / "rv40e_fanholes.toml").crank_bearing
+    d_we, d_pw = bearing.roller_diameter, bearing.pitch_diameter
+    c0_hand = 44.0 * (1.0 - d_we / d_pw) * bearing.rollers * bearing.roller_length * d_we
+    c0 = bearing_checks.crank_bearing_static_rating(bearing)
+    span, z_ecc, p = 33.0, 11.5, 100.0
+    r2 = float(bearing_checks.support_reactions(span, [z_ecc], np.array([[p, 0.0]]))[1, 0])
+    checks = (
+        Check("most loaded roller of rigid rings, Z = 14, F = 3000 N, a roller on the load line, N",
+              "Stribeck, line contact: Q_max = F/Σcos^(19/9)ψ_j (Harris & Kotzalas)", q_closed, float(q.max()),
+              float(q.max()) / q_closed - 1.0, 1e-10),
+        Check("rigid-ring factor Q_max·Z/F for 2000 rollers",
+              "its integral limit 2π/∫cos^(19/9)ψ dψ = 4.085 (Stribeck's 'about 4.08')", limit, k_many,
+              k_many / limit - 1.0, 1e-6),
+        Check("C0 of the shipped crank bearing (D_we 5, D_pw 31, Z 14, L_we 9 mm), N",
+              "ISO 76: C0r = 44·(1 − D_we·cos α/D_pw)·i·Z·L_we·D_we·cos α", c0_hand, c0, c0 / c0_hand - 1.0, 1e-12),
+        Check("support-bearing reaction R2 of one eccentric load P = 100 N at z = 11.5 mm, span 33 mm, N",
+              "beam statics: R2 = P·z/L", p * z_ecc / span, r2, r2 / (p * z_ecc / span) - 1.0, 1e-12),
+    )
+    return Section("13. The checks next to L10h",
+                   "The rigid most loaded roller (one model for the Hertz table, the slice table and rvfem rigid), "
+                   "the static safety S0 = C0/P0 and the support bearings' loads (docs/theory.md). The same checks "
+                   "and the run's end-to-end agreement are in tests/evaluate/test_bearing_checks.py.", checks)
