@@ -39,6 +39,8 @@ def documented_keys(after: str | None = None) -> set[str]:
     keys: set[str] = set()
     parents: list[str] = []
     for row in table.splitlines()[2:]:
+        if not row.startswith("|"):       # the end of a generated table
+            break
         first = row.split("|")[1].strip()
         names = re.findall(r"`([^`]+)`", first)
         if first.startswith("&nbsp;"):

@@ -26,7 +26,7 @@ LAZY_LIBRARIES = {"matplotlib", "pyvista", "vtkmodules", "PIL", "dask", "distrib
 
 MAX_FUNCTION_LINES = 80
 
-SUBLAYERED = {"rvfem.solve", "rvfem.case", "rvfem.app"}
+SUBLAYERED = {"rvfem.solve", "rvfem.case", "rvfem.app", "rvfem.results"}
 """The subpackages whose modules are layered among themselves by a contract of their own."""
 
 

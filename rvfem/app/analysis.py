@@ -13,11 +13,15 @@ design study uses :func:`analyse` directly::
 :func:`analyse_rigid` is the rigid handbook evaluation alone (what ``rvfem rigid`` prints): loads,
 ISO 281 rating and life, Stribeck/Hertz pressures and the duty cycle, in milliseconds.
 
-Adding a result: give :class:`Analysis` a new field with a default (``None`` when it does not
-apply), compute it in :func:`analyse` (its stages after the model: ``_analyse_from_model`` and
-``_evaluate``), add a piece to :data:`rvfem.outputs.summary.SUMMARY_PIECES` and its
-keys to docs/outputs.md (a test checks that the documented and the written keys agree). The
-physics and the sources of every formula are in docs/theory.md.
+:func:`analyse` is a scheduler: after its fixed front (check, mesh, model, rigid references, load
+cycle and its stress envelope) it computes every result section of :mod:`rvfem.results.registry` in
+the order of their stages, with the P2 model in a child process and the attribution on a background
+thread as executor choices. Adding a result is a section (:class:`rvfem.results.section.Section`: what
+it requires, its ``compute``, its summary keys and their documentation, its screen lines and report
+rows) and its line in :data:`rvfem.results.registry.BUILTIN_SECTIONS`, or one
+:func:`rvfem.results.registry.register_section` line from outside the package; its result is the
+:class:`Analysis` field of its name or ``Analysis.extra[name]``. The physics and the sources of every
+formula are in docs/theory.md.
 """
 
 from __future__ import annotations
@@ -30,7 +34,8 @@ import os
 import time
 import tomllib
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from types import MappingProxyType
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple
 
@@ -70,6 +75,21 @@ from rvfem.mesh import mesh_case
 from rvfem.solve import cycle as cycle_module
 from rvfem.solve import models
 from rvfem.solve.cycle import AngleLoads, build_system
+from rvfem.results import attribution as attribution_section
+from rvfem.results import registry as sections_registry
+from rvfem.results.section import Section
+from rvfem.results.duty_cycle import duty_cycle_fe
+from rvfem.results.accuracy import run_accuracy
+from rvfem.results.analysis import (
+    Analysis,
+    AnalysisOptions,
+    CaseProvenance,
+    DutyCycleFE,
+    DutyCycleResult,
+    RigidAnalysis,
+    RigidBearing,
+    StressResult,
+)
 
 if TYPE_CHECKING:  # the heavier modules are imported where used
     from rvfem.evaluate.compare import Comparison
@@ -114,7 +134,7 @@ STAGES: dict[str, str] = {
     "rigid": "rigid handbook model",
     "cycle": "flexible load cycle",
     "evaluation": "evaluation: rigid vs flexible, stresses, Hertz",
-    "stress": "structural stress peak re-solved on P2 at its crank angles",
+    "stress": "stresses: the structural peak re-solved on P2 at its crank angles, the hot spots' histories",
     "attribution": "attribution: the reducer-stage models step by step (computed beside other stages)",
     "duty_cycle": "flexible load cycle at the other duty-cycle torques",
     "accuracy": "torsional rigidity and lost motion at crank angle 0",
@@ -195,32 +215,6 @@ class _StageSteps:
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class CaseProvenance:
-    """Where the analysed case comes from.
-
-    Attributes
-    ----------
-    file : str or None
-        Case file path as given (None for a case built in code).
-    sha256 : str or None
-        sha256 of the case file's bytes.
-    matches_file : bool
-        True if the analysed case is exactly the file's (no overrides, not modified in code).
-    overrides : dict
-        Dotted case key → value, for every value set on top of the file: ``KEY=VALUE`` overrides
-        (:attr:`rvfem.case.definition.Case.overrides`, ``rvfem ... --set``) and the options
-        ``angle_step_deg``, ``bearing_model``, ``order`` (``--step``, ``--bearing-model``,
-        ``--order``).
-    defaults_used : tuple of (str, value)
-        Dotted keys that neither the file nor an override sets, with the default value used.
-    """
-
-    file: str | None
-    sha256: str | None
-    matches_file: bool
-    overrides: dict = field(default_factory=dict)
-    defaults_used: tuple[tuple[str, Any], ...] = ()
 
 
 _WITH_OVERRIDES = " (with overrides)"  # suffix rvfem.case.definition.load_case gives Case.source with overrides
@@ -409,98 +403,8 @@ def cycle_angles(case: Case) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class RigidBearing:
-    """One crank bearing in the rigid handbook evaluation.
-
-    Attributes
-    ----------
-    loads : rvfem.evaluate.rigid.BearingLoadSummary
-        Maximum, minimum (with crank angles, degrees), equivalent load (N) and L10h (hours).
-    crank_angle_deg : float
-        Position α_i of the crank, degrees.
-    max_roller_load_N : float
-        The most loaded roller: the largest roller load of rigid rings under the handbook forces
-        over the cycle (:data:`rvfem.evaluate.hertz.RIGID_ROLLER_MODEL`), N.
-    hertz_inner, hertz_outer : rvfem.evaluate.hertz.HertzLineContact
-        Hertz contact of that roller on the eccentric (convex) and in the disc bore (concave).
-    max_roller_theta_deg : float
-        Crank angle of that roller load, degrees.
-    depth : rvfem.evaluate.roller_life.BearingDepth or None
-        κ, a_ISO, L_nm and L10r of the bearing under the handbook forces (the run's rigid column);
-        None for a bearing model without discrete rollers.
-    """
-
-    loads: rigid.BearingLoadSummary
-    crank_angle_deg: float
-    max_roller_load_N: float
-    hertz_inner: hertz.HertzLineContact
-    hertz_outer: hertz.HertzLineContact
-    max_roller_theta_deg: float = math.nan
-    depth: BearingDepth | None = None
 
 
-@dataclass(frozen=True, eq=False)
-class RigidAnalysis:
-    """The rigid handbook evaluation of a case: loads, rating, lives, Hertz, duty cycle.
-
-    Where the handbook model is not defined (Zp − Zc ≠ 1) the evaluation keeps its layout with
-    nothing made up: ``loads`` are NaN (:func:`rvfem.evaluate.rigid.undefined_loads`), ``bearings`` is
-    empty, ``duty_cycle`` is None and ``references`` says why.
-
-    Attributes
-    ----------
-    case : Case
-    loads : rvfem.evaluate.rigid.RigidLoads
-        Bearing forces over the sampled crank angles (and the handbook components k, k_y, ΣP…);
-        NaN where the handbook is not defined.
-    bearings : tuple of RigidBearing
-        One per bearing; empty where the handbook is not defined.
-    rating_N : float
-        ISO 281 dynamic load rating C of the crank bearing, N.
-    bearing_speed_rpm : float
-        n_b = n_out·Zp/(Zp − Zc), rpm.
-    exponent : float
-        Equivalent-load exponent p.
-    stribeck_factor : float
-        k of the most loaded roller Q_max = k·F_max/Z of the rigid rings (the largest over the
-        bearings; :func:`rvfem.evaluate.hertz.rigid_ring_factor` for a roller on the load line).
-    duty_cycle : rvfem.evaluate.iso281.DutyCycleLife or None
-        Service life of the case's duty cycle from the shortest bearing life (None without a duty
-        cycle, or where the handbook is not defined).
-    references : rvfem.evaluate.rigid.References or None
-        Which rigid references are defined for the case and why (:func:`rvfem.evaluate.rigid.references`,
-        as for the rigid evaluation alone: the equal share of the FE pin resultant is not part of
-        it).
-    warnings : tuple of rvfem.evaluate.validity.ResultWarning
-        Results outside their model's range (:func:`rvfem.evaluate.validity.rigid_warnings`: P/C, lives
-        under 1 h, Hertz pressures); empty when all hold.
-    checks : rvfem.evaluate.bearing_checks.BearingChecks or None
-        Static safety S0 and minimum load of the crank bearing under the handbook forces (no support
-        bearings: the rigid model has no crankshaft beam); None where the handbook is not defined.
-    """
-
-    case: Case
-    loads: rigid.RigidLoads
-    bearings: tuple[RigidBearing, ...]
-    rating_N: float
-    bearing_speed_rpm: float
-    exponent: float
-    stribeck_factor: float
-    duty_cycle: iso281.DutyCycleLife | None
-    references: References | None = None
-    warnings: tuple[ResultWarning, ...] = ()
-    checks: BearingChecks | None = None
-
-    @property
-    def angle_step_deg(self) -> float:
-        """Crank-angle step actually used, degrees."""
-        return 360.0 / self.loads.theta.size
-
-    @property
-    def defined(self) -> bool:
-        """True if the handbook model applies to the case (the loads are numbers, not NaN)."""
-        return bool(self.bearings)
 
 
 def analyse_rigid(case: Case, theta: np.ndarray | None = None,
@@ -581,275 +485,14 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None,
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, eq=False)
-class StressResult:
-    """Disc stresses of a load cycle.
-
-    Attributes
-    ----------
-    peak : rvfem.evaluate.postprocess.PeakStress
-        Largest vertex von Mises stress over every solved crank angle (the cycle's envelope).
-    away_from_contacts : rvfem.evaluate.postprocess.PeakStress or None
-        The same ignoring a band along the tooth profile and the bores (the structural peak).
-    band_mm : dict
-        Boundary name → width of the ignored band, mm.
-    snapshots : tuple of rvfem.evaluate.postprocess.FieldSnapshot
-        The kept fields (saved angles, largest bearing load, the two peaks, ``field_step_deg``).
-    recovered : rvfem.evaluate.postprocess.RecoveredPeak or None
-        The structural peak re-solved on P2 at its crank angles with the cycle's forces, with its
-        convergence check (None when ``analyse(..., recover_stress=False)`` or when no vertex lies
-        outside the contact bands). This is the structural peak the reports lead with.
-    history : rvfem.evaluate.postprocess.HotSpotHistory or None
-        Vertex stresses over every solved crank angle at the structural peak and the contact-zone
-        peak (for a fatigue check).
-    """
-
-    peak: PeakStress
-    away_from_contacts: PeakStress | None
-    band_mm: dict[str, float]
-    snapshots: tuple[FieldSnapshot, ...]
-    recovered: RecoveredPeak | None = None
-    history: HotSpotHistory | None = None
-
-    @property
-    def structural(self) -> PeakStress | None:
-        """The structural peak away from contacts to report: P2-recovered if available, else P1."""
-        if self.recovered is not None:
-            return self.recovered.peak
-        return self.away_from_contacts
 
 
-@dataclass(frozen=True)
-class DutyCycleFE:
-    """The duty cycle evaluated with the flexible model at every duty-cycle torque.
-
-    The service life of :class:`DutyCycleResult` ``flexible`` scales the rated flexible life with
-    (T_i/T0)^(10/3) (Gao et al. eq. 18): it assumes the bearing loads grow linearly with the
-    torque. The FE model is not linear (contact sets, Palmgren roller law, clearance), so here the
-    load cycle is solved at each distinct positive duty-cycle torque (same disc model and
-    compliance, no new factorisation) and Palmgren-Miner is applied to the bearing lives from
-    those equivalent loads: 1/L = Σ s_i/L_i per bearing, s_i the time shares, L_i the L10h at the
-    row's F_m and bearing speed; the service life is the shortest bearing's.
-
-    Attributes
-    ----------
-    torques_Nm : tuple of float
-        Distinct positive duty-cycle output torques, N·m.
-    equivalent_load_N : tuple of tuple of float
-        Flexible F_m per torque and bearing, N.
-    linear_scaling_error_percent : tuple of float
-        Per torque: largest over the bearings of F_m(T_i)/(F_m(T0)·T_i/T0) − 1, %.
-    service_life_h : float
-        Palmgren-Miner service life from the FE loads at every torque, hours.
-    linear_scaling_life_h : float
-        The same from the linear scaling (= ``DutyCycleResult.flexible.service_life_h``), hours.
-    seconds : float
-        Wall time of the extra load cycles, s.
-    """
-
-    torques_Nm: tuple[float, ...]
-    equivalent_load_N: tuple[tuple[float, ...], ...]
-    linear_scaling_error_percent: tuple[float, ...]
-    service_life_h: float
-    linear_scaling_life_h: float
-    seconds: float
-
-    @property
-    def life_difference_percent(self) -> float:
-        """(FE at every torque − linear scaling)/linear scaling of the service life, %."""
-        return 100.0 * (self.service_life_h / self.linear_scaling_life_h - 1.0)
 
 
-@dataclass(frozen=True)
-class DutyCycleResult:
-    """Duty-cycle service life (Palmgren-Miner) from the rigid and the flexible bearing lives
-    (both scaled linearly with the torque, Gao et al. eq. 18), and the flexible one from the FE
-    at every duty-cycle torque (``flexible_fe``, None when not computed). ``rigid`` is None where
-    the handbook is not defined (Zp − Zc ≠ 1)."""
-
-    rigid: iso281.DutyCycleLife | None
-    flexible: iso281.DutyCycleLife
-    flexible_fe: DutyCycleFE | None = None
 
 
-def duty_cycle_fe(system, thetas: np.ndarray, cycle, comparison, linear_life_h: float) -> DutyCycleFE:
-    """Solve the flexible load cycle at every distinct positive duty-cycle torque of the case and
-    the service life from those loads (:class:`DutyCycleFE`; sources: ISO 281 life, Gao et al.
-    eqs. 16-18 with the FE loads in place of the linear scaling).
-
-    Parameters
-    ----------
-    system : rvfem.solve.cycle.DiscSystem
-        The case's disc model (its compliance is reused).
-    thetas : ndarray
-        Crank angles, rad (those of ``cycle``).
-    cycle : rvfem.solve.cycle.CycleResult
-        The cycle at the case's own torque (reused for a duty row at that torque).
-    comparison : rvfem.evaluate.compare.Comparison
-        Its comparison (F_m at the case's torque).
-    linear_life_h : float
-        The linear-scaling service life, hours.
-    """
-
-    t0 = time.perf_counter()
-    case = system.case
-    rows = case.loads.duty_cycle
-    rated_T = case.loads.torque_Nm
-    torques = sorted({float(r.torque_Nm) for r in rows if r.torque_Nm > 0})
-    rated_fm = [b.flexible.equivalent_N for b in comparison.bearings]
-    fm: dict[float, list[float]] = {}
-    for torque in torques:
-        if math.isclose(torque, rated_T, rel_tol=1e-12):
-            fm[torque] = rated_fm
-            continue
-        # the same system at another operating point: no new factorisation, the compliance
-        # columns and contact sets of the case's cycle reused
-        op = cycle_module.OperatingPoint(torque, case.analysis.friction)
-        cyc = cycle_module.load_cycle(system, thetas, op=op, saved_angles_deg=())
-        fm[torque] = [float(equivalent_load(f, case.analysis.equivalent_load_exponent))
-                      for f in cyc.bearing_loads.T]
-    errors = tuple(100.0 * max((f / (f0 * t / rated_T) - 1.0 for f, f0 in zip(fm[t], rated_fm)), key=abs)
-                   for t in torques)
-    rating = iso281.crank_bearing_rating(case.crank_bearing)
-    total = sum(r.time_share for r in rows)
-    lives = []
-    for i in range(len(rated_fm)):
-        damage = 0.0  # Σ s_i / L_i, 1/h
-        for r in rows:
-            if r.torque_Nm <= 0:
-                continue
-            n_b = iso281.bearing_speed_rpm(r.speed_rpm, case.pins.count, case.cycloid.teeth)
-            life = iso281.rating_life_hours(rating, fm[float(r.torque_Nm)][i], n_b)
-            # a life that underflows to 0 h is infinite damage, not a division by zero
-            damage += (r.time_share / total) / life if life > 0 else math.inf
-        lives.append(math.inf if damage == 0 else 1.0 / damage)
-    return DutyCycleFE(torques_Nm=tuple(torques), equivalent_load_N=tuple(tuple(fm[t]) for t in torques),
-                       linear_scaling_error_percent=errors, service_life_h=min(lives),
-                       linear_scaling_life_h=linear_life_h, seconds=time.perf_counter() - t0)
 
 
-@dataclass(frozen=True, eq=False)
-class Analysis:
-    """Everything one analysis of a case computed (see the module docstring); writes nothing.
-
-    Attributes
-    ----------
-    case : Case
-        The case as analysed (overrides applied).
-    provenance : CaseProvenance
-        Case file, checksum, overrides and defaults used.
-    geometry : rvfem.geometry.DiscGeometry
-    mesh : rvfem.mesh.DiscMesh
-    system : rvfem.solve.cycle.DiscSystem
-        The factorised disc model (for further solves).
-    theta : ndarray (n,)
-        Crank angles of the cycle, rad.
-    rigid : RigidAnalysis
-        The handbook evaluation at the same angles (``rigid.loads`` are the handbook curves; NaN
-        where the handbook is not defined, Zp − Zc ≠ 1).
-    classical : rvfem.evaluate.rigid.PinForces or None
-        Classical rigid pin forces at the same angles (moment exact at every angle); None where the
-        distribution does not hold (Zp − Zc ≠ 1, :func:`rvfem.evaluate.rigid.classical_applicable`).
-    cycle : rvfem.solve.cycle.CycleResult
-        The flexible load cycle.
-    comparison : rvfem.evaluate.compare.Comparison
-        Rigid, flexible and equal-share load statistics and lives per bearing; the deltas are
-        against ``references.bearing_loads``.
-    stress : StressResult
-    hertz : dict of str to rvfem.evaluate.hertz.RollerHertz
-        ``fe_rollers`` (bearing model ``rollers`` only), ``stribeck_rigid``, ``stribeck_flexible``.
-    torsional_stiffness_Nm_per_arcmin : float
-        Disc torque / mean carrier rotation.
-    duty_cycle : DutyCycleResult or None
-        None if the case has no duty cycle.
-    timings : dict
-        Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*``,
-        ``cycle_per_angle`` and, with the attribution, ``attribution_compute`` (its own wall time;
-        the stage ``attribution`` is the wait for it when :func:`analyse` computes it beside other
-        stages, the computation itself when ``rvfem run`` does, after the VTK files).
-    attribution : rvfem.evaluate.attribution.Attribution or None
-        None from ``analyse(..., attribute=False)`` until the caller adds it. The flexibility
-        effect step by step: handbook → equal share of the FE pin resultant →
-        one disc with T/discs → two discs sharing the carrier → crankshafts (those that apply;
-        without the handbook where it is not defined); ``attribution.final`` is the case's own
-        model (``cycle``).
-    references : rvfem.evaluate.rigid.References or None
-        The rigid references the run is compared with, and why (:func:`rvfem.evaluate.rigid.references`).
-    warnings : tuple of rvfem.evaluate.validity.ResultWarning
-        Results outside their model's range (:func:`rvfem.evaluate.validity.analysis_warnings`: P/C,
-        lives under 1 h, Hertz pressures, disc stress against the yield strength, deformation
-        against the element size); empty when all hold.
-    roller_depth : rvfem.evaluate.roller_life.CrankBearingDepth or None
-        The crank bearing in depth (slice pressures, film, κ, a_ISO, L_nm, L10r; rigid and flexible);
-        None for a bearing model without discrete rollers.
-    accuracy : dict or None
-        Torsional rigidity (N·m/arcmin) and lost motion (arcmin) of the stage at the case's torque
-        from a few points of the hysteresis loop at crank angle 0 (:func:`run_accuracy`); None when
-        they could not be solved.
-    bearing_checks : rvfem.evaluate.bearing_checks.BearingChecks or None
-        Static safety S0 and minimum load of the crank bearing (rigid and flexible) and the support
-        bearings' loads and lives.
-    """
-
-    case: Case
-    provenance: CaseProvenance
-    geometry: DiscGeometry
-    mesh: DiscMesh
-    system: DiscSystem
-    theta: np.ndarray
-    rigid: RigidAnalysis
-    classical: PinForces
-    cycle: CycleResult
-    comparison: Comparison
-    stress: StressResult
-    hertz: dict[str, hertz.RollerHertz]
-    torsional_stiffness_Nm_per_arcmin: float
-    duty_cycle: DutyCycleResult | None = None
-    timings: dict = field(default_factory=dict)
-    attribution: Attribution | None = None
-    references: References | None = None
-    warnings: tuple[ResultWarning, ...] = ()
-    roller_depth: CrankBearingDepth | None = None
-    accuracy: dict | None = None
-    bearing_checks: BearingChecks | None = None
-
-    @property
-    def max_load_index(self) -> tuple[int, int]:
-        """(angle index, bearing index) of the largest FE bearing load of the cycle."""
-
-        return max_load_index(self.cycle.bearing_forces)
-
-    @property
-    def rigid_forces(self) -> np.ndarray | list[None]:
-        """Handbook force of every bearing on the disc, (n, N, 2), N (the layout of
-        ``cycle.bearing_forces``); where the handbook is not defined (Zp − Zc ≠ 1) a list of n
-        None, one per crank angle (nothing to draw or compare)."""
-        if not self.rigid.defined:
-            return [None] * len(self.theta)
-        hb = self.rigid.loads
-        return np.stack([hb.fx.T, hb.fy.T], axis=2)
-
-    @property
-    def equal_share_forces(self) -> np.ndarray:
-        """Equal share of the FE pin resultant for every bearing, (n, N, 2), N
-        (:func:`rvfem.evaluate.compare.equal_share_forces`): the bearing-load reference for any tooth
-        difference."""
-
-        return equal_share_forces(self.case, self.cycle)
-
-    @property
-    def reference_loads(self) -> np.ndarray:
-        """|F| of the bearing-load reference the deltas are against, (n, N), N: the handbook, or the
-        equal share of the FE pin resultant where the handbook is not defined."""
-        if self.comparison.reference == "handbook":
-            return np.asarray(self.rigid.loads.magnitude).T
-        return np.linalg.norm(self.equal_share_forces, axis=2)
-
-    @property
-    def pin_centres(self) -> np.ndarray:
-        """Pin centres in the disc frame at every crank angle, (n, Zp, 2), mm."""
-
-        return np.stack([pin_centres(self.case, float(th)) for th in self.theta])
 
 
 def repository_path(relative: str | os.PathLike, start: str | os.PathLike | None = None) -> Path:
@@ -1133,11 +776,11 @@ def analyse(case: Case | str | os.PathLike, *, overrides: tuple[str, ...] = (),
              else None)
     background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
     try:
-        geometry, mesh, system = _disc_model(case, stages, cache_dir)
+        model = _disc_model(case, stages, cache_dir, checked)
         if on_model is not None:
-            on_model(system)
-        return _analyse_from_model(case, checked.provenance, stages, checked.thetas, checked.saved, geometry, mesh,
-                                   system, background, recover_stress, duty_fe, attribute, child)
+            on_model(model.system)
+        options = AnalysisOptions(recover_stress=recover_stress, duty_fe=duty_fe, attribute=attribute)
+        return _analyse_from_model(case, checked.provenance, stages, model, background, options, child)
     finally:
         background.shutdown(wait=True, cancel_futures=True)
         if child is not None:
@@ -1185,10 +828,21 @@ def _checked_case(case, provenance: CaseProvenance | None, stages: Stages, *, ov
     return _CheckedCase(case=case, provenance=provenance, thetas=thetas, saved=saved)
 
 
-def _disc_model(case: Case, stages: Stages, cache_dir: str | os.PathLike | None):
+@dataclass(frozen=True, eq=False)
+class _DiscModel:
+    """The disc model of :func:`analyse` and the crank angles it is solved at."""
+
+    geometry: DiscGeometry
+    mesh: DiscMesh
+    system: DiscSystem
+    thetas: np.ndarray
+    saved: tuple[float, ...]
+
+
+def _disc_model(case: Case, stages: Stages, cache_dir: str | os.PathLike | None, checked: _CheckedCase) -> _DiscModel:
     """The ``mesh`` and ``model`` stages of :func:`analyse`: the disc geometry, its mesh (cached in
     ``cache_dir``, default :func:`default_cache_dir`) and the assembled, factorised disc model
-    (:class:`rvfem.solve.cycle.DiscSystem`)."""
+    (:class:`rvfem.solve.cycle.DiscSystem`), with the angles of ``checked``."""
     t = stages.start("mesh")
     geometry = disc_geometry(case)
     mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
@@ -1197,31 +851,42 @@ def _disc_model(case: Case, stages: Stages, cache_dir: str | os.PathLike | None)
     t = stages.start("model")
     system = cycle_module.build_system(case, mesh, geometry=geometry)
     stages.end("model", t)
-    return geometry, mesh, system
+    return _DiscModel(geometry=geometry, mesh=mesh, system=system, thetas=checked.thetas, saved=checked.saved)
 
 
-def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh, system, background,
-                        recover_stress, duty_fe, attribute=True, child=None):
-    """The stages of :func:`analyse` after the model; ``background`` runs the work beside them."""
+@dataclass(frozen=True, eq=False)
+class StressEnvelope:
+    """The load cycle's stress envelope as the ``evaluation`` stage finds it (what the ``stress``
+    section starts from): the peak anywhere, the peak away from the contact bands, the bands' widths
+    (mm) and the kept fields."""
 
+    peak: PeakStress
+    away_from_contacts: PeakStress | None
+    band_mm: dict[str, float]
+    snapshots: tuple[FieldSnapshot, ...]
+
+
+def _analyse_from_model(case: Case, provenance: CaseProvenance, stages: Stages, model: _DiscModel,
+                        background: ThreadPoolExecutor, options: AnalysisOptions,
+                        child: ChildProcess | None = None) -> Analysis:
+    """The stages of :func:`analyse` after the model: its fixed front (the rigid references, the load
+    cycle and its stress envelope), then every result section (:func:`_compute_sections`)."""
     # the rigid model before the cycle: a case outside every rigid reference fails fast
     t = stages.start("rigid")
     references = rigid.references(case)
     if not (references.handbook.defined or references.equal_share.defined):
         raise CaseError(f"{case.source}: {references.equal_share.why}")
     steps = _StageSteps(stages, "rigid", extra=1)   # the slices of each bearing, then the rest
-    rigid_analysis = analyse_rigid(case, thetas, progress=steps)
-    classical = (rigid.classical_pin_forces(case, thetas, exact_moment=True)
+    rigid_analysis = analyse_rigid(case, model.thetas, progress=steps)
+    classical = (rigid.classical_pin_forces(case, model.thetas, exact_moment=True)
                  if references.classical_pin_forces.defined else None)
     log.info("%s: bearing loads compared with %s", case.name, rigid.REFERENCE_NAMES[references.bearing_loads])
     steps.end(t)
 
-    n = len(thetas)
+    system, mesh, n = model.system, model.mesh, len(model.thetas)
     t = stages.start("cycle", n)
-
-    # the P2 model of the stress stage, built in a child process during the load cycle
-    p2 = _P2Model(system, mesh, background, child) if recover_stress and system.model.order == 1 else None
-
+    # the P2 model of the stress section, built in a child process during the load cycle
+    p2 = _P2Model(system, mesh, background, child) if options.recover_stress and system.model.order == 1 else None
     try:
         def report(i: int, total: int) -> None:  # the last angle is reported by stages.end
             if p2 is not None:
@@ -1229,193 +894,130 @@ def _analyse_from_model(case, provenance, stages, thetas, saved, geometry, mesh,
             if i < total:
                 stages.tick("cycle", i, total)
 
-        cycle = cycle_module.load_cycle(system, thetas, progress=report, saved_angles_deg=saved, stress_envelope=True)
+        cycle = cycle_module.load_cycle(system, model.thetas, progress=report, saved_angles_deg=model.saved,
+                                        stress_envelope=True)
         stages.end("cycle", t, n)
 
         t = stages.start("evaluation")
-        comparison = compare.rigid_vs_flexible(case, cycle)
-        # peaks over every solved angle (the cycle's stress envelope); their fields are kept too
-        peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
-        band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
-        band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
-        away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
-        snapshots = postprocess.field_snapshots(
-            system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
+        envelope = _stress_envelope(case, system, mesh, cycle)
+        available: dict[str, Any] = {
+            "case": case, "provenance": provenance, "geometry": model.geometry, "mesh": mesh, "system": system,
+            "theta": np.asarray(model.thetas), "rigid": rigid_analysis, "classical": classical, "references": references,
+            "cycle": cycle, "comparison": compare.rigid_vs_flexible(case, cycle), "stress_envelope": envelope,
+            "torsional_stiffness_Nm_per_arcmin": cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm),
+            "options": options,
+            "p2": (None if not options.recover_stress else
+                   lambda system_, cycle_, mesh_, band, away: _recover_structural_peak(system_, cycle_, mesh_, band, away, p2)),
+        }
         stages.end("evaluation", t)
-
-        # what the flexibility effect is made of: the modelling steps the case's own model does not
-        # already give, on the same angles and the same compliance. Mostly small dense solves, it runs
-        # beside the stress stage (whose P2 re-solve is made in the P2 model's child process); the
-        # two share read-only data and the P1 compliance, whose cache is locked
-        pending = background.submit(_timed, attribution_of, system, thetas, cycle) if attribute else None
-        stress, roller_hertz, stiffness, duty = _evaluate(
-            case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
-            recover_stress, p2)
+        computed, seconds = _compute_sections(available, stages, background, release={"stress": p2})
     finally:
         if p2 is not None:          # the P2 model (a few hundred MB) is not needed any more
             p2.close()
-            p2 = None
-    attribution = None
-    if pending is not None:
-        t = stages.start("attribution")
-        attribution, attribution_seconds = pending.result()
-        stages.end("attribution", t)
-    # the secondary analyses below (and the attribution's steps) may not refuse a case whose load
-    # cycle solved: one that cannot be made is left out with a warning that says why
-    not_computed = list(attribution_warnings(attribution))
-    if duty is not None and duty_fe:
-        duty = _duty_cycle_stage(stages, system, thetas, cycle, comparison, duty, not_computed)
-
-    accuracy = _accuracy_stage(stages, system)
     timings = dict(stages.seconds)
-    if pending is not None:
-        timings["attribution_compute"] = attribution_seconds
+    timings.update({f"{name}_compute": s for name, s in seconds.items()})
     timings.update({"model_" + k: v for k, v in system.setup_seconds.items()})
     timings["cycle_per_angle"] = stages.seconds["cycle"] / n
-    result = Analysis(case=case, provenance=provenance, geometry=geometry, mesh=mesh, system=system,
-                      theta=np.asarray(thetas), rigid=rigid_analysis, classical=classical, cycle=cycle,
-                      comparison=comparison, stress=stress, hertz=roller_hertz,
-                      torsional_stiffness_Nm_per_arcmin=stiffness, duty_cycle=duty, timings=timings,
-                      attribution=attribution, references=references, accuracy=accuracy)
-    result = _with_roller_depth(result, stages)
-    return dataclasses.replace(result, warnings=result.warnings + tuple(not_computed)) if not_computed else result
+    if computed.get("roller_depth") is not None:
+        timings["roller_depth"] = computed["roller_depth"].seconds
+    return _analysis_of({**available, **computed}, timings)
 
 
-def _accuracy_stage(stages: Stages, system) -> dict | None:
-    """The ``accuracy`` stage of :func:`analyse` (:func:`run_accuracy`)."""
-    t = stages.start("accuracy")
-    accuracy = run_accuracy(system)
-    stages.end("accuracy", t)
-    return accuracy
+def _stress_envelope(case: Case, system: DiscSystem, mesh: DiscMesh, cycle: CycleResult) -> StressEnvelope:
+    """The peaks over every solved angle (the cycle's stress envelope), anywhere and away from the
+    contact bands (:data:`CONTACT_BAND_ELEMENTS` element sizes), and the kept fields with theirs."""
+    peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
+    assert peak is not None               # nothing excluded: the disc's largest vertex stress
+    band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
+    band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
+    away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
+    snapshots = postprocess.field_snapshots(
+        system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])
+    return StressEnvelope(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots)
 
 
-def _duty_cycle_stage(stages, system, thetas, cycle, comparison, duty, not_computed: list):
-    """The ``duty_cycle`` stage of :func:`analyse`: ``duty`` with the flexible FE at every duty-cycle
-    torque (:func:`duty_cycle_fe`); if that does not solve, ``duty`` as it is and a ``not_computed``
-    warning appended to ``not_computed``."""
-    t = stages.start("duty_cycle")
-    try:
-        duty = dataclasses.replace(duty, flexible_fe=duty_cycle_fe(system, thetas, cycle, comparison,
-                                                                   duty.flexible.service_life_h))
-    except ContactError as exc:
-        log.info("the flexible FE at every duty-cycle torque not computed: %s", exc)
-        not_computed.append(validity.ResultWarning(
-            "not_computed", f"the flexible FE at every duty-cycle torque not computed: {exc}; the service "
-            "life is the linear scaling of the case's own cycle", 1.0, 0.0, ""))
-    stages.end("duty_cycle", t)
-    return duty
+_ANALYSIS_FIELDS = tuple(f.name for f in dataclasses.fields(Analysis) if f.name not in ("timings", "extra"))
+"""The fields of :class:`~rvfem.results.analysis.Analysis` the results fill (by name)."""
 
 
-def _with_roller_depth(result: Analysis, stages: Stages | None = None) -> Analysis:
-    """The analysis with the crank bearing in depth (slices of every roller, film, a_ISO, L_nm and
-    L10r, rigid and flexible; :func:`rvfem.evaluate.roller_life.crank_bearing_depth`; stage
-    ``roller_slices`` of ``stages`` when the cycle has roller loads) and all warnings."""
-    stages = Stages(None) if stages is None else stages
-    sliced = result.cycle.roller_loads is not None
-    if sliced:
-        t = stages.start("roller_slices")
-    steps = _StageSteps(stages, "roller_slices")
-    rigid_depths = tuple(b.depth for b in result.rigid.bearings if b.depth is not None)
-    depth = roller_life.crank_bearing_depth(result.case, result.theta, result.cycle, result.rigid_forces,
-                                            result.comparison, result.rigid.rating_N, result.rigid.bearing_speed_rpm,
-                                            rigid_depths=rigid_depths or None,
-                                            progress=steps)
-    if depth is not None:
-        result.timings["roller_depth"] = depth.seconds
-    checks = _bearing_checks(result)
-    if sliced:
-        steps.end(t)
-        result.timings["roller_slices"] = stages.seconds["roller_slices"]
-    return dataclasses.replace(result, roller_depth=depth, bearing_checks=checks,
-                               warnings=validity.analysis_warnings(result) + validity.roller_depth_warnings(depth)
-                               + validity.bearing_check_warnings(checks))
+def _analysis_of(results: Mapping[str, Any], timings: dict[str, float]) -> Analysis:
+    """The :class:`Analysis` of the results so far: the fields by name, the results of sections
+    from outside rvfem in ``extra``."""
+    own = {name: results[name] for name in _ANALYSIS_FIELDS if name in results}
+    extra = {s.name: results[s.name] for s in sections_registry.sections()
+             if s.name not in _ANALYSIS_FIELDS and s.name in results}
+    return Analysis(**own, timings=timings, extra=MappingProxyType(extra))
 
 
-def _bearing_checks(result: Analysis) -> bearing_checks.BearingChecks:
-    """Static safety, minimum load and support bearings of a run
-    (:func:`rvfem.evaluate.bearing_checks.case_bearing_checks`)."""
-    bearings = result.comparison.bearings
-    models_ = {"flexible": [b.flexible for b in bearings]}
-    if result.rigid.defined and all(b.rigid is not None for b in bearings):
-        models_["rigid"] = [b.rigid for b in bearings if b.rigid is not None]
-    return bearing_checks.case_bearing_checks(
-        result.case, result.theta, result.rigid.rating_N, result.rigid.bearing_speed_rpm,
-        {m: max(s.max_N for s in v) for m, v in models_.items()},
-        {m: min(s.min_N for s in v) for m, v in models_.items()}, result.cycle.disc_bearing_forces)
+def _stage_rank(stage: str | None) -> int:
+    order = list(STAGES)
+    return order.index(stage) if stage in order else len(order)
 
 
-def run_accuracy(system) -> dict | None:
-    """Torsional rigidity and lost motion of the case's stage at its torque and pin friction, at
-    crank angle 0, from six solves on the factorised disc (:func:`rvfem.evaluate.accuracy.quick_figures`;
-    ``rvfem hysteresis`` gives the whole loop averaged over a mesh period). None if a solve fails
-    (logged): the run's other results do not depend on it."""
-    case = system.case
-    try:
-        figures = accuracy_eval.quick_figures(cycle_module.case_stage(system), abs(float(case.loads.torque_Nm)),
-                                              float(case.analysis.friction))
-    except (ContactError, ValueError) as exc:
-        log.warning("torsional rigidity and lost motion not computed: %s", exc)
-        return None
-    return {**figures, "crank_angle_deg": 0.0, "torque_Nm": abs(float(case.loads.torque_Nm))}
+def _compute_sections(available: dict[str, Any], stages: Stages, background: ThreadPoolExecutor,
+                      release: Mapping[str, Any] = MappingProxyType({})) -> tuple[dict[str, Any], dict[str, float]]:
+    """Compute every result section that has a ``compute`` (:func:`rvfem.results.registry.sections`).
+
+    The order: by their stage among :data:`STAGES` (the order the user sees), those without a stage
+    after them, and those that require ``analysis`` (the whole result so far) last, each group in the
+    sections' order. A ``thread`` section starts on ``background`` as soon as the front is done and
+    is waited for (its stage) at its turn. ``release[name].close()`` is called once section
+    ``name`` is done (the P2 model after the stress). Returns the results by section name and the
+    wall time of the thread sections' own work (s), by name.
+    """
+    chosen = [s for s in sections_registry.sections() if s.compute is not None]
+    order = sorted(chosen, key=lambda s: ("analysis" in s.requires, _stage_rank(s.stage)))
+    results: dict[str, Any] = {}
+    seconds: dict[str, float] = {}
+
+    def inputs(section: Section, progress: Callable[[int, int], None] | None = None) -> dict[str, Any]:
+        given = {**available, **results}
+        if "analysis" in section.requires:
+            given["analysis"] = _analysis_of(given, dict(stages.seconds))
+        missing = [r for r in section.requires if r not in given]
+        if missing:
+            raise RuntimeError(f"result section {section.name!r} requires {', '.join(missing)}, which nothing computed "
+                               "before it")
+        return {**given, "progress": progress or (lambda done, total: None)}
+
+    def applies(section: Section) -> bool:
+        return section.applies is None or bool(section.applies({**available, **results}))
+
+    started = {s.name: background.submit(_timed, s.compute, inputs(s)) for s in order
+               if s.compute is not None and s.executor == "thread" and "analysis" not in s.requires and applies(s)}
+    for s in order:
+        if s.compute is None or (s.name not in started and not applies(s)):
+            results[s.name] = None
+            continue
+        stage = s.stage
+        steps = _StageSteps(stages, stage) if stage is not None and stage not in stages.seconds else None
+        t = stages.start(stage) if steps is not None and stage is not None else time.perf_counter()
+        if s.name in started:
+            results[s.name], seconds[s.name] = started[s.name].result()
+        else:
+            results[s.name] = s.compute(inputs(s, steps))
+        if steps is not None:
+            steps.end(t)
+        elif stage is not None:
+            stages.seconds[stage] += time.perf_counter() - t
+        if s.name in release and release[s.name] is not None:
+            release[s.name].close()
+    return results, seconds
 
 
-def attribution_of(system, thetas, cycle):
-    """The attribution of a case's flexible load cycle (:func:`rvfem.evaluate.attribution.attribution`): the
-    modelling steps the case's own model does not already give, on the same angles and the same
-    compliance."""
-
-    return attribution.attribution(system, thetas, cycles={attribution.case_step(system.case): cycle})
+def attribution_of(system: DiscSystem, thetas: np.ndarray, cycle: CycleResult) -> Attribution:
+    """The attribution of a case's flexible load cycle (the ``attribution`` section,
+    :func:`rvfem.results.attribution.compute`)."""
+    return attribution_section.compute({"system": system, "theta": thetas, "cycle": cycle})
 
 
-def attribution_warnings(result) -> tuple:
+def attribution_warnings(result: Attribution | None) -> tuple[ResultWarning, ...]:
     """The warnings of the attribution steps that could not be made
     (:func:`rvfem.evaluate.attribution.skipped_warnings`); none for None."""
     return attribution.skipped_warnings(result)
 
 
-def _timed(function, *args, **kwargs):
+def _timed(function: Callable[..., Any], *args: Any, **kwargs: Any) -> tuple[Any, float]:
     """``(function(*args, **kwargs), wall time in s)``."""
     t0 = time.perf_counter()
     return function(*args, **kwargs), time.perf_counter() - t0
-
-
-def _evaluate(case, stages, system, mesh, cycle, comparison, rigid_analysis, peak, away, band, snapshots,
-              recover_stress, p2=None):
-    """The stress stage (the structural peak re-solved on P2) and the rest of the evaluation:
-    hot-spot histories, Hertz, torsional stiffness, duty-cycle lives from the rigid and flexible
-    loads. Returns (StressResult, Hertz results, stiffness, DutyCycleResult or None)."""
-
-    recovered = None
-    if recover_stress and away is not None:
-        t = stages.start("stress")
-        recovered = _recover_structural_peak(system, cycle, mesh, band, away, p2)
-        stages.end("stress", t)
-        if not any(math.isclose(s.theta_deg, recovered.peak.theta_deg, abs_tol=1e-9) for s in snapshots):
-            snapshots = postprocess.field_snapshots(system, cycle, extra_angles=[
-                math.radians(x) for x in (peak.theta_deg, away.theta_deg, recovered.peak.theta_deg)])
-    t = time.perf_counter()
-    spots = {"structural": recovered.peak if recovered is not None else away, "contact_zone": peak}
-    spots = {k: v for k, v in spots.items() if v is not None}
-    factors = {}
-    if recovered is not None and recovered.p1_at_peak_MPa > 0:
-        factors["structural"] = recovered.peak.von_mises_MPa / recovered.p1_at_peak_MPa
-    history = postprocess.hot_spot_history(system, cycle, spots, factors)
-    stress = StressResult(peak=peak, away_from_contacts=away, band_mm=band, snapshots=snapshots,
-                          recovered=recovered, history=history)
-    rigid_forces = None
-    if rigid_analysis.defined:
-        hb = rigid_analysis.loads
-        rigid_forces = np.stack([hb.fx.T, hb.fy.T], axis=2)
-    roller_hertz = hertz.most_loaded_roller_hertz(
-        case, cycle.theta, cycle.bearing_forces, cycle.roller_loads, rigid_forces,
-        None if rigid_forces is None else roller_slices.case_rigid_roller_loads(case, cycle.theta, rigid_forces),
-        roller_slices.case_rigid_roller_loads(case, cycle.theta, cycle.bearing_forces))
-    stiffness = cycle.torsional_stiffness_Nm_per_arcmin(case.loads.disc_torque_Nmm)
-    duty = None
-    if case.loads.duty_cycle:
-        duty = DutyCycleResult(
-            rigid=(iso281.case_duty_cycle_life(case, [b.rigid.L10h for b in comparison.bearings])
-                   if rigid_analysis.defined else None),
-            flexible=iso281.case_duty_cycle_life(case, [b.flexible.L10h for b in comparison.bearings]))
-    stages.seconds["evaluation"] += time.perf_counter() - t
-    return stress, roller_hertz, stiffness, duty

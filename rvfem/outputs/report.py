@@ -26,11 +26,12 @@ import jinja2
 
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
 from rvfem.case.definition import ROLLER_PROFILE_KINDS, Case
-from rvfem.case.schema import toml_literal
 from rvfem.case.schema import file_fields, format_quantity
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
-from rvfem.outputs.design_summary import bearing_check_lines, mass_strength_report
+from rvfem.results.bearing_checks import bearing_check_lines
+from rvfem.results.format import toml_text
+from rvfem.results.mass_strength import mass_strength_report
 from rvfem.solve.models import bearing_model, pin_model
 from rvfem.units import nm_from_nmm
 
@@ -39,17 +40,6 @@ __all__ = ["TEMPLATE", "assumptions", "key_field_angles", "png_data_uri", "rende
 
 TEMPLATE = "report.html.j2"
 """The report's template, in the folder ``templates`` of this package (shipped as package data)."""
-
-
-def toml_text(value: Any) -> str:
-    """A case value as it is written in a case file (TOML): ``true``, ``0.0``, ``"text"``,
-    ``[1.0, 2.0]``, ``{equidistant = 0.0, shift = 0.0}`` (no Python ``True`` or dicts in what users
-    read; :func:`rvfem.case.schema.toml_literal` with bare keys), or ``str(value)`` for anything TOML
-    cannot hold."""
-    try:
-        return toml_literal(value, bare_keys=True)
-    except CaseError:
-        return str(value)
 
 
 def key_field_angles(summary: dict, case: Case) -> list[float]:

@@ -15,8 +15,9 @@ whose ``WRITER_MODULES`` lists this module and the other writer modules);
     write_report      report.html (self-contained)
     write_summary     summary.json
 
-The content of ``summary.json`` is built in one place, :func:`build_summary`, from the typed pieces
-of :data:`SUMMARY_PIECES`; docs/outputs.md documents every key (a test checks that the two agree).
+The content of ``summary.json`` is built in one place, :func:`build_summary`, from the result
+sections (:func:`rvfem.results.registry.sections`); their key declarations generate the key table of
+docs/outputs.md (a test checks that the table and the keys written agree).
 :func:`result_folder` is the atomic result folder: results are written into a temporary folder next
 to the target and moved into place only when complete.
 
@@ -32,36 +33,36 @@ import json
 import logging
 import math
 import os
-import platform
-import shlex
 import shutil
-import sys
 import tempfile
 import uuid
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from importlib import metadata
 from pathlib import Path
-from typing import Any, Callable, Iterable, Iterator, Mapping
+from typing import Any, Callable, Iterable, Iterator
 
 import numpy as np
 
 from rvfem import __version__
 from rvfem.case.definition import case_to_dict, file_sha256
 from rvfem.errors import FolderNotEmptyError, OutputError
-from rvfem.evaluate.bearing_checks import MINIMUM_LOAD_FRACTION, STATIC_SAFETY_NORMAL, STATIC_SAFETY_SHOCK
 from rvfem.evaluate.hertz import RIGID_ROLLER_MODEL
-from rvfem.evaluate.postprocess import user_feature_name
 from rvfem.evaluate.rigid import references
 from rvfem.geometry import crank_centres
 from rvfem.outputs import plots, render, tables, vtkio
-from rvfem.outputs.design_summary import fatigue_point_data, piece_mass_strength
 from rvfem.outputs.plots import mesh_plot, rim_closeup
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
 from rvfem.outputs.roller_outputs import roller_pressure_calls
-from rvfem.outputs.vtkio import vtu_name
-from rvfem.units import arcmin_from_rad
+from rvfem.results import registry as sections_registry
+from rvfem.results.bearing_checks import bearing_checks_dict
+from rvfem.results.files import stress_image_name
+from rvfem.results.format import angle, json_ready
+from rvfem.results.header import CLI_MODULES, CLI_SCRIPTS, SCHEMA_VERSION, VERSIONED_PACKAGES, command_line, environment
+from rvfem.results.mass_strength import fatigue_point_data
+from rvfem.results.references import references_dict
+from rvfem.results.roller_depth import depth_life_dict
+from rvfem.results.section import SummaryContext
 
 log = logging.getLogger(__name__)
 
@@ -76,7 +77,6 @@ __all__ = [
     "IMAGE_SIZE",
     "DEFORMATION_DISPLAY_FRACTION",
     "SummaryContext",
-    "SUMMARY_PIECES",
     "json_ready",
     "RESULT_MARKER",
     "is_rvfem_folder",
@@ -104,9 +104,6 @@ __all__ = [
     "writers",
 ]
 
-SCHEMA_VERSION = 2
-"""Version of the ``summary.json`` layout (docs/outputs.md); bumped when a key changes meaning or
-disappears (new keys do not bump it)."""
 
 RIGID_SCHEMA_VERSION = 1
 """Version of the ``rvfem rigid --json`` layout (docs/outputs.md); bumped when a key changes meaning
@@ -126,31 +123,6 @@ TickCallback = Callable[[int, int], None]
 # --------------------------------------------------------------------------------------------
 # JSON
 # --------------------------------------------------------------------------------------------
-
-
-def json_ready(obj: Any) -> Any:
-    """A copy of ``obj`` that :func:`json.dumps` writes as strict JSON.
-
-    Numpy scalars become Python numbers, tuples lists, dataclasses dicts, and non-finite floats
-    (an infinite life at zero load, a ratio that cannot be formed) become ``None`` (JSON
-    ``null``): ``Infinity`` and ``NaN`` are not JSON and most readers reject them.
-    """
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return json_ready(dataclasses.asdict(obj))
-    if isinstance(obj, dict):
-        return {str(k): json_ready(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [json_ready(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return json_ready(obj.tolist())
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        v = float(obj)
-        return v if math.isfinite(v) else None
-    return obj
 
 
 def _dump(obj: Any) -> str:
@@ -336,479 +308,6 @@ def result_folder(out_dir: str | os.PathLike, *, overwrite: bool = False, what: 
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class SummaryContext:
-    """What the summary needs besides the analysis.
-
-    Attributes
-    ----------
-    files : tuple of str
-        Files of the result folder, relative paths (posix).
-    timings : dict
-        Wall time per stage (s), including the writers' and ``total``.
-    """
-
-    files: tuple[str, ...] = ()
-    timings: Mapping[str, float] = dataclasses.field(default_factory=dict)
-
-
-def _stats_dict(s) -> dict:
-    return {
-        "max_load_N": s.max_N,
-        "max_at_deg": _angle(s.max_at_deg),
-        "min_load_N": s.min_N,
-        "min_at_deg": _angle(s.min_at_deg),
-        "equivalent_load_N": s.equivalent_N,
-        "L10h_h": s.L10h,
-    }
-
-
-def _hertz_dict(h) -> dict:
-    return {
-        "roller_load_N": h.roller_load_N,
-        "bearing": None if h.bearing is None else h.bearing + 1,
-        "roller": None if h.roller is None else h.roller + 1,
-        "theta_deg": _angle(h.theta_deg),
-        "factor": h.factor,
-        "inner": dataclasses.asdict(h.inner),
-        "outer": dataclasses.asdict(h.outer),
-    }
-
-
-def _depth_life_dict(d) -> dict | None:
-    """κ, a_ISO and the lives of one BearingDepth (``rvfem rigid --json``'s bearings)."""
-    if d is None:
-        return None
-    return {"kappa": d.kappa, "a_iso": d.a_iso, "L_nm_h": d.L_nm_h, "L10r_h": d.L10r_h,
-            "film_thickness_min_um": d.film_thickness_min_um, "roller_peak_pressure_MPa": d.roller_peak_pressure_MPa}
-
-
-def bearing_checks_dict(checks) -> dict | None:
-    """The ``bearing_checks`` object of summary.json and ``rvfem rigid --json``
-    (:class:`rvfem.evaluate.bearing_checks.BearingChecks`)."""
-    if checks is None:
-        return None
-    static = {m: {"C0_N": v.static_rating_N, "P0_N": v.p0_N, "S0": v.s0, "verdict": v.verdict}
-              for m, v in checks.static.items()}
-    minimum = {m: {"min_load_N": v.min_load_N, "fraction_of_C": v.fraction_of_C, "below": v.below}
-               for m, v in checks.minimum.items()}
-    out = {
-        "static_safety": {**static, "limits": {"normal": STATIC_SAFETY_NORMAL, "shock_or_accuracy": STATIC_SAFETY_SHOCK},
-                          "source": "S0 = C0/P0, P0 = F_r,max (ISO 76); limits: bearing makers' rule (SKF catalogue)"},
-        "minimum_load": {**minimum, "required_fraction_of_C": MINIMUM_LOAD_FRACTION,
-                         "source": "P_min = 0.02·C for cylindrical roller bearings: bearing makers' rule "
-                                   "(SKF catalogue), not ISO"},
-        "support_bearings": None if checks.support is None else [
-            {"support": b.support, "crank": b.crank + 1, "max_load_N": b.max_N, "max_at_deg": _angle(b.max_at_deg),
-             "min_load_N": b.min_N, "equivalent_load_N": b.equivalent_N, "L10h_h": b.L10h} for b in checks.support],
-        "support_note": checks.support_note,
-    }
-    if "rigid" in checks.minimum and "flexible" in checks.minimum and checks.minimum["rigid"].min_load_N > 0:
-        out["minimum_load"]["flexible_vs_rigid_percent"] = 100.0 * (
-            checks.minimum["flexible"].min_load_N / checks.minimum["rigid"].min_load_N - 1.0)
-    return out
-
-
-def _piece_bearing_checks(a, ctx: SummaryContext) -> dict:
-    return {"bearing_checks": bearing_checks_dict(getattr(a, "bearing_checks", None))}
-
-
-ANGLE_DECIMALS = 6
-"""Crank angles in ``summary.json`` and ``rvfem rigid --json`` are rounded to this many decimals
-(no float noise such as 255.00000000000003; every step rvfem accepts is a whole multiple of
-1e-6°)."""
-
-
-def _angle(deg):
-    """A crank angle for the user, degrees, rounded to :data:`ANGLE_DECIMALS` (None stays None)."""
-    return None if deg is None else round(float(deg), ANGLE_DECIMALS) + 0.0
-
-
-def _peak_dict(peak) -> dict:
-    return {
-        "x_mm": peak.x_mm,
-        "y_mm": peak.y_mm,
-        "radius_mm": peak.radius_mm,
-        "theta_deg": _angle(peak.theta_deg),
-        "feature": user_feature_name(peak.feature),
-        "feature_label": peak.feature_label,
-        "distance_to_feature_mm": peak.distance_to_feature_mm,
-    }
-
-
-VERSIONED_PACKAGES = ("numpy", "scipy", "scikit-fem", "gmsh", "vtk", "pyvista", "matplotlib", "meshio")
-"""Packages whose installed versions ``summary.json`` records (``environment.versions``)."""
-
-
-CLI_MODULES = ("rvfem", "rvfem.__main__", "rvfem.app.cli")
-"""Modules whose ``python -m`` run is the ``rvfem`` command (``__main__.__spec__.name``)."""
-
-CLI_SCRIPTS = ("rvfem", "rvfem.exe", "rvfem-script.py")
-"""File names of the ``rvfem`` console script (``sys.argv[0]``) on POSIX and Windows."""
-
-
-def command_line() -> str | None:
-    """The command line of this process if it is the ``rvfem`` command (None from Python, a
-    notebook or a test runner), shell-quoted.
-
-    Decided from the entry point, not from where the files lie: the process is the ``rvfem``
-    command if its ``__main__`` module is :mod:`rvfem` run with ``python -m rvfem`` (or
-    ``-m rvfem.app.cli``; the name of ``__main__.__spec__`` is one of :data:`CLI_MODULES`), or if
-    it is a plain script (no module spec) named ``rvfem``, the console script the installation
-    writes (:data:`CLI_SCRIPTS`). ``python -m pytest`` started in a folder named ``rvfem`` is
-    not the command.
-    """
-
-    argv = list(sys.argv)
-    if not argv:
-        return None
-    main = sys.modules.get("__main__")
-    spec = getattr(main, "__spec__", None)
-    name = getattr(spec, "name", None)
-    if name in CLI_MODULES:
-        return shlex.join(["rvfem", *argv[1:]])
-    if name in (None, "__main__") and Path(argv[0]).name in CLI_SCRIPTS:
-        return shlex.join(["rvfem", *argv[1:]])
-    return None
-
-
-def environment() -> dict:
-    """When, how and with what a result was computed: UTC date and time, the command line
-    (:func:`command_line`), Python, the platform and the versions of
-    :data:`VERSIONED_PACKAGES` (None if not installed)."""
-
-    versions: dict[str, str | None] = {}
-    for name in VERSIONED_PACKAGES:
-        try:
-            versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            versions[name] = None
-    return {
-        "date_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-        "command_line": command_line(),
-        "python": platform.python_version(),
-        "platform": platform.platform(),
-        "versions": versions,
-    }
-
-
-def _piece_header(a, ctx: SummaryContext) -> dict:
-    p, case = a.provenance, a.case
-    return {
-        "schema_version": SCHEMA_VERSION,
-        "rvfem_version": __version__,
-        "environment": environment(),
-        "case": {
-            "name": case.name,
-            "description": case.description,
-            "file": p.file,
-            "sha256": p.sha256,
-            "matches_file": p.matches_file,
-            "digest": case.digest(),
-            "overrides": dict(p.overrides),
-            "defaults_used": {k: v for k, v in p.defaults_used},
-        },
-    }
-
-
-def _piece_warnings(a, ctx: SummaryContext) -> dict:
-    return {"warnings": [w.as_dict() for w in a.warnings]}
-
-
-def _piece_model(a, ctx: SummaryContext) -> dict:
-    case, model, c = a.case, a.system.model, a.comparison
-    return {"model": {
-        "bearing_model": case.crank_bearing.model,
-        "element_order": model.order,
-        "pin_model": a.system.pin_model,
-        "pin_friction": case.analysis.friction,
-        "nodes": model.n_nodes,
-        "vertices": model.n_vertices,
-        "dofs": model.n_dofs,
-        "elements": model.n_elements,
-        "mesh_file": a.mesh.path.name,
-        "mesh_min_quality": a.mesh.min_quality,
-        "mesh_symmetry": a.system.symmetry,
-        "angle_step_deg": 360.0 / len(a.theta),
-        "angles": len(a.theta),
-        "angles_solved": int(a.cycle.timings.get("pair_solves", len(a.theta))),
-        "output_torque_Nm": case.loads.torque_Nm,
-        "discs": case.loads.discs,
-        "disc_torque_Nmm": case.loads.disc_torque_Nmm,
-        "torque_convention": "disc torque T_out/discs = moment of the pin forces about the disc centre "
-                             "(handbook: sum P_x = T/(2 e Zc))",
-        "radial_clearance_mm": case.crank_bearing.radial_clearance,
-        "equivalent_load_exponent": c.exponent,
-        "dynamic_load_rating_N": c.rating_N,
-        "bearing_speed_rpm": c.bearing_speed_rpm,
-        "handbook_k_y": c.handbook_k_y,
-        "fe_pin_resultant_ratio": c.pin_resultant_ratio,
-    }}
-
-
-def _references_dict(refs) -> dict:
-    """The ``references`` object of ``summary.json`` and ``rvfem rigid --json``."""
-    return {
-        "bearing_loads": refs.bearing_loads,
-        **{key: {"defined": ref.defined, "why": ref.why} for key, ref in refs.items()},
-    }
-
-
-def _piece_references(a, ctx: SummaryContext) -> dict:
-    return {"references": _references_dict(a.references)}
-
-
-def _piece_bearings(a, ctx: SummaryContext) -> dict:
-    bearings = [{
-        "bearing": bc.bearing + 1,
-        "crank_angle_deg": a.case.cranks.angles_deg[bc.bearing],
-        "rigid": None if bc.rigid is None else _stats_dict(bc.rigid),
-        "flexible": _stats_dict(bc.flexible),
-        "equal_share": _stats_dict(bc.equal_share),
-        "delta_max_percent": bc.delta_max_percent,
-        "delta_min_percent": bc.delta_min_percent,
-        "delta_equivalent_percent": bc.delta_equivalent_percent,
-        "life_ratio": bc.life_ratio,
-    } for bc in a.comparison.bearings]
-    k, i = a.max_load_index
-    return {
-        "bearings": bearings,
-        "max_bearing_load": {
-            "bearing": i + 1,
-            "theta_deg": _angle(math.degrees(float(a.theta[k]))),
-            "flexible_N": float(a.cycle.bearing_loads[k, i]),
-        },
-    }
-
-
-def _piece_cycle(a, ctx: SummaryContext) -> dict:
-    cy = a.cycle
-    arcmin = arcmin_from_rad(np.asarray(cy.carrier_rotation))
-    return {
-        "pins_in_contact": {
-            "min": int(cy.pins_in_contact.min()),
-            "max": int(cy.pins_in_contact.max()),
-            "mean": float(cy.pins_in_contact.mean()),
-            "of": a.case.pins.count,
-        },
-        "torsional_stiffness_Nm_per_arcmin": a.torsional_stiffness_Nm_per_arcmin,
-        "carrier_rotation_arcmin": {"min": float(arcmin.min()), "max": float(arcmin.max()),
-                                    "mean": float(arcmin.mean())},
-        "equilibrium_residual": float(cy.equilibrium_residual.max()),
-        "active_set_iterations": {"max": int(cy.iterations.max()), "mean": float(cy.iterations.mean())},
-    }
-
-
-def _piece_stress(a, ctx: SummaryContext) -> dict:
-    s = a.stress
-    away, rec = s.away_from_contacts, s.recovered
-    structural = s.structural
-    return {
-        "peak_von_mises_MPa": None if structural is None else structural.von_mises_MPa,
-        "peak_von_mises_at": None if structural is None else _peak_dict(structural),
-        "stress": {
-            "structural_peak": None if rec is None else {
-                "von_mises_MPa": rec.peak.von_mises_MPa,
-                "at": _peak_dict(rec.peak),
-                "method": rec.method,
-                "element_order": 2,
-                "estimated_error_MPa": rec.estimated_error_MPa,
-                "estimated_error_percent": rec.estimated_error_percent,
-                "p1_MPa": rec.p1_MPa,
-                "p1_at_peak_MPa": rec.p1_at_peak_MPa,
-                "p1_error_percent": rec.p1_error_percent,
-                "angles_deg": [_angle(x) for x in rec.angles_deg],
-                "seconds": rec.seconds,
-            },
-            "away_from_contacts": None if away is None else {
-                "peak_von_mises_MPa": away.von_mises_MPa,
-                "element_order": a.system.model.order,
-                "at": _peak_dict(away),
-                "profile_band_mm": s.band_mm["profile"],
-                "bore_band_mm": s.band_mm.get("bore_0"),
-            },
-            "contact_zone": {
-                "peak_von_mises_MPa": s.peak.von_mises_MPa,
-                "at": _peak_dict(s.peak),
-                "mesh_dependent": True,
-            },
-            "field_angles_deg": [_angle(snap.theta_deg) for snap in s.snapshots],
-            "hot_spots": [] if s.history is None else [_hot_spot_dict(s.history, j)
-                                                       for j in range(len(s.history.names))],
-        },
-    }
-
-
-def _hot_spot_dict(h, j: int) -> dict:
-    vm, sd = h.von_mises[:, j], h.dominant[:, j]
-    return {
-        "name": h.names[j],
-        "at": _peak_dict(h.peaks[j]),
-        "von_mises_max_MPa": float(vm.max()),
-        "von_mises_min_MPa": float(vm.min()),
-        "dominant_principal_max_MPa": float(sd.max()),
-        "dominant_principal_min_MPa": float(sd.min()),
-        "dominant_principal_range_MPa": float(sd.max() - sd.min()),
-        "dominant_principal_mean_MPa": float(0.5 * (sd.max() + sd.min())),
-        "p2_factor": h.p2_factor[j],
-    }
-
-
-def _piece_hertz(a, ctx: SummaryContext) -> dict:
-    h = a.hertz
-    return {"hertz": {
-        "rigid_roller_model": RIGID_ROLLER_MODEL,
-        "stribeck_factor": h["stribeck_rigid"].factor if "stribeck_rigid" in h else h["stribeck_flexible"].factor,
-        "fe_rollers": _hertz_dict(h["fe_rollers"]) if "fe_rollers" in h else None,
-        "stribeck_rigid": _hertz_dict(h["stribeck_rigid"]) if "stribeck_rigid" in h else None,
-        "stribeck_flexible": _hertz_dict(h["stribeck_flexible"]),
-    }}
-
-
-def _piece_duty_cycle(a, ctx: SummaryContext) -> dict:
-    if a.duty_cycle is None:
-        return {}
-    fe = a.duty_cycle.flexible_fe
-    return {"duty_cycle": {
-        "rigid": None if a.duty_cycle.rigid is None else dataclasses.asdict(a.duty_cycle.rigid),
-        "flexible": dataclasses.asdict(a.duty_cycle.flexible),
-        "flexible_fe": None if fe is None else {
-            "torques_Nm": list(fe.torques_Nm),
-            "equivalent_load_N": [list(row) for row in fe.equivalent_load_N],
-            "linear_scaling_error_percent": list(fe.linear_scaling_error_percent),
-            "service_life_h": fe.service_life_h,
-            "life_difference_percent": fe.life_difference_percent,
-            "seconds": fe.seconds,
-        },
-    }}
-
-
-def _piece_reducer_stage(a, ctx: SummaryContext) -> dict:
-    cy, case = a.cycle, a.case
-    share = None
-    disc_b = None
-    if cy.disc_torque_Nmm is not None and cy.disc_torque_Nmm.shape[1] == 2:
-        s = cy.disc_torque_Nmm[:, 0] / case.loads.disc_torque_Nmm
-        share = {"min": float(s.min()), "max": float(s.max())}
-        disc_b = float(np.linalg.norm(cy.disc_bearing_forces[:, 1], axis=-1).max())
-    f = cy.crankshaft_influence if a.attribution.final == "crankshafts" else None
-    w = cy.eccentric_displacement
-    return {"reducer_stage": {
-        "model": cy.stage,
-        "step": a.attribution.final,
-        "crank_support_rigid": f is None,
-        "torque_share": share,
-        "disc_b_max_load_N": disc_b,
-        "crankshaft_influence_mm_per_N": None if f is None else f.tolist(),
-        "eccentric_displacement_max_mm": None if (w is None or f is None) else float(np.linalg.norm(w, axis=-1).max()),
-    }}
-
-
-def _piece_attribution(a, ctx: SummaryContext) -> dict:
-    rows = a.attribution.table(a.case.analysis.equivalent_load_exponent)
-    for r in rows:
-        r["final"] = r["step"] == a.attribution.final
-    return {"attribution": rows}
-
-
-def _image_key(rel: str) -> str:
-    return Path(rel).stem
-
-
-def _piece_files(a, ctx: SummaryContext) -> dict:
-    files = set(ctx.files)
-    fields = []
-    for snap in a.stress.snapshots:
-        entry = {"theta_deg": _angle(snap.theta_deg), "vtu": f"vtk/{vtu_name(snap.theta_deg)}"}
-        image = f"images/{_stress_image_name(snap.theta_deg)}"
-        if image in files:
-            entry["image"] = image
-        fields.append(entry)
-    return {
-        "fields": sorted(fields, key=lambda f: f["theta_deg"]),
-        "images": {_image_key(f): f for f in sorted(files) if f.startswith("images/") and f.endswith(".png")},
-        "plots": {_image_key(f): f for f in sorted(files) if f.startswith("plots/") and f.endswith(".png")},
-        "timings_s": dict(ctx.timings),
-        "files": sorted(files),
-    }
-
-
-def _depth_dict(d) -> dict:
-    return {
-        "roller_peak_pressure_MPa": d.roller_peak_pressure_MPa,
-        "roller_edge_factor": d.roller_edge_factor,
-        "peak_raceway": d.raceway,
-        "peak_theta_deg": _angle(d.theta_deg),
-        "peak_roller": d.roller + 1,
-        "peak_roller_load_N": d.roller_load_N,
-        "max_roller_load_N": d.max_roller_load_N,
-        "max_roller_theta_deg": _angle(d.max_roller_theta_deg),
-        "max_roller": d.max_roller + 1,
-        "peak_tilt_mrad": d.tilt_mrad,
-        "max_shear_MPa": d.max_shear_MPa,
-        "max_shear_depth_mm": d.max_shear_depth_mm,
-        "film_thickness_min_um": d.film_thickness_min_um,
-        "film_thickness_central_um": d.film_thickness_central_um,
-        "film_parameter": d.film_parameter,
-        "kappa": d.kappa,
-        "a_iso": d.a_iso,
-        "L10h_h": d.L10h,
-        "L_nm_h": d.L_nm_h,
-        "L10r_h": d.L10r_h,
-    }
-
-
-def _piece_roller_depth(a, ctx: SummaryContext) -> dict:
-    depth = getattr(a, "roller_depth", None)
-    if depth is None:
-        return {"crank_bearing_depth": None}
-    rigid = {d.bearing: d for d in depth.rigid}
-    bearings = []
-    for f in depth.flexible:
-        r = rigid.get(f.bearing)
-        ratio = (lambda key: None if r is None or not getattr(r, key) else getattr(f, key) / getattr(r, key))
-        bearings.append({"bearing": f.bearing + 1, "rigid": None if r is None else _depth_dict(r),
-                         "flexible": _depth_dict(f), "L10h_ratio": ratio("L10h"), "L_nm_ratio": ratio("L_nm_h"),
-                         "L10r_ratio": ratio("L10r_h")})
-    return {"crank_bearing_depth": {
-        "profile": a.case.crank_bearing.profile.kind,
-        "slices": a.case.crank_bearing.profile.slices,
-        "max_slope_mrad": depth.max_slope_mrad,
-        "bearings": bearings,
-    }}
-def _piece_accuracy(a, ctx: SummaryContext) -> dict:
-    """Torsional rigidity and lost motion at the case's torque (a few points of the hysteresis loop)."""
-    acc = getattr(a, "accuracy", None)
-    if not acc:
-        return {}
-    return {"accuracy": {"torsional_rigidity_Nm_per_arcmin": acc["torsional_rigidity_Nm_per_arcmin"],
-                         "lost_motion_arcmin": acc["lost_motion_arcmin"],
-                         "crank_angle_deg": acc["crank_angle_deg"], "torque_Nm": acc["torque_Nm"]}}
-
-
-SUMMARY_PIECES: tuple[Callable[[Any, SummaryContext], dict], ...] = (
-    _piece_header,
-    _piece_warnings,
-    _piece_model,
-    _piece_references,
-    _piece_bearings,
-    _piece_cycle,
-    _piece_stress,
-    piece_mass_strength,
-    _piece_hertz,
-    _piece_duty_cycle,
-    _piece_reducer_stage,
-    _piece_attribution,
-    _piece_roller_depth,
-    _piece_bearing_checks,
-    _piece_accuracy,
-    _piece_files,
-)
-"""The pieces of ``summary.json`` in order: each ``piece(analysis, context) -> dict`` of top-level
-keys. A new result of :class:`~rvfem.app.analysis.Analysis` adds one piece here and its keys to
-docs/outputs.md."""
-
-
 def build_summary(analysis, context: SummaryContext | None = None) -> dict:
     """The content of ``summary.json`` (JSON-ready: non-finite numbers are None).
 
@@ -820,8 +319,8 @@ def build_summary(analysis, context: SummaryContext | None = None) -> dict:
     """
     context = context or SummaryContext(timings=dict(analysis.timings))
     summary: dict[str, Any] = {}
-    for piece in SUMMARY_PIECES:
-        summary.update(piece(analysis, context))
+    for section in sections_registry.sections():
+        summary.update(section.summary(analysis, context))
     return json_ready(summary)
 
 
@@ -921,10 +420,6 @@ def write_vtk(analysis, folder: str | os.PathLike, *, tick: TickCallback | None 
 # --------------------------------------------------------------------------------------------
 
 
-def _stress_image_name(theta_deg: float) -> str:
-    return f"stress_theta_{theta_deg % 360:06.2f}.png"
-
-
 def image_count(analysis) -> int:
     """Number of images :func:`write_images` draws (for a progress bar)."""
     s = analysis.stress
@@ -974,7 +469,7 @@ def _image_set(analysis, images: Path) -> _ImageSet:
     stress: list[tuple[Path, Any, dict[str, Any]]] = []
     for snap in snapshots:
         label = "  (max. bearing load)" if snap.index == k_max else ""
-        stress.append((images / _stress_image_name(snap.theta_deg), scene(snap, label), {}))
+        stress.append((images / stress_image_name(snap.theta_deg), scene(snap, label), {}))
     half = max(5.0, 12.0 * case.mesh.size_bore)
     rec = a.stress.recovered
     for key, pk, what in (("stress_peak_closeup", peak, "contact-zone peak (mesh-dependent)"),
@@ -1242,16 +737,16 @@ def rigid_summary(result) -> dict:
         "bearing": b.loads.bearing + 1,
         "crank_angle_deg": b.crank_angle_deg,
         "max_load_N": b.loads.max_N,
-        "max_at_deg": _angle(b.loads.max_at_deg),
+        "max_at_deg": angle(b.loads.max_at_deg),
         "min_load_N": b.loads.min_N,
-        "min_at_deg": _angle(b.loads.min_at_deg),
+        "min_at_deg": angle(b.loads.min_at_deg),
         "equivalent_load_N": b.loads.equivalent_N,
         "L10h_h": b.loads.L10h,
         "max_roller_load_N": b.max_roller_load_N,
-        "max_roller_at_deg": _angle(b.max_roller_theta_deg),
+        "max_roller_at_deg": angle(b.max_roller_theta_deg),
         "hertz_inner": dataclasses.asdict(b.hertz_inner),
         "hertz_outer": dataclasses.asdict(b.hertz_outer),
-        "depth": _depth_life_dict(b.depth),
+        "depth": depth_life_dict(b.depth),
     } for b in result.bearings]
     if not result.defined:   # the handbook is not defined (Zp − Zc ≠ 1): the same keys, null
         bearings = [{
@@ -1285,7 +780,7 @@ def rigid_summary(result) -> dict:
         "stribeck_factor": result.stribeck_factor,
         "rigid_roller_model": RIGID_ROLLER_MODEL,
         "bearing_checks": bearing_checks_dict(result.checks),
-        "references": _references_dict(result.references or references(case, fe=False)),
+        "references": references_dict(result.references or references(case, fe=False)),
         "warnings": [w.as_dict() for w in result.warnings],
         "bearings": bearings,
     }

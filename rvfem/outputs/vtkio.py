@@ -41,7 +41,9 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+
 from rvfem.evaluate.postprocess import FieldSnapshot
+from rvfem.results.files import vtu_name
 
 __all__ = ["POINT_FIELDS", "CELL_FIELDS", "ENVELOPE_FILE", "MESH_ZLIB_LEVEL", "ZLIB_LEVEL", "ZLIB_STRATEGY",
            "VtuMesh", "vtu_mesh", "vtu_name", "write_vtu", "write_pvd", "envelope_field", "write_envelope_vtu"]
@@ -61,11 +63,6 @@ POINT_FIELDS = {
 
 #: Cell-data arrays of every ``.vtu``.
 CELL_FIELDS = ("sxx_MPa", "syy_MPa", "sxy_MPa", "von_mises_MPa", "s1_MPa", "s2_MPa")
-
-
-def vtu_name(theta_deg: float) -> str:
-    """File name of the field at crank angle θ (degrees): ``disc_theta_060.00.vtu``."""
-    return f"disc_theta_{theta_deg % 360.0:06.2f}.vtu"
 
 
 def _xyz(a: np.ndarray) -> np.ndarray:

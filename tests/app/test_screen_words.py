@@ -80,7 +80,7 @@ def _mass_summary(area: float, solid_area: float) -> dict:
 
 
 def test_a_solid_disc_says_it_has_no_lightening_holes():
-    from rvfem.outputs.design_summary import mass_strength_lines
+    from rvfem.results.mass_strength import mass_strength_lines
 
     solid = mass_strength_lines(_mass_summary(7000.0, 7000.0))[0]
     assert "no lightening holes" in solid and "save" not in solid
@@ -143,7 +143,7 @@ def test_the_readme_lists_every_shipped_case_and_every_file_a_run_writes():
 
 
 def test_the_wall_time_line_says_the_drawing_ran_beside_the_writing():
-    from rvfem.app.screen import _drawing_text
+    from rvfem.results.screen_lines import drawing_text as _drawing_text
 
     files = ["summary.json"] + [f"images/stress_{k}.png" for k in range(10)]
     text = _drawing_text({"plots": 0.2, "images": 0.1, "drawing_background": 11.4}, files)

@@ -206,7 +206,7 @@ def test_envelope_field_agrees_with_the_hot_spot_histories(tmp_path):
     over the structural peak."""
     from rvfem.app.analysis import analyse
     from rvfem.evaluate.design_checks import design_checks
-    from rvfem.outputs.design_summary import fatigue_point_data
+    from rvfem.results.mass_strength import fatigue_point_data
 
     a = analyse(coarse_case("rv40e_fanholes"), angle_step_deg=10.0, cache_dir=tmp_path / "meshes")
     field = fatigue_point_data(a)["fatigue_safety_factor_P1"]

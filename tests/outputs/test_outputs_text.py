@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from rvfem.app.screen import _life, _sig, warning_lines
+from rvfem.results.screen_lines import life as _life, sig as _sig, warning_lines
 from rvfem.outputs.report import toml_text
 
 
@@ -55,7 +55,7 @@ def test_warning_lines():
 def test_roller_depth_lines_merge_bearings_with_equal_results():
     """With N-fold symmetry the bearings carry equal loads: one set of lines names them together;
     a bearing that differs keeps its own lines."""
-    from rvfem.app.screen import roller_depth_lines
+    from rvfem.results.screen_lines import roller_depth_lines
 
     entry = {"roller_peak_pressure_MPa": 1911.0, "roller_edge_factor": 1.22, "peak_raceway": "eccentric",
              "film_thickness_min_um": 0.053, "kappa": 0.72, "a_iso": 0.92, "L10h_h": 27768.0,

@@ -1,4 +1,5 @@
-"""The mass-and-strength piece of ``summary.json`` (:data:`rvfem.outputs.summary.SUMMARY_PIECES`).
+"""The mass-and-strength section: disc mass and inertia, static and fatigue safety
+(:mod:`rvfem.evaluate.design_checks`).
 
 Top-level keys scripts can rely on: ``disc_mass_kg``, ``disc_polar_inertia_kg_mm2``,
 ``static_safety_factor``, ``fatigue_safety_factor`` and ``fatigue_safety_factor_at`` (the hot spot
@@ -13,9 +14,10 @@ from typing import Any
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
 from rvfem.evaluate.postprocess import PeakStress, feature_label, user_feature_label, user_feature_name
 from rvfem.evaluate.strength import FATIGUE_CRITERION, fatigue_field
+from rvfem.results.section import KeyRow, Section, SummaryContext
 
-__all__ = ["piece_mass_strength", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
-           "fatigue_point_data"]
+__all__ = ["SECTION", "fatigue_point_data", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
+           "compute", "summary"]
 
 
 def _where(peak: PeakStress) -> dict[str, Any]:
@@ -58,9 +60,16 @@ def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
     }
 
 
-def piece_mass_strength(a, ctx) -> dict[str, Any]:
-    """Summary piece: mass, inertia and safety factors of an analysis."""
-    return mass_strength_dict(design_checks(a), a.case.material)
+def compute(inputs: Any) -> DesignChecks:
+    """Mass, inertia, static and fatigue safety of the disc (:func:`rvfem.evaluate.design_checks.design_checks`)."""
+    return design_checks(inputs["analysis"])
+
+
+def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
+    """Mass, inertia and safety factors of an analysis (its top-level keys of ``summary.json``;
+    computed here for an analysis made without them)."""
+    checks = a.mass_strength if a.mass_strength is not None else design_checks(a)
+    return mass_strength_dict(checks, a.case.material)
 
 
 def _words(at: dict) -> str:
@@ -127,34 +136,68 @@ def fatigue_point_data(analysis) -> dict:
             fatigue_field(cy.signed_von_mises_max, cy.signed_von_mises_min, analysis.case.material)}
 
 
-def _fmt(value, fmt: str) -> str:
-    """A number for a line, a dash for None, ``inf`` for infinity."""
-    if value is None:
-        return "–"
-    return format(float(value), fmt) if math.isfinite(float(value)) else "inf"
+KEYS = (
+    KeyRow('`disc_mass_kg`',
+           'float',
+           "**disc mass** m = ρ·b·A, kg: area A of the disc with its holes (Green's theorem over the outlines, `rvfem.geometry.mass`), width b = `cycloid.thickness`, ρ = `material.density_kg_m3`"),
+    KeyRow('`disc_polar_inertia_kg_mm2`',
+           'float',
+           '**polar moment of inertia** of the disc about its own axis through the disc centre, I = ρ·b·∬(x² + y²) dA, kg·mm²'),
+    KeyRow('`static_safety_factor`',
+           'float or null',
+           '**static safety against yield** R_p0.2/σ_vM at the structural peak (`peak_von_mises_MPa`, P2 away from contacts); null without a structural peak'),
+    KeyRow('`fatigue_safety_factor`',
+           'float or null',
+           '**fatigue safety factor**, the smallest over the hot spots (`mass_strength.fatigue_hot_spots[]`): the FKM guideline\'s signed von Mises stress over the cycle, its amplitude and mean on the Goodman line of σ_W and R_m (docs/theory.md, "Mass and strength"); null if infinite or without hot spots'),
+    KeyRow('`fatigue_safety_factor_at`, `mass_strength.static_peak_at`, `mass_strength.fatigue_hot_spots[].at`',
+           'object or null',
+           "where the governing hot spot, the static check's peak, each hot spot is"),
+    KeyRow('&nbsp;&nbsp;`.x_mm`, `.y_mm`, `.theta_deg`, `.feature`, `.feature_label`',
+           'float, float, float, str, str',
+           'position, the crank angle of its von Mises peak and the nearest boundary, numbered from 1 (`bore_1`), and the same in words (`bore 1`)'),
+    KeyRow('`fatigue_safety_factor_at.hot_spot`',
+           'str',
+           'which hot spot governs (`structural`, `contact_zone`)'),
+    KeyRow('`mass_strength`',
+           'object',
+           'the details of the four keys above'),
+    KeyRow('`mass_strength.disc_area_mm2`, `mass_strength.disc_polar_moment_mm4`',
+           'float',
+           'A and ∬(x² + y²) dA of the disc with its holes'),
+    KeyRow('`mass_strength.solid_disc_mass_kg`, `mass_strength.solid_disc_polar_inertia_kg_mm2`',
+           'float',
+           'the same disc without the lightening holes (central hole and bores kept)'),
+    KeyRow('`mass_strength.mass_saving_percent`, `mass_strength.inertia_saving_percent`',
+           'float',
+           'what the lightening holes save against that solid disc, %'),
+    KeyRow('`mass_strength.density_kg_m3`, `mass_strength.thickness_mm`',
+           'float',
+           'ρ and b'),
+    KeyRow('`mass_strength.yield_strength_MPa`, `mass_strength.ultimate_strength_MPa`, `mass_strength.fatigue_limit_MPa`',
+           'float',
+           "the material's R_p0.2, R_m and σ_W (`[material]`)"),
+    KeyRow('`mass_strength.static_peak_von_mises_MPa`',
+           'float',
+           'the stress of the static check (where: `mass_strength.static_peak_at`)'),
+    KeyRow('`mass_strength.fatigue_criterion`',
+           'str',
+           'the criterion in words'),
+    KeyRow('`mass_strength.fatigue_hot_spots[]`',
+           'array',
+           'one entry per hot spot of `stress.hot_spots[]`'),
+    KeyRow('`mass_strength.fatigue_hot_spots[].name`',
+           'str',
+           'the hot spot (where: `.at`, above)'),
+    KeyRow('`mass_strength.fatigue_hot_spots[].amplitude_MPa`, `mass_strength.fatigue_hot_spots[].mean_MPa`',
+           'float',
+           "σ_a = (max − min)/2 and σ_m = (max + min)/2 of the signed von Mises stress over the cycle (the cycle's history times `p2_factor`)"),
+    KeyRow('`mass_strength.fatigue_hot_spots[].signed_von_mises_max_MPa`, `mass_strength.fatigue_hot_spots[].signed_von_mises_min_MPa`',
+           'float',
+           'its largest and smallest value'),
+    KeyRow('`mass_strength.fatigue_hot_spots[].p2_factor`, `mass_strength.fatigue_hot_spots[].safety_factor`',
+           'float',
+           'the P2/P1 factor applied; the Goodman safety factor (null if infinite)'),
+)
+"""Its rows of the key table (docs/outputs.md)."""
 
-
-def bearing_check_lines(checks: dict | None) -> list[str]:
-    """The crank bearing's static safety S0 and minimum load (rigid and flexible, where there) and the
-    support bearings' loads and lives (the ``bearing_checks`` object of summary.json or ``rvfem rigid
-    --json``)."""
-    if not checks:
-        return []
-    models = [m for m in ("rigid", "flexible") if m in checks["static_safety"]]
-    st, mn = checks["static_safety"], checks["minimum_load"]
-    lines = ["  static safety S0 = C0/P0 (ISO 76, C0 = " + f"{st[models[0]]['C0_N']:.0f} N): " + ", ".join(
-        f"{m} {_fmt(st[m]['S0'], '.2f')}" for m in models) + "; makers ask ≥ 1, ≥ 2 with shock or high accuracy"]
-    change = mn.get("flexible_vs_rigid_percent")
-    lines.append("  minimum load (skidding): smallest bearing load " + ", ".join(
-        f"{m} {mn[m]['min_load_N']:.0f} N = {100 * mn[m]['fraction_of_C']:.2f} % of C" for m in models)
-        + (f" (flexible {change:+.0f} %)" if change is not None else "")
-        + f"; makers' rule ≥ {100 * mn['required_fraction_of_C']:g} % of C")
-    sup = checks.get("support_bearings")
-    if sup:
-        lines.append("  support bearings (crankshaft beam): " + "; ".join(
-            f"{b['support']} max {b['max_load_N']:.0f} N, F_m {b['equivalent_load_N']:.0f} N"
-            + (f", L10h {_fmt(b['L10h_h'], '.0f')} h" if b["L10h_h"] is not None else "") for b in sup)
-            + (f" ({checks['support_note']})" if checks.get("support_note") else ""))
-    elif checks.get("support_note"):
-        lines.append(f"  support bearings: {checks['support_note']}")
-    return lines
+SECTION = Section("mass_strength", summary, KEYS, requires=("analysis",), compute=compute, screen=mass_strength_lines, screen_rank=40)
