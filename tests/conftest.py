@@ -168,17 +168,21 @@ def pytest_collection_modifyitems(config, items):
 
 def _registry_tables() -> tuple[dict, ...]:
     """The tables a plug-in registers itself in: the crank-bearing and pin models
-    (:mod:`rvfem.case.registry`) and the writers of a result folder (:mod:`rvfem.outputs.registry`)."""
+    (:mod:`rvfem.case.registry`), the writers of a result folder (:mod:`rvfem.outputs.registry`), the
+    stage components (:mod:`rvfem.solve.stage_parts`) and their case tables
+    (:func:`rvfem.case.definition.register_component_table`)."""
     from rvfem.case import registry as models
+    from rvfem.case import whole_case
     from rvfem.outputs import registry as writers
+    from rvfem.solve import stage_parts
 
-    return models._BEARINGS, models._PINS, writers._WRITERS
+    return models._BEARINGS, models._PINS, writers._WRITERS, stage_parts._REGISTERED, whole_case._COMPONENT_TABLES
 
 
 @contextmanager
 def saved_registries() -> Iterator[None]:
-    """The model and writer registries as they were before the block, whatever it registered or
-    removed (restored in place: every module holding a table sees it restored). For fixtures wider
+    """The model, writer and stage-component registries as they were before the block, whatever it
+    registered or removed (restored in place: every module holding a table sees it restored). For fixtures wider
     than a test; a test asks for the :func:`registries` fixture."""
     tables = _registry_tables()
     saved = [dict(table) for table in tables]
@@ -192,8 +196,9 @@ def saved_registries() -> Iterator[None]:
 
 @pytest.fixture
 def registries() -> Iterator[None]:
-    """The model and writer registries saved before the test and restored after it: a test that
-    registers a plug-in (a bearing or pin model, a writer) leaves no trace in the next one."""
+    """The model, writer and stage-component registries saved before the test and restored after it:
+    a test that registers a plug-in (a bearing or pin model, a writer, a stage component and its case
+    table) leaves no trace in the next one."""
     with saved_registries():
         yield
 

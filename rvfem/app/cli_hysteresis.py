@@ -12,6 +12,7 @@ from rvfem.app.screen import warning_lines
 from rvfem.case.definition import load_case
 from rvfem.errors import CaseError
 from rvfem.outputs.summary import check_output_folder
+from rvfem.solve.stage_parts import not_modelled
 
 __all__ = ["HYSTERESIS"]
 
@@ -72,7 +73,7 @@ def _run(args: argparse.Namespace) -> int:
         te = s["transmission_error"]
         print(f"  transmission error p-p: no load {te['no_load_peak_to_peak_arcsec']:.3f} arcsec, loaded "
               f"{te['loaded_peak_to_peak_arcsec']:.3f} arcsec")
-    print("  not modelled: main bearings, carrier end plates, pin housing, input spur stage (see accuracy.md)")
+    print(f"  not modelled: {', '.join(short for short, _ in not_modelled())} (see accuracy.md)")
     for line in warning_lines(s["warnings"]):   # the range warnings rvfem run gives at this torque
         print(line)
     print(f"  wall time {s['timings']['total_s']:.1f} s; results: {out}/ (summary.json, accuracy.md, hysteresis.csv)")

@@ -28,22 +28,27 @@ from rvfem.outputs import accuracy as files
 from rvfem.outputs.summary import result_folder
 from rvfem.solve import accuracy
 from rvfem.solve.cycle import build_system, case_stage
-from rvfem.solve.stage_parts import held_in_words
+from rvfem.solve.stage_parts import held_in_words, not_modelled
 from rvfem.units import ARCSEC_PER_RAD
 
 log = logging.getLogger(__name__)
 
-__all__ = ["LEFT_OUT", "accuracy_study", "loop_option_problem", "loop_warnings", "mesh_period_angles"]
+__all__ = ["accuracy_study", "left_out", "loop_option_problem", "loop_warnings", "mesh_period_angles"]
 
-LEFT_OUT = (f"The stage model holds {held_in_words()}. It leaves out the main (output) bearings, the carrier's "
-            "end plates and pins (the carrier is rigid), the pin housing (the pins' seats are rigid), the input spur stage (with the input locked the "
-            "crankshafts do not turn relative to the carrier) and the rotation of the pins in their grooves. The "
-            "output rotation is the carrier rotation of the stage model's torque convention (each disc's torque about "
-            "its own centre, the eccentrics turning about the disc centre). Pin friction is Coulomb with full "
-            "sliding at every step: it vanishes with the load, so without a clearance the loop has no width at zero "
-            "torque. Catalogue rigidity and lost motion are measured on the whole reducer: this model's rigidity is "
-            "an upper bound and its lost motion a lower bound.")
-"""What the stage model leaves out, for the report and the screen."""
+
+def left_out() -> str:
+    """What the stage model holds and leaves out, in words, for the report: the stage's components
+    (:func:`rvfem.solve.stage_parts.held_in_words`) and the parts of the reducer none of them brings
+    in (:func:`rvfem.solve.stage_parts.not_modelled`), then the conventions of the loop."""
+    parts = [words for _, words in not_modelled()]
+    leaves = (", ".join(parts[:-1]) + " and " + parts[-1]) if len(parts) > 1 else "".join(parts)
+    return (f"The stage model holds {held_in_words()}. "
+            + (f"It leaves out {leaves}. " if parts else "")
+            + "The output rotation is the carrier rotation of the stage model's torque convention (each disc's "
+            "torque about its own centre, the eccentrics turning about the disc centre). Pin friction is Coulomb "
+            "with full sliding at every step: it vanishes with the load, so without a clearance the loop has no "
+            "width at zero torque. Catalogue rigidity and lost motion are measured on the whole reducer: this "
+            "model's rigidity is an upper bound and its lost motion a lower bound.")
 
 
 def mesh_period_angles(case: Case, count: int = 9) -> np.ndarray:
@@ -163,7 +168,7 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
         fig = accuracy_figures(torque, mean, branch, T)
         summary = {"case": case.name, "torque_Nm": T, "friction": mu, "steps": steps,
                    "angles_deg": [math.degrees(t) for t in thetas], **fig.as_dict(),
-                   "per_angle": per_angle, "stage": stage.describe(), "left_out": LEFT_OUT,
+                   "per_angle": per_angle, "stage": stage.describe(), "left_out": left_out(),
                    "warnings": [w.as_dict() for w in warnings]}
         files.write_loop_csv(out / "hysteresis.csv", torque, branch, mean, np.degrees(thetas), rotations)
         files.hysteresis_plot(out / "plots" / "hysteresis.png", torque, branch, mean, fig, T,

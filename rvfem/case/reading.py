@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any, Sequence
 
 from rvfem.case.schema import closest, file_fields, read_table, table_error
-from rvfem.case.whole_case import _HOLE_SHAPES, Case, _other_hole_names
+from rvfem.case.whole_case import _COMPONENT_TABLES, _HOLE_SHAPES, Case, _component_table_names, _other_hole_names
 from rvfem.errors import CaseError
 
 __all__ = [
@@ -34,12 +34,16 @@ __all__ = [
 def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     """Validate a parsed case (a dict shaped like the TOML file) and build a :class:`Case`.
 
+    The tables of registered hole shapes and stage components are top-level tables like the
+    built-in ones (:attr:`Case.other_holes`, :attr:`Case.component_tables`).
+
     Raises
     ------
     CaseError
         With the file (``source``) and the dotted key of the first problem found.
     """
-    others = _other_hole_names()
+    holes, components = _other_hole_names(), _component_table_names()
+    others = holes + components
     if not others or not isinstance(data, dict):
         return read_table(Case, data, "", source, extra={"source": source})
     known = tuple(spec.name for spec in file_fields(Case)) + others
@@ -51,9 +55,16 @@ def case_from_dict(data: dict, source: str = "<dict>") -> Case:
     values: dict[str, Any] = {"<source>": source}
     case = read_table(Case, {k: v for k, v in data.items() if k not in others}, "", source, values,
                       extra={"source": source})
+    changes: dict[str, Any] = {}
     tables = tuple((name, read_table(_HOLE_SHAPES[name].table, data[name], name, source, values))
-                   for name in others if name in data)
-    return dataclasses.replace(case, other_holes=tables) if tables else case
+                   for name in holes if name in data)
+    if tables:
+        changes["other_holes"] = tables
+    given = tuple((name, read_table(_COMPONENT_TABLES[name].schema, data[name], name, source, values))
+                  for name in components if name in data)
+    if given:   # a table there by default and not given is added by Case, with its defaults
+        changes["component_tables"] = given
+    return dataclasses.replace(case, **changes) if changes else case
 
 
 def table_class(dotted: str) -> type:
@@ -63,6 +74,8 @@ def table_class(dotted: str) -> type:
     parts = [p for p in dotted.split(".") if p]
     if parts and parts[0] in _other_hole_names():
         cls, parts = _HOLE_SHAPES[parts[0]].table, parts[1:]
+    elif parts and parts[0] in _component_table_names():
+        cls, parts = _COMPONENT_TABLES[parts[0]].schema, parts[1:]
     for part in parts:
         spec = {s.name: s for s in file_fields(cls)}.get(part)
         if spec is None or spec.item is None:

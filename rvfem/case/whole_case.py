@@ -44,6 +44,10 @@ __all__ = [
     "unregister_hole_table",
     "hole_table_names",
     "registered_hole_shapes",
+    "ComponentTable",
+    "register_component_table",
+    "unregister_component_table",
+    "component_tables",
     "MIN_DUTY_TORQUE_NM",
     "MAX_MESH_NODES",
     "estimated_mesh_nodes",
@@ -92,7 +96,8 @@ def register_hole_table(shape: type) -> None:
         raise ValueError(f"a hole shape needs a table name (a Python identifier), got {name!r}")
     if name in _BUILTIN_HOLE_CLASSES and table is not _BUILTIN_HOLE_CLASSES[name]:
         raise ValueError(f"the table {name!r} is read as {_BUILTIN_HOLE_CLASSES[name].__name__}")
-    if name not in _BUILTIN_HOLE_CLASSES and name in {f.name for f in dataclasses.fields(Case)}:
+    if name not in _BUILTIN_HOLE_CLASSES and (name in {f.name for f in dataclasses.fields(Case)}
+                                              or name in _COMPONENT_TABLES):
         raise ValueError(f"{name!r} is a table of the case format already")
     if _HOLE_SHAPES.get(name, shape) is not shape:
         raise ValueError(f"the hole table {name!r} is registered by {_HOLE_SHAPES[name].__qualname__} already")
@@ -126,6 +131,92 @@ def registered_hole_shapes() -> tuple[type[Any], ...]:
 def _other_hole_names() -> tuple[str, ...]:
     """The registered hole tables that are not fields of :class:`Case`."""
     return tuple(name for name in _HOLE_SHAPES if name not in BUILTIN_HOLE_TABLES)
+
+
+# --------------------------------------------------------------------------------------------
+# Tables of stage components. A part of the reducer stage registered from outside the case's
+# fields (rvfem.solve.stage_parts.register_stage_component, from any module, a test module
+# included) may own a table of the case file: the one registration point for its schema is
+# register_component_table. Its table is read into Case.component_tables and is a top-level
+# table of the file like the built-in ones; unknown keys in it are refused as anywhere else.
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ComponentTable:
+    """The table of a stage component in the case format.
+
+    Attributes
+    ----------
+    name : str
+        The table's name in the case file (``[name]``).
+    schema : type
+        Its keys: a frozen dataclass whose fields are declared with
+        :func:`~rvfem.case.schema.param` (type, unit, default, bounds, meaning). It may have a
+        method ``check(fail)`` with the checks between its keys (``fail(key, message)`` returns the
+        error to raise).
+    by_default : bool
+        True: a case that does not give the table has it with its defaults (every key then needs a
+        default); False: without the table the case does not have the component.
+    owner : str
+        The component's name, for messages.
+    """
+
+    name: str
+    schema: type[Any]
+    by_default: bool = False
+    owner: str = ""
+
+
+_COMPONENT_TABLES: dict[str, ComponentTable] = {}
+
+
+def register_component_table(name: str, schema: type, *, by_default: bool = False, owner: str = "") -> None:
+    """Make ``schema`` the table ``[name]`` of the case format, owned by the stage component
+    ``owner``. Use :func:`rvfem.solve.stage_parts.register_stage_component`, which calls this for a
+    component with a table.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not a valid table name, names another table of the case format (a field of
+        :class:`Case`, a hole table) or is registered by another component; or ``by_default``
+        with a key that has no default.
+    TypeError
+        ``schema`` is not a frozen dataclass whose fields are declared with
+        :func:`~rvfem.case.schema.param`.
+    """
+    if not (isinstance(name, str) and name.isidentifier()):
+        raise ValueError(f"a stage component's table needs a name (a Python identifier), got {name!r}")
+    if name in {f.name for f in dataclasses.fields(Case)} or name in hole_table_names():
+        raise ValueError(f"{name!r} is a table of the case format already")
+    known = _COMPONENT_TABLES.get(name)
+    if known is not None and (known.schema is not schema or known.owner != owner):
+        raise ValueError(f"the table {name!r} is registered by the component {known.owner!r} already")
+    if not (isinstance(schema, type) and dataclasses.is_dataclass(schema)
+            and getattr(schema, "__dataclass_params__").frozen):
+        raise TypeError(f"the table {name!r} of component {owner!r} must be a frozen dataclass, got {schema!r}")
+    specs = file_fields(schema)     # every key declared with param (raises TypeError otherwise)
+    missing = [spec.name for spec in specs if spec.required]
+    if by_default and missing:
+        raise ValueError(f"the table {name!r} of component {owner!r} is there by default, so every key needs a "
+                         f"default; {', '.join(missing)} has none")
+    _COMPONENT_TABLES[name] = ComponentTable(name, schema, bool(by_default), owner)
+
+
+def unregister_component_table(name: str) -> None:
+    """Remove the table ``name`` of a registered component from the case format (an unknown name is
+    ignored)."""
+    _COMPONENT_TABLES.pop(name, None)
+
+
+def component_tables() -> tuple[ComponentTable, ...]:
+    """The registered tables of stage components, in the order they were registered."""
+    return tuple(_COMPONENT_TABLES.values())
+
+
+def _component_table_names() -> tuple[str, ...]:
+    return tuple(_COMPONENT_TABLES)
 
 
 MAX_NAME_LENGTH = 100
@@ -175,7 +266,9 @@ class Case:
     ``overrides`` records the ``KEY=VALUE`` overrides applied on reading. ``other_holes`` holds
     the tables of the registered hole shapes that are not fields (:func:`register_hole_table`) as
     ``(table name, table)`` pairs; :meth:`replace` sets them by name like fields, and
-    :meth:`hole_tables` lists every hole table of the case.
+    :meth:`hole_tables` lists every hole table of the case. ``component_tables`` holds the tables
+    of the registered stage components (:func:`register_component_table`) the same way
+    (:meth:`component_table` reads one).
     """
 
     name: str = param(max_length=MAX_NAME_LENGTH, default_from=_file_stem,
@@ -198,12 +291,14 @@ class Case:
     source: str = param("<code>", compare=False, in_file=False)
     overrides: tuple[str, ...] = param((), compare=False, in_file=False)
     other_holes: tuple[tuple[str, Any], ...] = param((), in_file=False)
+    component_tables: tuple[tuple[str, Any], ...] = param((), in_file=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "source", str(self.source))
         object.__setattr__(self, "overrides", tuple(self.overrides))
         check_fields(self, "", self.source)
         _check_other_holes(self)
+        _check_component_tables(self)
         for check in _CROSS_CHECKS:
             check(self)
 
@@ -229,6 +324,11 @@ class Case:
             raise LookupError(f"no hole shape is registered for the table {exc.args[0]!r} "
                               "(the built-in ones are registered by importing rvfem.geometry)") from None
 
+    def component_table(self, name: str) -> Any:
+        """The table ``name`` of a registered stage component (:func:`register_component_table`),
+        or None if the case does not have it."""
+        return dict(self.component_tables).get(name)
+
     def hole_table(self, name: str) -> Any:
         """The hole table ``name`` of the case, or None if the case has none."""
         return dict(self.hole_tables()).get(name)
@@ -240,11 +340,13 @@ class Case:
 
     def replace(self, **changes: Any) -> "Case":
         """A copy with top-level fields replaced (validated again); the table of a registered hole
-        shape is replaced by its name like a field (None removes it)."""
-        others = {name: changes.pop(name) for name in _other_hole_names() if name in changes}
-        if others:
-            tables = {**dict(changes.get("other_holes", self.other_holes)), **others}
-            changes["other_holes"] = tuple((name, t) for name, t in tables.items() if t is not None)
+        shape or stage component is replaced by its name like a field (None removes it; a table
+        there by default comes back with its defaults)."""
+        for field, names in (("other_holes", _other_hole_names()), ("component_tables", _component_table_names())):
+            given = {name: changes.pop(name) for name in names if name in changes}
+            if given:
+                tables = {**dict(changes.get(field, getattr(self, field))), **given}
+                changes[field] = tuple((name, t) for name, t in tables.items() if t is not None)
         return dataclasses.replace(self, **changes)
 
     def digest(self) -> str:
@@ -347,6 +449,40 @@ def _check_other_holes(case: Case) -> None:
         check_fields(table, name, case.source)
     ordered = tuple(sorted((p for p in pairs if p[1] is not None), key=lambda p: names.index(p[0])))
     object.__setattr__(case, "other_holes", ordered)
+
+
+def _check_component_tables(case: Case) -> None:
+    """Check the tables of :attr:`Case.component_tables` against their declarations, add those
+    there by default that are missing (with their defaults), run each table's own ``check`` and
+    put them in the order of :func:`component_tables`."""
+    given = case.component_tables
+    pairs = list(given.items()) if isinstance(given, Mapping) else list(given)
+    names = _component_table_names()
+    tables: dict[str, Any] = {}
+    for pair in pairs:
+        if not (isinstance(pair, tuple) and len(pair) == 2 and pair[0] in names):
+            known = ", ".join(names) or "none"
+            raise _error(case, "component_tables", f"must hold (table name, table) pairs of the registered stage "
+                                                   f"components ({known}), got {pair!r}")
+        name, table = pair
+        if name in tables:
+            raise _error(case, name, "is given twice")
+        tables[name] = table
+    ordered = []
+    for entry in component_tables():
+        table = tables.get(entry.name)
+        if table is None and entry.by_default:
+            table = entry.schema()
+        if table is None:
+            continue
+        if not isinstance(table, entry.schema):
+            raise _error(case, entry.name, f"must be a {entry.schema.__name__}, got {table!r}")
+        check_fields(table, entry.name, case.source)
+        check = getattr(table, "check", None)
+        if check is not None:
+            check(lambda key, message, name=entry.name: _error(case, f"{name}.{key}", message))
+        ordered.append((entry.name, table))
+    object.__setattr__(case, "component_tables", tuple(ordered))
 
 
 def _check_holes(case: Case) -> None:
@@ -659,7 +795,7 @@ _CROSS_CHECKS = (_check_name, _check_cycloid_and_pins, _check_cranks, _check_cra
 # --------------------------------------------------------------------------------------------
 
 
-_NOT_IN_FILE = ("source", "overrides", "other_holes")
+_NOT_IN_FILE = ("source", "overrides", "other_holes", "component_tables")
 
 
 def table_to_dict(table: Any) -> Any:
@@ -675,9 +811,10 @@ def table_to_dict(table: Any) -> Any:
 
 def case_to_dict(case: Case) -> dict:
     """The case as a plain dict in the file's layout (round-trips through :func:`case_from_dict`);
-    the tables of registered hole shapes (:attr:`Case.other_holes`) are top-level tables."""
+    the tables of registered hole shapes (:attr:`Case.other_holes`) and stage components
+    (:attr:`Case.component_tables`) are top-level tables."""
     data = table_to_dict(case)
     data["loads"]["duty_cycle"] = data["loads"].get("duty_cycle", [])
-    for name, table in case.other_holes:
+    for name, table in case.other_holes + case.component_tables:
         data[name] = table_to_dict(table)
     return data

@@ -1,7 +1,7 @@
 """What the flexibility effect is made of: the attribution of the flexible bearing loads to the
 modelling steps handbook → equal share of the FE pin resultant → one flexible disc with T/discs →
-two discs sharing the carrier → crankshaft compliance, on the same crank angles and the same
-compliance.
+two discs sharing the carrier → crankshaft compliance (→ the step of each stage component that
+brings its own, :mod:`rvfem.solve.stage_parts`), on the same crank angles and the same compliance.
 
 The attribution is a secondary analysis: a step whose cycle cannot be solved (a contact problem the
 step's model does not settle, though the case's own model does) is left out of the chain and named
@@ -24,11 +24,11 @@ from rvfem.evaluate.rigid import (
     handbook_bearing_loads,
 )
 from rvfem.evaluate.validity import ResultWarning
-from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve.cycle import build_stage, load_cycle
-from rvfem.solve.stage_parts import STAGE_PARTS
+from rvfem.solve.stage_parts import build_components, stage_components
 
-__all__ = ["Attribution", "AttributionStep", "STEP_LABELS", "attribution", "case_step", "skipped_warnings"]
+__all__ = ["Attribution", "AttributionStep", "STEP_LABELS", "attribution", "case_step", "chain", "skipped_warnings",
+           "step_label"]
 
 log = logging.getLogger(__name__)
 
@@ -104,6 +104,31 @@ STEP_LABELS = {
 }
 
 
+def step_label(key: str) -> str:
+    """What the step ``key`` adds, in words: :data:`STEP_LABELS`, or the ``step_label`` of the stage
+    component that brings its own step (:mod:`rvfem.solve.stage_parts`)."""
+    if key in STEP_LABELS:
+        return STEP_LABELS[key]
+    for c in stage_components():
+        if c.step == key and c.step_label:
+            return c.step_label
+    raise KeyError(f"no attribution step {key!r}")
+
+
+def chain(case) -> list[str]:
+    """The model steps of the case's attribution after the handbook and the equal share, in order:
+    one flexible disc, two discs sharing the carrier (two discs), then the step of each stage
+    component the case has (:func:`rvfem.solve.stage_parts.stage_components`, in their order; the
+    crankshafts only with ``[crank_support]``), each step once."""
+    need = ["one_disc"]
+    if case.loads.discs == 2:
+        need.append("two_discs")
+    for c in stage_components():
+        if c.step is not None and c.step not in need and c.present(case):
+            need.append(c.step)
+    return need
+
+
 def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attribution:
     """Solve the modelling steps the case does not already have and collect their load curves, at
     the case's operating point.
@@ -135,22 +160,15 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
     """
     case = system.case
     cycles = dict(cycles or {})
-    need = ["one_disc"]
+    need = chain(case)
     discs = 2 if case.loads.discs == 2 else 1
-    if discs == 2:
-        need.append("two_discs")
-    f = crankshaft_influence(case)
-    # then the steps that bring in the stage's parts (the crankshafts' only where the case has them)
-    for part in STAGE_PARTS:
-        if part.step not in need and (f is not None or not part.crank):
-            need.append(part.step)
-    crank_steps = {p.step for p in STAGE_PARTS if p.crank}
     skipped: dict[str, str] = {}
-    for key in need:
+    for k, key in enumerate(need):
         if key in cycles:
             continue
-        stage = build_stage(system, discs=1 if key == "one_disc" else discs,
-                            influence=f if key in crank_steps else None)
+        # the step's stage: one disc or both, with every component first modelled up to this step
+        stage = build_components(build_stage(system, discs=1 if key == "one_disc" else discs, influence=None),
+                                 steps=tuple(need[:k + 1]))
         try:
             cycles[key] = load_cycle(system, thetas, saved_angles_deg=(), stage=stage)
         except ContactError as exc:
@@ -169,9 +187,9 @@ def attribution(system, thetas: np.ndarray, cycles: dict | None = None) -> Attri
         skipped["equal_share"] = "it is built from the pin forces of the one-disc step, which was not made"
     for key in need:
         if key in cycles:
-            steps.append(AttributionStep(key, STEP_LABELS[key], cycles[key].bearing_loads.T))
+            steps.append(AttributionStep(key, step_label(key), cycles[key].bearing_loads.T))
     for key, why in skipped.items():
-        log.info("attribution step %s (%s) not made: %s", key, STEP_LABELS[key], why)
+        log.info("attribution step %s (%s) not made: %s", key, step_label(key), why)
     return Attribution(np.asarray(thetas), tuple(steps), case_step(case), tuple(skipped.items()))
 
 
@@ -181,7 +199,7 @@ def skipped_warnings(result: Attribution | None) -> tuple[ResultWarning, ...]:
     with every step made."""
     if result is None:
         return ()
-    return tuple(ResultWarning("not_computed", f"attribution step {key} ({STEP_LABELS[key]}) not made: {why}; "
+    return tuple(ResultWarning("not_computed", f"attribution step {key} ({step_label(key)}) not made: {why}; "
                                "the other steps and the run's results stand", 1.0, 0.0, "")
                  for key, why in result.skipped)
 
@@ -189,9 +207,13 @@ def skipped_warnings(result: Attribution | None) -> tuple[ResultWarning, ...]:
 def case_step(case) -> str:
     """The attribution step that is the case's own model: ``one_disc`` (one disc with T/discs on
     rigid eccentrics: ``torque_split = "equal"``, or one disc without ``[crank_support]``),
-    ``two_discs`` (two discs on rigid eccentrics) or ``crankshafts``."""
+    ``two_discs`` (two discs on rigid eccentrics), ``crankshafts``, or the step of its own of the
+    last stage component the case has that brings one."""
     if case.loads.discs > 1 and case.loads.torque_split == "equal":
         return "one_disc"
+    own = [key for key in chain(case) if key not in STEP_LABELS]
+    if own:     # a stage component's own step, the last of the chain
+        return own[-1]
     if case.crank_support is not None:
         return "crankshafts"
     return "two_discs" if case.loads.discs == 2 else "one_disc"

@@ -5,7 +5,8 @@ let them turn by z_sun/z_planet of the output angle, a small part of the cycloid
 left out): the stage is held at one crank angle θ and only the torque on the carrier changes. Each
 load step is one contact solve of the stage (:func:`rvfem.solve.cycle.solve_pair`) on the same
 factorised discs and lazily filled column compliance, started from the step before it. The
-output rotation is the carrier rotation φ of that solve, in the torque convention of
+output rotation is the carrier rotation φ of that solve (plus the rotation of the stage's series
+output compliances under the output torque, where a component adds one), in the torque convention of
 :mod:`rvfem.solve.cycle` (each disc's torque about its own centre, the eccentrics turning about the
 disc centre: the handbook's and Liu et al.'s convention).
 
@@ -43,18 +44,18 @@ from rvfem.solve.cycle import (
     solve_pair,
     symmetry_plan,
 )
-from rvfem.solve.stage_parts import COMPONENTS, STIFFEN, stiffened_stage
+from rvfem.solve.stage_parts import STIFFEN, component_names, stiffened_stage
 from rvfem.units import arcmin_from_rad, nm_from_nmm
 
 log = logging.getLogger(__name__)
 
 __all__ = [
-    "COMPONENTS",
     "LOST_MOTION_FRACTION",
     "STIFFEN",
     "ZERO_FRACTION",
     "ComplianceShares",
     "HysteresisLoop",
+    "component_names",
     "compliance_shares",
     "hysteresis_loop",
     "loop_at_torques",
@@ -160,7 +161,9 @@ def loop_at_torques(stage: ReducerStage, theta: float, torques: Sequence[float] 
     between the steps (one per crank angle; a new one by default), so that the steps after the
     first do not build it again (:func:`rvfem.solve.contact.solve_bodies`).
 
-    Returns the carrier rotation of each step (rad), the Newton iterations and the pair results.
+    Returns the output rotation of each step (rad: the carrier rotation and the stage's series
+    output compliances, :attr:`rvfem.solve.cycle.PairResult.output_rotation`), the Newton
+    iterations and the pair results.
     """
     torques = np.asarray(torques, dtype=float)
     if slips is None:
@@ -174,7 +177,7 @@ def loop_at_torques(stage: ReducerStage, theta: float, torques: Sequence[float] 
         op = OperatingPoint(float(T), float(friction), int(slip) if friction > 0 else 0)
         pairs.append(_step(stage, theta, op, pairs[-1] if pairs else start, before, cache))
         before = float(T)
-    rotation = np.array([p.results[0].carrier_rotation for p in pairs])
+    rotation = np.array([p.output_rotation for p in pairs])
     iterations = np.array([p.results[0].solution.iterations for p in pairs])
     return rotation, iterations, pairs
 
@@ -272,10 +275,12 @@ class ComplianceShares:
 
 
 def compliance_shares(stage: ReducerStage, theta: float, torque_Nm: float, friction: float = 0.0,
-                      components: tuple = COMPONENTS) -> ComplianceShares:
+                      components: tuple[str, ...] | None = None) -> ComplianceShares:
     """Where the compliance sits (stiffen one component at a time, :func:`stiffened_stage`): the
     rotation a between 3 % and 100 % of ``torque_Nm`` (N·m) at crank angle θ (rad) with each
-    component :data:`STIFFEN` times stiffer, against the stage's own."""
+    component :data:`STIFFEN` times stiffer, against the stage's own. ``components``: their names,
+    default every component of the stage (:func:`rvfem.solve.stage_parts.component_names`); one the
+    stage does not have is left out (logged)."""
     torques = np.array([torque_Nm, 0.03 * torque_Nm])
     slips = np.ones(2, dtype=int)
 
@@ -285,7 +290,7 @@ def compliance_shares(stage: ReducerStage, theta: float, torque_Nm: float, frict
 
     a = rotation(stage)
     shares = {}
-    for c in components:
+    for c in component_names() if components is None else components:
         try:
             shares[c] = (a - rotation(stiffened_stage(stage, c))) / a
         except ValueError as exc:

@@ -22,7 +22,8 @@ The parts, from the bottom up: the disc model (:mod:`rvfem.solve.cycle_system`),
 crank angle and their cache (:mod:`rvfem.solve.cycle_contacts`), one crank angle
 (:mod:`rvfem.solve.cycle_angle`), the symmetries of a cycle (:mod:`rvfem.solve.cycle_symmetry`) and
 the reducer stage with its cycle (:mod:`rvfem.solve.cycle_stage`, where the two-disc stage is
-described). This module drives a crank revolution with them (:func:`load_cycle`), holds its results
+described) and the stage the case asks for, built by its components (:mod:`rvfem.solve.stage_parts`).
+This module drives a crank revolution with them (:func:`load_cycle`), holds its results
 (:class:`CycleResult`, :class:`AngleLoads`) and displacement fields, and gives all their names.
 """
 
@@ -49,7 +50,6 @@ from rvfem.solve.cycle_stage import (
     ReducerStage,
     _rotation,
     build_stage,
-    case_stage,
     coupling_matrix,
     half_pitch_case,
     likely_columns,
@@ -68,6 +68,7 @@ from rvfem.solve.cycle_symmetry import (
 )
 from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, build_system
 from rvfem.solve.models import roller_angles
+from rvfem.solve.stage_parts import case_stage
 from rvfem.units import arcmin_from_rad, nm_from_nmm
 
 __all__ = [

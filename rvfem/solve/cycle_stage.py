@@ -52,7 +52,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from rvfem.errors import CaseError
-from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import contact
 from rvfem.solve.contact import ContactSet
 from rvfem.solve.cycle_angle import angle_result, solve_from_last
@@ -99,12 +98,23 @@ class ReducerStage:
         ``"same_as_first"``).
     influence : ndarray (discs, discs) or None
         Crankshaft influence matrix, mm/N (None: rigid eccentrics).
+    output_compliances : tuple of (str, float)
+        Torsional compliances in series with the stage in the output's load path, each as
+        ``(component name, compliance in rad/(N·mm))``: a part of the reducer outside the discs'
+        contact problem (a stage component, :mod:`rvfem.solve.stage_parts`) whose rotation under
+        the output torque adds to the carrier rotation (:attr:`PairResult.output_rotation`). They
+        change no contact force: the output torque passes through them whole. Empty by default.
+
+    A new part of the stage is a new field with a default: the stage is changed by
+    :func:`dataclasses.replace` (never rebuilt positionally), so every other field is carried
+    through.
     """
 
     first: DiscSystem
     second: DiscSystem | None
     second_phase: float
     influence: np.ndarray | None
+    output_compliances: tuple[tuple[str, float], ...] = ()
 
     @property
     def discs(self) -> int:
@@ -124,6 +134,29 @@ class ReducerStage:
         f = self.influence
         return f is None or bool(np.isclose(f[0, 0], f[1, 1], rtol=1e-12, atol=0.0))
 
+    @property
+    def output_compliance_rad_per_Nmm(self) -> float:
+        """The series output compliances together, rad/(N·mm) (0 without any)."""
+        return float(sum(c for _, c in self.output_compliances))
+
+    def output_compliance(self, name: str) -> float | None:
+        """The series output compliance of the component ``name``, rad/(N·mm), or None if the stage
+        has none of it."""
+        return dict(self.output_compliances).get(name)
+
+    def with_output_compliance(self, name: str, rad_per_Nmm: float) -> "ReducerStage":
+        """The stage with the component ``name``'s series output compliance set to ``rad_per_Nmm``
+        (rad/(N·mm), ≥ 0; added after the others, or replacing its own), every other field carried
+        through."""
+        c = float(rad_per_Nmm)
+        if not (math.isfinite(c) and c >= 0.0):
+            raise ValueError(f"the output compliance of {name!r} must be finite and non-negative, got {rad_per_Nmm!r}")
+        others = tuple((n, v) for n, v in self.output_compliances if n != name)
+        if len(others) == len(self.output_compliances):
+            return dataclasses.replace(self, output_compliances=others + ((name, c),))
+        return dataclasses.replace(self, output_compliances=tuple((n, c if n == name else v)
+                                                                  for n, v in self.output_compliances))
+
     def describe(self) -> str:
         """What the stage model is, for the report and the screen."""
         if self.discs == 1:
@@ -134,7 +167,9 @@ class ReducerStage:
                        else "with its teeth half a pitch from disc A's against the bores and holes"))
         crank = ("crank support rigid: upper bound of the flexibility effect" if self.influence is None
                  else "crankshafts as beams on elastic support bearings")
-        return f"{disc}; {crank}"
+        springs = "".join(f"; {name} in series with the output ({1.0 / c if c > 0 else math.inf:.4g} N·mm/rad)"
+                          for name, c in self.output_compliances)
+        return f"{disc}; {crank}{springs}"
 
 
 def _rotation(beta: float) -> np.ndarray:
@@ -144,7 +179,8 @@ def _rotation(beta: float) -> np.ndarray:
 
 def build_stage(system, *, discs: int, influence: np.ndarray | None, second=None,
                 second_disc: str = "same_as_first") -> ReducerStage:
-    """A reducer stage of a disc model (:func:`case_stage` builds the one the case asks for).
+    """A reducer stage of a disc model (:func:`rvfem.solve.stage_parts.case_stage` builds the one the case
+    asks for).
 
     Parameters
     ----------
@@ -185,19 +221,6 @@ def single_disc_stage(system) -> ReducerStage:
     return build_stage(system, discs=1, influence=None)
 
 
-def case_stage(system, second=None, second_disc: str = "same_as_first") -> ReducerStage:
-    """The reducer stage the case asks for: both discs on one carrier for ``loads.discs = 2`` with
-    the crankshafts of ``[crank_support]`` (rigid eccentrics without it), or, with
-    ``loads.torque_split = "equal"`` or one disc, one disc carrying T_out/discs. The equal split is
-    rvfem 0.1's and the handbook's model, on rigid eccentrics ([crank_support] belongs to the
-    two-disc stage). ``second``, ``second_disc`` as in :func:`build_stage`."""
-    case = system.case
-    equal_split = case.loads.discs > 1 and case.loads.torque_split == "equal"
-    discs = 1 if equal_split or case.loads.discs == 1 else 2
-    influence = None if (discs == 1 and equal_split) else crankshaft_influence(case)
-    return build_stage(system, discs=discs, influence=influence, second=second, second_disc=second_disc)
-
-
 def half_pitch_case(case):
     """Disc B's case for the exact model: cranks (and the holes that follow them) turned by −β.
 
@@ -228,12 +251,17 @@ class PairResult:
         Each disc's share of the carrier torque, N·mm.
     eccentric_displacement : ndarray (discs, N, 2)
         Displacement of each eccentric relative to the carrier (crankshaft deflection), mm.
+    output_rotation : float
+        The output's rotation, rad: the carrier rotation of disc A's solve plus the rotation of the
+        stage's series output compliances under the output torque
+        (:attr:`ReducerStage.output_compliances`); the carrier rotation itself without them.
     """
 
     results: tuple
     bearing_forces: np.ndarray
     torque_Nmm: np.ndarray
     eccentric_displacement: np.ndarray
+    output_rotation: float
 
 
 def _disc_angles(stage: ReducerStage, theta: float) -> list[float]:
@@ -294,13 +322,19 @@ def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = Non
         max_iterations=case.analysis.max_active_set_iterations,
         label=f"at crank angle {math.degrees(theta):.2f}° ", names=names, g_cache=g_cache)
     return _pair(stage, tuple(angle_result(s, th, sol, c)
-                              for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)))
+                              for s, th, sol, (c, _) in zip(systems, thetas, sols, sets)), op)
 
 
-def _pair(stage: ReducerStage, results: tuple) -> PairResult:
-    """A PairResult from each disc's solution (disc A first)."""
-    return PairResult(results, *_stage_loads(stage, [r.bearing_forces for r in results],
-                                             [r.solution.residual["torque_Nmm"] for r in results]))
+def _pair(stage: ReducerStage, results: tuple, op: OperatingPoint) -> PairResult:
+    """A PairResult from each disc's solution (disc A first) at the operating point ``op``: the
+    series output compliances turn the output by their compliance times the whole output torque
+    (which passes through them; the discs modelled may carry only their share of it)."""
+    forces, torques, w = _stage_loads(stage, [r.bearing_forces for r in results],
+                                      [r.solution.residual["torque_Nmm"] for r in results])
+    rotation = results[0].carrier_rotation
+    if stage.output_compliances:
+        rotation = rotation + stage.output_compliance_rad_per_Nmm * nmm_from_nm(op.torque_Nm)
+    return PairResult(results, forces, torques, w, output_rotation=float(rotation))
 
 
 def _stage_loads(stage: ReducerStage, bearing_forces: list, torques: list):

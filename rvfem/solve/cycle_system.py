@@ -50,8 +50,6 @@ class OperatingPoint:
         :mod:`rvfem.solve.accuracy`).
     """
 
-    __module__ = "rvfem.solve.cycle"   # its public home, as the front door (``rvfem.OperatingPoint``) names it
-
     torque_Nm: float
     friction: float = 0.0
     slip: int = 0
@@ -64,6 +62,11 @@ class OperatingPoint:
     def disc_torque_Nmm(self, case: Case) -> float:
         """The torque of one disc with the equal share T_out/discs, N·mm."""
         return nmm_from_nm(self.torque_Nm) / case.loads.discs
+
+
+# its public home, as the front door (``rvfem.OperatingPoint``) names it; set after the class is made,
+# so that this module imports whether or not rvfem.solve.cycle has been imported before it
+OperatingPoint.__module__ = "rvfem.solve.cycle"
 
 
 @dataclass(frozen=True)

@@ -1,65 +1,151 @@
-"""The parts of a reducer stage whose compliance the stage model holds, listed once.
+"""The reducer stage as registered components: each part of the stage is one component, listed in one
+explicit table.
 
-Each part (:class:`StagePart`) names itself, says in words how the stage model holds it, names the
-attribution step that brings it into the model (:mod:`rvfem.evaluate.attribution`) and knows how to
-make itself :data:`STIFFEN` times stiffer. The compliance shares
-(:func:`rvfem.solve.accuracy.compliance_shares`), the list of components (:data:`COMPONENTS`), the
-attribution's chain of steps and the hysteresis study's note on what the model leaves out all
-iterate :data:`STAGE_PARTS`; a part added here reaches all four.
+A component (:class:`StageComponent`) is one series compliance of the stage. It declares
 
-A stiffened stage is the stage with the changed fields replaced (:func:`dataclasses.replace`), so a
-field of :class:`rvfem.solve.cycle.ReducerStage` that no part touches is carried through unchanged.
+* its ``name`` (its key in the compliance shares) and the case table it owns, with that table's
+  keys (``table`` and ``schema``: a dataclass of :mod:`rvfem.case.tables`, or the schema of a table
+  it brings into the case format; the ``_parameters`` of a solver class in sfepy's
+  ``solvers/nls.py``);
+* how it builds its part of the stage from the case (:meth:`StageComponent.build`, applied by
+  :func:`case_stage`) and whether the case has it at all (:meth:`StageComponent.present`);
+* how it makes itself :data:`STIFFEN` times stiffer (:meth:`StageComponent.stiffen`), for the
+  compliance shares (:func:`rvfem.solve.accuracy.compliance_shares`);
+* the attribution step that first models it (``step``, :mod:`rvfem.evaluate.attribution`;
+  ``step_label`` names a step of its own), and in words what the stage model holds of it
+  (``held``) and which of the parts the stage model leaves out it brings in (``models``, keys of
+  :data:`NOT_MODELLED`).
+
+The built-in components are listed in :data:`BUILTIN_COMPONENTS`, in the order of the load path from
+the pins to the carrier (as meshio lists its formats); a component written elsewhere (a notebook,
+a test module, a module of its own) is added after them with one line,
+``register_stage_component(MyComponent())``, which also adds its table to the case format
+(:func:`rvfem.case.definition.register_component_table`). :func:`stage_components` is the table the
+compliance shares, the attribution, :func:`case_stage` and the words of ``rvfem hysteresis``
+iterate.
+
+A component changes the stage only through :func:`dataclasses.replace` (or a method of
+:class:`~rvfem.solve.cycle_stage.ReducerStage` that uses it), so a field of the stage that it does not
+touch — another component's part included — is carried through unchanged. A part that acts in
+series with the whole stage in the output's load path (a carrier's torsion, a spring to the
+ground) adds a series output compliance (:meth:`~rvfem.solve.cycle_stage.ReducerStage.with_output_compliance`),
+which the hysteresis loop, the rigidity, the lost motion and the TE see in the output rotation
+(:attr:`~rvfem.solve.cycle_stage.PairResult.output_rotation`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
-from dataclasses import dataclass
 from types import SimpleNamespace
+from typing import Any, ClassVar
 
 import numpy as np
 
-from rvfem.case.definition import CrankSupport
+from rvfem.case.definition import (
+    Case,
+    CrankBearing,
+    CrankSupport,
+    Material,
+    Pins,
+    register_component_table,
+    unregister_component_table,
+)
+from rvfem.errors import CaseError
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import models
-from rvfem.solve.cycle import DiscSystem, OperatingPoint, ReducerStage, build_system, solve_pair
+from rvfem.solve.cycle_stage import ReducerStage, build_stage, solve_pair
+from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, build_system
 
-__all__ = ["COMPONENTS", "STAGE_PARTS", "STIFFEN", "StagePart", "held_in_words", "stage_part", "stiffened_stage"]
+__all__ = [
+    "BUILTIN_COMPONENTS",
+    "NOT_MODELLED",
+    "STIFFEN",
+    "StageComponent",
+    "build_components",
+    "case_stage",
+    "component_names",
+    "held_in_words",
+    "not_modelled",
+    "register_stage_component",
+    "stage_component",
+    "stage_components",
+    "stiffened_stage",
+    "unregister_stage_component",
+]
 
 STIFFEN = 1.0e3
-"""The factor a part is stiffened by to remove its compliance (:func:`stiffened_stage`)."""
+"""The factor a component is stiffened by to remove its compliance (:func:`stiffened_stage`)."""
 
 
-@dataclass(frozen=True)
-class StagePart:
-    """One series compliance of the reducer stage.
+class StageComponent:
+    """One part of the reducer stage (module docstring). Subclass it, set the class attributes and
+    override :meth:`build` (if the part is not already in the disc model or the crankshafts) and
+    :meth:`stiffen`.
 
     Attributes
     ----------
     name : str
-        The part's name in the compliance shares (``"disc body"``).
+        The component's name in the compliance shares (``"disc body"``); unique.
+    table : str or None
+        The case table it owns (``"pins"``; a new one for a component registered from outside,
+        :func:`register_stage_component`); None for a component without one.
+    schema : type or None
+        The dataclass of that table (its keys, declared with :func:`rvfem.case.schema.param`).
+    table_by_default : bool
+        For a new table: a case without it has it with its defaults (True), or has no such
+        component (False, the default).
     held : str
         How the stage model holds the part, in words (a noun phrase of :func:`held_in_words`).
-    step : str
-        The attribution step that first models the part as compliant (``one_disc`` or
-        ``crankshafts``, :data:`rvfem.evaluate.attribution.STEP_LABELS`).
-    stiffen : callable
-        ``stiffen(stage) → ReducerStage``: the stage with this part :data:`STIFFEN` times stiffer;
-        raises ValueError where the stage has no such compliance to remove.
+    step : str or None
+        The attribution step that first models the part (``one_disc``, ``two_discs`` or
+        ``crankshafts``, or a step of its own named by ``step_label``); None for a part that changes
+        no bearing load (a compliance in series with the whole stage): it has no step.
+    step_label : str or None
+        What its own attribution step adds, in words (None: ``step`` is a built-in step).
     body : bool
         True for the bodies the other parts connect (named first in :func:`held_in_words`).
-    crank : bool
-        True for the parts of the crankshaft model (the stage's crankshaft influence matrix), which
-        the attribution's step adds only where the case has one.
+    models : tuple of str
+        The keys of :data:`NOT_MODELLED` it brings into the model (they leave the left-out list).
     """
 
-    name: str
-    held: str
-    step: str
-    stiffen: Callable[[ReducerStage], ReducerStage]
-    body: bool = False
-    crank: bool = False
+    name: ClassVar[str]
+    table: ClassVar[str | None] = None
+    schema: ClassVar[type[Any] | None] = None
+    table_by_default: ClassVar[bool] = False
+    held: ClassVar[str]
+    step: ClassVar[str | None] = None
+    step_label: ClassVar[str | None] = None
+    body: ClassVar[bool] = False
+    models: ClassVar[tuple[str, ...]] = ()
+
+    def parameters(self, case: Case) -> Any:
+        """The component's table of ``case`` (a field of the case, or a registered component table),
+        or None if the case does not have it."""
+        if self.table is None:
+            return None
+        if self.table in {f.name for f in dataclasses.fields(Case)}:
+            return getattr(case, self.table)
+        return case.component_table(self.table)
+
+    def present(self, case: Case) -> bool:
+        """True if ``case`` has the part (its table, where it owns one)."""
+        return self.table is None or self.parameters(case) is not None
+
+    def build(self, stage: ReducerStage) -> ReducerStage:
+        """The stage with this part added, from the stage's case (``stage.first.case``). The default
+        returns the stage as it is: the part is in the disc's model (:func:`build_system`), which the
+        stage is made of."""
+        return stage
+
+    def stiffen(self, stage: ReducerStage) -> ReducerStage:
+        """The stage with this part :data:`STIFFEN` times stiffer; ValueError where the stage has no
+        such compliance to remove."""
+        raise ValueError(f"the component {self.name!r} cannot be stiffened")
+
+
+# ------------------------------------------------------------------------------------------------
+# The built-in components
+# ------------------------------------------------------------------------------------------------
 
 
 def _with_disc_system(stage: ReducerStage, system: DiscSystem) -> ReducerStage:
@@ -69,37 +155,67 @@ def _with_disc_system(stage: ReducerStage, system: DiscSystem) -> ReducerStage:
     return dataclasses.replace(stage, first=system, second=None if stage.second is None else system)
 
 
-def _stiff_pins(stage: ReducerStage) -> ReducerStage:
-    """Linear pin springs of STIFFEN × the secant stiffness of the pins' law at the mean pin load
-    (the profile's gaps kept)."""
-    system = stage.first
-    k = STIFFEN * _secant_stiffness(system, "pins", stage)
-    return _with_disc_system(stage, dataclasses.replace(system, pin_model="linear", pin_stiffness_N_per_mm=k,
-                                                        pins=models.pin_model("linear")(system.case, k),
-                                                        contact_sets={}))
+class PinFlankContact(StageComponent):
+    """The pins against the disc's flanks: the pin law of ``[pins]`` at the gaps of the modified
+    profile, built with the disc's model."""
+
+    name = "pin–flank contact"
+    table, schema = "pins", Pins
+    held = "the pins (Hertz contact at the gaps of the modified profile)"
+    step = "one_disc"
+
+    def stiffen(self, stage: ReducerStage) -> ReducerStage:
+        """Linear pin springs of STIFFEN × the secant stiffness of the pins' law at the mean pin load
+        (the profile's gaps kept)."""
+        system = stage.first
+        k = STIFFEN * _secant_stiffness(system, "pins", stage)
+        return _with_disc_system(stage, dataclasses.replace(system, pin_model="linear", pin_stiffness_N_per_mm=k,
+                                                            pins=models.pin_model("linear")(system.case, k),
+                                                            contact_sets={}))
 
 
-def _stiff_disc(stage: ReducerStage) -> ReducerStage:
-    """The disc's E × STIFFEN: a new factorisation of the same mesh and models."""
-    s = stage.first
-    system = build_system(s.case, s.mesh, bearing_model=s.bearing_model, pin_model=s.pin_model,
-                          stiffness_scale=STIFFEN * s.stiffness_scale, bearing_stiffness_scale=s.bearing_stiffness_scale,
-                          pin_stiffness_N_per_mm=s.pin_stiffness_N_per_mm, geometry=s.geometry)
-    return _with_disc_system(stage, system)
+class DiscBody(StageComponent):
+    """The disc's elastic body (its material, ``[material]``, on its mesh), built with the disc's
+    model."""
+
+    name = "disc body"
+    table, schema = "material", Material
+    held = "both discs"
+    step = "one_disc"
+    body = True
+
+    def stiffen(self, stage: ReducerStage) -> ReducerStage:
+        """The disc's E × STIFFEN: a new factorisation of the same mesh and models."""
+        s = stage.first
+        system = build_system(s.case, s.mesh, bearing_model=s.bearing_model, pin_model=s.pin_model,
+                              stiffness_scale=STIFFEN * s.stiffness_scale,
+                              bearing_stiffness_scale=s.bearing_stiffness_scale,
+                              pin_stiffness_N_per_mm=s.pin_stiffness_N_per_mm, geometry=s.geometry)
+        return _with_disc_system(stage, system)
 
 
-def _stiff_rollers(stage: ReducerStage) -> ReducerStage:
-    """Linear roller springs of STIFFEN × the secant of the rollers' law at the mean roller load
-    (the clearance kept)."""
-    system = stage.first
-    if system.bearing_model != "rollers":
-        raise ValueError("the roller share needs the 'rollers' bearing model")
-    k = STIFFEN * _secant_stiffness(system, "rollers", stage)
-    case = system.case
-    stiff = case.replace(crank_bearing=dataclasses.replace(case.crank_bearing, stiffness_law="linear",
-                                                           linear_stiffness_N_per_mm=k))
-    return _with_disc_system(stage, dataclasses.replace(system, case=stiff, bearings=models.bearing_model("rollers")(stiff),
-                                                        contact_sets={}))
+class CrankBearingRollers(StageComponent):
+    """The crank bearings' rollers with their clearance (``[crank_bearing]``), built with the disc's
+    model."""
+
+    name = "crank-bearing rollers"
+    table, schema = "crank_bearing", CrankBearing
+    held = "the crank-bearing rollers with their clearance"
+    step = "one_disc"
+
+    def stiffen(self, stage: ReducerStage) -> ReducerStage:
+        """Linear roller springs of STIFFEN × the secant of the rollers' law at the mean roller load
+        (the clearance kept)."""
+        system = stage.first
+        if system.bearing_model != "rollers":
+            raise ValueError("the roller share needs the 'rollers' bearing model")
+        k = STIFFEN * _secant_stiffness(system, "rollers", stage)
+        case = system.case
+        stiff = case.replace(crank_bearing=dataclasses.replace(case.crank_bearing, stiffness_law="linear",
+                                                               linear_stiffness_N_per_mm=k))
+        return _with_disc_system(stage, dataclasses.replace(system, case=stiff,
+                                                            bearings=models.bearing_model("rollers")(stiff),
+                                                            contact_sets={}))
 
 
 def _beam_support(stage: ReducerStage, name: str) -> CrankSupport:
@@ -116,64 +232,198 @@ def _with_support(stage: ReducerStage, cs: CrankSupport) -> ReducerStage:
     return dataclasses.replace(stage, influence=influence[:stage.discs, :stage.discs])
 
 
-def _stiff_crankshaft(stage: ReducerStage) -> ReducerStage:
-    """The crankshaft beam's E × STIFFEN (bending and shear)."""
-    cs = _beam_support(stage, "crankshaft bending/shear")
-    return _with_support(stage, dataclasses.replace(cs, youngs_modulus=cs.youngs_modulus * STIFFEN, bending_stiffness_Nmm2=(
-        None if cs.bending_stiffness_Nmm2 is None else cs.bending_stiffness_Nmm2 * STIFFEN)))
+class Crankshafts(StageComponent):
+    """The crankshafts as beams on their support bearings (``[crank_support]``): the stage's
+    crankshaft influence matrix (:func:`rvfem.fem.crankshaft.crankshaft_influence`, which holds the
+    support bearings' compliance too)."""
+
+    name = "crankshaft bending/shear"
+    table, schema = "crank_support", CrankSupport
+    held = "the crankshafts as beams"
+    step = "crankshafts"
+
+    def build(self, stage: ReducerStage) -> ReducerStage:
+        """The stage on the crankshafts of ``[crank_support]`` (the influence matrix of the discs it
+        has), except for one disc carrying T/discs with ``loads.torque_split = "equal"``: the
+        handbook's model, on rigid eccentrics."""
+        case = stage.first.case
+        if stage.discs == 1 and case.loads.discs > 1 and case.loads.torque_split == "equal":
+            return stage
+        influence = crankshaft_influence(case)
+        if influence is None:
+            return stage
+        f = np.asarray(influence, dtype=float)
+        if stage.discs == 2 and f.shape != (2, 2):
+            raise CaseError("the crankshaft influence matrix of two discs must be 2×2")
+        return dataclasses.replace(stage, influence=f[:stage.discs, :stage.discs])
+
+    def stiffen(self, stage: ReducerStage) -> ReducerStage:
+        """The crankshaft beam's E × STIFFEN (bending and shear)."""
+        cs = _beam_support(stage, self.name)
+        return _with_support(stage, dataclasses.replace(cs, youngs_modulus=cs.youngs_modulus * STIFFEN,
+                                                        bending_stiffness_Nmm2=(None if cs.bending_stiffness_Nmm2 is None
+                                                                                else cs.bending_stiffness_Nmm2 * STIFFEN)))
 
 
-def _stiff_support(stage: ReducerStage) -> ReducerStage:
-    """The support bearings' (and the carrier's) stiffness × STIFFEN."""
-    cs = _beam_support(stage, "support bearings")
+class SupportBearings(StageComponent):
+    """The crankshafts' support bearings (and the carrier's seats of them), ``[crank_support]``:
+    the supports of the crankshaft beam, built into its influence matrix by :class:`Crankshafts`."""
 
-    def scale(v: float | tuple[float, ...] | None) -> float | tuple[float, ...] | None:
-        return None if v is None else (tuple(x * STIFFEN for x in v) if isinstance(v, tuple) else v * STIFFEN)
+    name = "support bearings"
+    table, schema = "crank_support", CrankSupport
+    held = "their support bearings"
+    step = "crankshafts"
 
-    return _with_support(stage, dataclasses.replace(cs, support_stiffness_N_per_mm=scale(cs.support_stiffness_N_per_mm),
-                                                    carrier_stiffness_N_per_mm=scale(cs.carrier_stiffness_N_per_mm)))
+    def stiffen(self, stage: ReducerStage) -> ReducerStage:
+        """The support bearings' (and the carrier's) stiffness × STIFFEN."""
+        cs = _beam_support(stage, self.name)
+
+        def scale(v: float | tuple[float, ...] | None) -> float | tuple[float, ...] | None:
+            return None if v is None else (tuple(x * STIFFEN for x in v) if isinstance(v, tuple) else v * STIFFEN)
+
+        return _with_support(stage, dataclasses.replace(cs, support_stiffness_N_per_mm=scale(cs.support_stiffness_N_per_mm),
+                                                        carrier_stiffness_N_per_mm=scale(cs.carrier_stiffness_N_per_mm)))
 
 
-STAGE_PARTS: tuple[StagePart, ...] = (
-    StagePart("pin–flank contact", "the pins (Hertz contact at the gaps of the modified profile)", "one_disc",
-              _stiff_pins),
-    StagePart("disc body", "both discs", "one_disc", _stiff_disc, body=True),
-    StagePart("crank-bearing rollers", "the crank-bearing rollers with their clearance", "one_disc", _stiff_rollers),
-    StagePart("crankshaft bending/shear", "the crankshafts as beams", "crankshafts", _stiff_crankshaft, crank=True),
-    StagePart("support bearings", "their support bearings", "crankshafts", _stiff_support, crank=True),
+BUILTIN_COMPONENTS: tuple[StageComponent, ...] = (
+    PinFlankContact(),
+    DiscBody(),
+    CrankBearingRollers(),
+    Crankshafts(),
+    SupportBearings(),
 )
-"""The series compliances of the stage, in the order of the load path from the pins to the carrier."""
+"""The stage's built-in components, in the order of the load path from the pins to the carrier: the
+one place they are listed."""
 
-COMPONENTS = tuple(p.name for p in STAGE_PARTS)
-"""The parts' names, in the order of the load path (:data:`STAGE_PARTS`)."""
+_REGISTERED: dict[str, StageComponent] = {}
+"""The components registered since (:func:`register_stage_component`), in the order registered."""
 
 
-def stage_part(name: str) -> StagePart:
-    """The part of :data:`STAGE_PARTS` called ``name``; ValueError naming the known ones otherwise."""
-    for p in STAGE_PARTS:
-        if p.name == name:
-            return p
-    raise ValueError(f"unknown component {name!r}; known: {', '.join(COMPONENTS)}")
+NOT_MODELLED: tuple[tuple[str, str], ...] = (
+    ("main bearings", "the main (output) bearings"),
+    ("carrier end plates", "the carrier's end plates and pins (the carrier is rigid)"),
+    ("pin housing", "the pin housing (the pins' seats are rigid)"),
+    ("input spur stage", "the input spur stage (with the input locked the crankshafts do not turn relative to "
+                         "the carrier)"),
+    ("pin rotation", "the rotation of the pins in their grooves"),
+)
+"""The parts of the reducer the built-in stage model leaves out, as (short name, words); a component
+that brings one in names its short name in ``models``."""
+
+
+def register_stage_component(component: StageComponent) -> StageComponent:
+    """Add ``component`` to the stage's components, after the built-in ones (and its table, if it
+    brings one, to the case format: :func:`rvfem.case.definition.register_component_table`).
+    Returns it.
+
+    Raises
+    ------
+    ValueError
+        Its name is another component's, or its table cannot be registered.
+    TypeError
+        It is not a :class:`StageComponent`.
+    """
+    if not isinstance(component, StageComponent):
+        raise TypeError(f"a stage component must be a StageComponent, got {component!r}")
+    name = getattr(component, "name", None)
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"a stage component needs a name, got {name!r}")
+    if name in {c.name for c in BUILTIN_COMPONENTS} or (name in _REGISTERED and _REGISTERED[name] is not component):
+        raise ValueError(f"a stage component called {name!r} is registered already")
+    unknown = set(component.models) - {key for key, _ in NOT_MODELLED}
+    if unknown:
+        raise ValueError(f"the component {name!r} brings in {', '.join(sorted(unknown))}, which are not among the "
+                         f"parts left out ({', '.join(key for key, _ in NOT_MODELLED)})")
+    table = component.table
+    if table is not None and table not in {f.name for f in dataclasses.fields(Case)}:
+        if component.schema is None:
+            raise ValueError(f"the component {name!r} owns the table {table!r} but declares no schema for it")
+        register_component_table(table, component.schema, by_default=component.table_by_default, owner=name)
+    _REGISTERED[name] = component
+    return component
+
+
+def unregister_stage_component(name: str) -> None:
+    """Remove the registered component ``name`` (and its table); a built-in component cannot be
+    removed, an unknown name is ignored."""
+    if name in {c.name for c in BUILTIN_COMPONENTS}:
+        raise ValueError(f"the built-in stage component {name!r} cannot be unregistered")
+    component = _REGISTERED.pop(name, None)
+    if component is not None and component.table is not None:
+        unregister_component_table(component.table)
+
+
+def stage_components() -> tuple[StageComponent, ...]:
+    """The stage's components: the built-in ones (:data:`BUILTIN_COMPONENTS`), then those registered
+    since, in the order registered."""
+    return BUILTIN_COMPONENTS + tuple(_REGISTERED.values())
+
+
+def component_names() -> tuple[str, ...]:
+    """The components' names, in the order of :func:`stage_components`."""
+    return tuple(c.name for c in stage_components())
+
+
+def stage_component(name: str) -> StageComponent:
+    """The component called ``name``; ValueError naming the known ones otherwise."""
+    for c in stage_components():
+        if c.name == name:
+            return c
+    raise ValueError(f"unknown component {name!r}; known: {', '.join(component_names())}")
 
 
 def stiffened_stage(stage: ReducerStage, component: str) -> ReducerStage:
-    """The stage with one component (:data:`COMPONENTS`) :data:`STIFFEN` times stiffer.
+    """The stage with one component (:func:`component_names`) :data:`STIFFEN` times stiffer
+    (:meth:`StageComponent.stiffen`).
 
     Pins: linear springs of STIFFEN × the secant stiffness of the Hertz contact at the mean pin load
     (the gaps of the profile kept); disc: E × STIFFEN (a new factorisation); rollers: linear
     springs of STIFFEN × the secant of their law at the mean roller load (clearance kept);
     crankshaft: E × STIFFEN of the beam (bending and shear); support bearings (and carrier):
-    stiffness × STIFFEN. The stage shares the disc's factorisation and compliance except for the
-    disc body; every other field of the stage is carried through unchanged.
+    stiffness × STIFFEN; a registered component as it says. The stage shares the disc's
+    factorisation and compliance except for the disc body; every other field of the stage is
+    carried through unchanged.
     """
-    return stage_part(component).stiffen(stage)
+    return stage_component(component).stiffen(stage)
+
+
+def build_components(stage: ReducerStage, steps: tuple[str, ...] | None = None) -> ReducerStage:
+    """``stage`` with the part of every component its case has (:meth:`StageComponent.present`)
+    built in, in the order of :func:`stage_components`; only the components first modelled at one
+    of ``steps`` (attribution step keys) if given — those without a step are then left out."""
+    case = stage.first.case
+    for c in stage_components():
+        if c.present(case) and (steps is None or c.step in steps):
+            stage = c.build(stage)
+    return stage
+
+
+def case_stage(system: DiscSystem, second: DiscSystem | None = None, second_disc: str = "same_as_first") -> ReducerStage:
+    """The reducer stage the case asks for: both discs on one carrier for ``loads.discs = 2`` or,
+    with ``loads.torque_split = "equal"`` or one disc, one disc carrying T_out/discs, with the part
+    of every component the case has built in (:func:`build_components`): the crankshafts of
+    ``[crank_support]`` (rigid eccentrics without it, and for the equal split, rvfem 0.1's and the
+    handbook's model) and whatever the registered components add. ``second``, ``second_disc`` as
+    in :func:`rvfem.solve.cycle_stage.build_stage`."""
+    case = system.case
+    equal_split = case.loads.discs > 1 and case.loads.torque_split == "equal"
+    discs = 1 if equal_split or case.loads.discs == 1 else 2
+    stage = build_stage(system, discs=discs, influence=None, second=second, second_disc=second_disc)
+    return build_components(stage)
 
 
 def held_in_words() -> str:
     """What the stage model holds, in words: the bodies first, then the parts that connect them along
     the load path (``"both discs, the pins (…), … and their support bearings"``)."""
-    phrases = [p.held for p in STAGE_PARTS if p.body] + [p.held for p in STAGE_PARTS if not p.body]
+    components = stage_components()
+    phrases = [c.held for c in components if c.body] + [c.held for c in components if not c.body]
     return ", ".join(phrases[:-1]) + " and " + phrases[-1]
+
+
+def not_modelled() -> tuple[tuple[str, str], ...]:
+    """The parts of :data:`NOT_MODELLED` that no component brings in, as (short name, words)."""
+    brought = {key for c in stage_components() for key in c.models}
+    return tuple((key, words) for key, words in NOT_MODELLED if key not in brought)
 
 
 def _secant_stiffness(system: DiscSystem, which: str, stage: ReducerStage) -> float:

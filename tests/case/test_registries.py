@@ -74,6 +74,90 @@ def test_a_model_of_the_package_with_an_undeclared_name_is_refused_when_register
     assert registry.model_requires("pin", "outside") == ("radius",)
 
 
+def test_the_front_door_alone_accepts_every_model_name_rvfem_run_accepts():
+    """``import rvfem; rvfem.load_case(...)`` in a fresh interpreter (nothing imported but the
+    front door's case reader) against the names the command line has once it is loaded: the
+    solver's classes and the case reader's choices of ``rvfem run``'s own interpreter."""
+    code = """
+import json
+import rvfem.app.cli                      # what `rvfem run` loads before it reads a case
+from rvfem.case import registry
+from rvfem.case.schema import file_fields
+from rvfem.case.tables import CrankBearing, Pins
+choices = {kind: sorted(spec.param.allowed()) for kind, cls in (("bearing", CrankBearing), ("pin", Pins))
+           for spec in file_fields(cls) if spec.name == "model"}
+classes = {kind: sorted(registry.registered_models(kind)) for kind in ("bearing", "pin")}
+requires = {kind: {n: list(registry.model_requires(kind, n)) for n in classes[kind]} for kind in classes}
+print(json.dumps({"choices": choices, "classes": classes, "requires": requires}))
+"""
+    run = json.loads(_fresh(code))
+    assert run["choices"] == run["classes"]                 # rvfem run accepts exactly the names it can solve
+    overrides = [[f"{table}.model={name}"] + [f"{table}.{key}=1e5" for key in run["requires"][kind][name]]
+                 for kind, table in (("bearing", "crank_bearing"), ("pin", "pins")) for name in run["classes"][kind]]
+    code = f"""
+import json, sys
+import rvfem
+read = [[c.crank_bearing.model, c.pins.model] for c in
+        (rvfem.load_case({str(CASES_DIR / 'rv40e.toml')!r}, given) for given in {overrides!r})]
+print(json.dumps({{"read": read, "solver imported": any(m.startswith("rvfem.solve") for m in sys.modules)}}))
+"""
+    out = json.loads(_fresh(code))
+    assert not out["solver imported"]
+    names = run["classes"]["bearing"] + run["classes"]["pin"]
+    assert [b if i < len(run["classes"]["bearing"]) else p for i, (b, p) in enumerate(out["read"])] == names
+
+
+# Tables of stage components
+
+
+def test_a_component_table_is_refused_where_it_would_clash_or_cannot_be_read(registries):
+    from dataclasses import dataclass
+
+    from rvfem.case.definition import Pins, component_tables, register_component_table
+    from rvfem.case.schema import param
+
+    @dataclass(frozen=True)
+    class Spring:
+        stiffness: float = param(unit="N·mm/rad", low=0.0, low_open=True, doc="stiffness")
+
+    @dataclass(frozen=True)
+    class Undeclared:
+        stiffness: float = 1.0
+
+    with pytest.raises(ValueError, match="'pins' is a table of the case format already"):
+        register_component_table("pins", Spring, owner="x")
+    with pytest.raises(ValueError, match="'fan_holes' is a table of the case format already"):
+        register_component_table("fan_holes", Spring, owner="x")
+    with pytest.raises(TypeError, match="is not declared with rvfem.case.schema.param"):
+        register_component_table("spring", Undeclared, owner="x")
+    with pytest.raises(ValueError, match="every key needs a default; stiffness has none"):
+        register_component_table("spring", Spring, by_default=True, owner="x")
+    register_component_table("spring", Spring, owner="x")
+    with pytest.raises(ValueError, match="registered by the component 'x' already"):
+        register_component_table("spring", Pins, owner="y")
+    assert [t.name for t in component_tables()] == ["spring"]
+
+
+def test_a_component_table_there_by_default_is_read_with_its_defaults(registries, tmp_path):
+    from dataclasses import dataclass
+
+    from rvfem.case.definition import case_to_dict, register_component_table
+    from rvfem.case.schema import param
+
+    @dataclass(frozen=True)
+    class Seats:
+        groove_radius: float = param(6.0, unit="mm", low=0.0, low_open=True, doc="groove radius")
+
+    register_component_table("seats", Seats, by_default=True, owner="pin seats")
+    case = load_case(CASES_DIR / "rv40e.toml")
+    assert case.component_table("seats") == Seats()
+    assert case_to_dict(case)["seats"] == {"groove_radius": 6.0}
+    assert load_case(CASES_DIR / "rv40e.toml", ["seats.groove_radius=7.5"]).component_table("seats") == Seats(7.5)
+    from rvfem.errors import CaseError
+    with pytest.raises(CaseError, match="'seats.groove' is not a known key"):
+        load_case(CASES_DIR / "rv40e.toml", ["seats.groove=7.5"])
+
+
 def test_a_declared_required_key_missing_is_named():
     from rvfem.errors import CaseError
     with pytest.raises(CaseError, match=r"'pins.linear_stiffness_N_per_mm' is missing \(required when pins.model = 'linear'\)"):

@@ -127,6 +127,7 @@ def test_attribution_step_that_does_not_solve_is_left_out_with_a_warning(monkeyp
 
     monkeypatch.setattr(attribution_module, "build_stage",
                         lambda system, discs, influence: "one_disc" if discs == 1 else "two_discs")
+    monkeypatch.setattr(attribution_module, "build_components", lambda stage, steps: stage)
     monkeypatch.setattr(attribution_module, "load_cycle", load_cycle)
     result = attribution_module.attribution(types.SimpleNamespace(case=case), thetas, cycles={final: own})
     assert [s.key for s in result.steps] == ["handbook", "two_discs", "crankshafts"]

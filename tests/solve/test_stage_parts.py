@@ -1,6 +1,7 @@
-"""The stage's parts listed once (:mod:`rvfem.solve.stage_parts`): a stiffened stage carries every
-other field of the stage through, and each part's compliance share is the one an independently
-built stiffer model gives (the case's own tables or model options changed, a new model built)."""
+"""The stage's components listed once (:mod:`rvfem.solve.stage_parts`): the stage they build is the
+one the case's tables describe, a stiffened stage carries every other field of the stage through,
+and each part's compliance share is the one an independently built stiffer model gives (the case's
+own tables or model options changed, a new model built)."""
 
 from __future__ import annotations
 
@@ -10,12 +11,20 @@ import numpy as np
 import pytest
 from conftest import coarse_case
 
-from rvfem.app.hysteresis import LEFT_OUT
-from rvfem.evaluate.attribution import STEP_LABELS
+from rvfem.app.hysteresis import left_out
+from rvfem.evaluate.attribution import STEP_LABELS, chain
+from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.mesh import mesh_case
 from rvfem.solve import cycle
-from rvfem.solve.accuracy import COMPONENTS, compliance_shares, loop_at_torques
-from rvfem.solve.stage_parts import STAGE_PARTS, STIFFEN, stiffened_stage
+from rvfem.solve.accuracy import compliance_shares, loop_at_torques
+from rvfem.solve.stage_parts import (
+    BUILTIN_COMPONENTS,
+    STIFFEN,
+    StageComponent,
+    component_names,
+    register_stage_component,
+    stiffened_stage,
+)
 
 T_R = 412.0
 LINEAR = dict(pins={"model": "linear", "linear_stiffness_N_per_mm": 2e5},
@@ -40,14 +49,26 @@ def _changed(before, after) -> set[str]:
     return {f.name for f in dataclasses.fields(before) if getattr(before, f.name) is not getattr(after, f.name)}
 
 
-@pytest.mark.parametrize("part", STAGE_PARTS, ids=lambda p: p.name)
+def test_the_components_build_the_stage_the_cases_tables_describe(linear_stage):
+    """Both discs on one carrier (disc B as disc A) on the crankshaft influence of [crank_support],
+    with no series output compliance: the stage built directly from the case's keys."""
+    system = linear_stage.first
+    direct = cycle.build_stage(system, discs=2, influence=crankshaft_influence(system.case))
+    assert linear_stage.second is linear_stage.first is direct.first
+    np.testing.assert_array_equal(linear_stage.influence, direct.influence)
+    assert (linear_stage.second_phase, linear_stage.output_compliances) == (direct.second_phase, ()) == (0.0, ())
+    assert linear_stage.describe() == direct.describe()
+
+
+@pytest.mark.parametrize("part", BUILTIN_COMPONENTS, ids=lambda p: p.name)
 def test_stiffening_a_part_carries_every_other_field_of_the_stage_through(linear_stage, part):
     stage = TaggedStage(**{f.name: getattr(linear_stage, f.name) for f in dataclasses.fields(linear_stage)},
-                        tag="carrier spring")
+                        tag="carrier spring").with_output_compliance("a spring", 1e-9)
     stiff = stiffened_stage(stage, part.name)
     assert type(stiff) is TaggedStage and stiff.tag == "carrier spring"
+    assert stiff.output_compliances == (("a spring", 1e-9),)
     # a disc's part changes the disc model (disc B is disc A), a crankshaft part the influence matrix
-    assert _changed(stage, stiff) == ({"influence"} if part.crank else {"first", "second"})
+    assert _changed(stage, stiff) == ({"influence"} if part.step == "crankshafts" else {"first", "second"})
     assert stiff.second is stiff.first
 
 
@@ -62,7 +83,7 @@ def test_compliance_shares_equal_those_of_independently_built_stiffer_models(lin
     (the secant of a linear spring without a gap is its stiffness), the support bearings' and the
     carrier's stiffness × STIFFEN in ``[crank_support]``."""
     shares = compliance_shares(linear_stage, 0.0, T_R)
-    assert tuple(shares.shares) == COMPONENTS == tuple(p.name for p in STAGE_PARTS)
+    assert tuple(shares.shares) == component_names() == tuple(p.name for p in BUILTIN_COMPONENTS)
     a = _rotation_arcmin(linear_stage)
     assert shares.rotation_arcmin == pytest.approx(a, rel=1e-12)
     case, mesh = linear_stage.first.case, linear_stage.first.mesh
@@ -87,9 +108,32 @@ def test_compliance_shares_equal_those_of_independently_built_stiffer_models(lin
 
 
 def test_the_parts_are_what_the_left_out_note_and_the_attribution_name():
-    assert LEFT_OUT.startswith("The stage model holds both discs, the pins (Hertz contact at the gaps of the "
-                               "modified profile), the crank-bearing rollers with their clearance, the "
-                               "crankshafts as beams and their support bearings. It leaves out")
-    assert {p.step for p in STAGE_PARTS} <= set(STEP_LABELS)
+    assert left_out().startswith("The stage model holds both discs, the pins (Hertz contact at the gaps of the "
+                                 "modified profile), the crank-bearing rollers with their clearance, the "
+                                 "crankshafts as beams and their support bearings. It leaves out the main (output) "
+                                 "bearings, the carrier's end plates")
+    assert {p.step for p in BUILTIN_COMPONENTS} <= set(STEP_LABELS)
     with pytest.raises(ValueError, match="unknown component 'carrier'; known: pin–flank contact"):
         stiffened_stage(None, "carrier")
+
+
+class _Housing(StageComponent):
+    """A component that brings in a part left out and an attribution step of its own (no table)."""
+
+    name = "pin housing"
+    held = "the pin housing"
+    step = "housing"
+    step_label = "with the pin housing"
+    models = ("pin housing",)
+
+
+def test_a_registered_component_reaches_the_words_and_the_attribution_chain(registries, linear_stage):
+    register_stage_component(_Housing())
+    words = left_out()
+    assert "their support bearings and the pin housing. It leaves out the main (output) bearings, the " \
+           "carrier's end plates and pins (the carrier is rigid), the input spur stage" in words
+    assert chain(linear_stage.first.case) == ["one_disc", "two_discs", "crankshafts", "housing"]
+    with pytest.raises(ValueError, match="'pin housing' is registered already"):
+        register_stage_component(type("Other", (_Housing,), {})())
+    with pytest.raises(ValueError, match="brings in carrier, which are not among the parts left out"):
+        register_stage_component(type("Carrier", (StageComponent,), {"name": "c", "held": "c", "models": ("carrier",)})())
