@@ -264,7 +264,7 @@ def _section_peak(xc, w, q, b):
 def test_round_cornered_roller_against_an_independent_strip_solve(load):
     # the shipped straight roller (corner radius 0.2 mm) at the default 30 slices, strips of the
     # nominal Hertz width (no local-width iteration, the same physics in both): the peak and the
-    # mid-length pressure against a reference of some 600 strips, 1 µm at the ends
+    # mid-length pressure against a reference of 392 strips, 1 µm at the ends
     corner = 0.2
     prof = RollerProfile(corner_radius=corner)
     b0 = hertz_line_contact(load, LENGTH, 2.5, 13.0, concave=False).half_width_mm
