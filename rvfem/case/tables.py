@@ -231,6 +231,19 @@ class RollerProfile:
     * ``"combined"``: straight centre, then a circular segment of length a =
       ``modification_length`` dropping by b = ``modification_drop`` at the end of L_we (their
       eq. 10, R = (a² + b²)/(2b)).
+
+    Every kind ends in rounded corners beyond L_we: a circular arc of radius r =
+    ``corner_radius`` tangent to the generatrix at ±L_we/2, over an axial length c =
+    ``chamfer_length`` (default r: a quarter circle down to the end face; a maker's chamfer
+    dimension where it is shorter). Zhang et al. describe the RV crank-bearing roller as a
+    "straight generatrix and round corners" (their eq. 8 and Fig. 5) without giving r; ISO 12297
+    (cylindrical rollers; its national twin GOST 22696-2013) counts the corner outside the
+    effective length, L_we = L_w − 2r with r the roller's chamfer dimension, as the case does.
+    The default r = 0.2 mm is a chamfer of that standard's order for a roller of a few mm
+    diameter, not a value read from its table for D_w = 5 mm: give the maker's value where it is
+    known (the edge pressure grows as r shrinks; r = 0 is the sharp end, whose edge pressure is a
+    singularity that grows with the number of slices). The corner is what bounds the straight
+    roller's edge pressure (docs/theory.md § 12).
     """
 
     kind: str = param("straight", choices=tuple(ROLLER_PROFILE_KINDS),
@@ -246,6 +259,13 @@ class RollerProfile:
     misalignment_mrad: float = param(0.0, unit="mrad", low=-10.0, high=10.0,
                                      doc="extra tilt of the eccentric against the bore (mounting, machining), "
                                          "added to the crankshaft's slope")
+    corner_radius: float = param(0.2, unit="mm", low=0.0, high=20.0,
+                                 doc="radius r of the rounded corners beyond the effective length, every kind "
+                                     "(0: a sharp end)")
+    chamfer_length: float | None = param(None, unit="mm", low=0.0, low_open=True, high=20.0,
+                                         default_doc="`corner_radius` (a quarter circle)",
+                                         doc="axial length c of each corner (the maker's chamfer dimension), "
+                                             "at most `corner_radius`")
     slices: int = param(30, low=8, high=400, doc="slices along the roller of the slice model")
 
 

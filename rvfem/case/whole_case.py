@@ -726,7 +726,8 @@ def _positive_definite(matrix: tuple[tuple[float, ...], ...]) -> bool:
 
 def _check_roller_profile(case: Case) -> None:
     """A crowned roller's drop has to fit its length: the combined profile's modified segment within
-    half the roller, the arc's radius beyond it (docs/theory.md § 12)."""
+    half the roller, the arc's radius beyond it; the corner's axial length at most its radius and
+    shorter than half the roller (docs/theory.md § 12)."""
     b, key = case.crank_bearing, "crank_bearing.profile."
     half = 0.5 * b.roller_length
     if b.profile.kind == "combined" and b.profile.modification_length >= half:
@@ -735,6 +736,16 @@ def _check_roller_profile(case: Case) -> None:
     if b.profile.kind == "arc" and b.profile.crown_radius <= half:
         raise _error(case, key + "crown_radius", f"({b.profile.crown_radius:g} mm) must exceed half the roller "
                      f"length ({half:g} mm)")
+    prof = b.profile
+    if prof.chamfer_length is not None and prof.chamfer_length > prof.corner_radius:
+        raise _error(case, key + "chamfer_length", f"({prof.chamfer_length:g} mm) must not exceed "
+                     f"{key}corner_radius ({prof.corner_radius:g} mm): the corner's arc of radius r reaches the end "
+                     "face within r; give a larger corner_radius or a shorter chamfer_length")
+    corner = prof.corner_radius if prof.chamfer_length is None else prof.chamfer_length
+    if prof.corner_radius > 0.0 and corner >= half:
+        name = "corner_radius" if prof.chamfer_length is None else "chamfer_length"
+        raise _error(case, key + name, f"({corner:g} mm) must be shorter than half the roller length ({half:g} mm): "
+                     "the corner is the short rounded end beyond the effective length")
     defaults = {f.name: f.default for f in dataclasses.fields(RollerProfile)}
     for name, kind in _PROFILE_KEY_KIND.items():
         value = getattr(b.profile, name)

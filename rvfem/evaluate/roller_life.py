@@ -163,7 +163,7 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
     shape = q.shape
     flat_q = q.reshape(-1)
     flat_t = np.broadcast_to(tilts, shape).reshape(-1)
-    x, dx = roller_slices.slice_centres(length_mm, profile.slices)
+    x, dx = roller_slices.slice_layout(profile, length_mm)
     r_red, e_star = raceway.reduced_radius_mm, raceway.composite_modulus_MPa
     drop = roller_slices.profile_drop(profile, length_mm, x, composite_modulus_MPa=e_star, reduced_radius_mm=r_red)
     out = np.zeros((flat_q.size, x.size))
@@ -186,19 +186,27 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
         p, _ = roller_slices.solve_slices(influence, 2.0 * b_g * dx,
                                           flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx],
                                           inverse=inverse)
-        out[idx] = p * 2.0 * b_g
+        out[idx] = (p * 2.0 * b_g) @ roller_slices.section_window(x, dx, b_g).T
     return out.reshape(shape + (x.size,))
 
 
-def lamina_ratings(case, slices: int) -> tuple[float, float]:
-    """Basic dynamic load ratings of one lamina on the inner and outer raceway, N (ISO/TS 16281,
+def lamina_ratings(case, slices):
+    """Basic dynamic load ratings of the laminae on the inner and outer raceway, N (ISO/TS 16281,
     line contact): q_c = 552·b_m·λν·γ^(2/9)·(1 ∓ γ)^(29/27)/(1 ± γ)^(1/4)·D_we^(29/27)·
-    (L_we/n_s)^(7/9)·Z^(−1/4), upper signs for the inner raceway. b_m and λν as in the case's basic
-    rating C (ISO 281), so that the two lives rest on the same material and edge factors."""
+    w^(7/9)·Z^(−1/4), upper signs for the inner raceway, w the lamina width (L_we/n_s for n_s
+    equal laminae). b_m and λν as in the case's basic rating C (ISO 281), so that the two lives
+    rest on the same material and edge factors.
+
+    ``slices`` is the number n_s of equal laminae over L_we (two floats returned), or the widths of
+    unequal laminae in mm (two arrays): the rating of a lamina scales with its width^(7/9), so
+    that Σ_k (q_k/q_c,k)^(9/2) over laminae of a uniform load per length is the same however the
+    length is cut (the slice model's laminae are refined at the roller ends,
+    :func:`rvfem.evaluate.roller_slices.slice_layout`)."""
     b = case.crank_bearing
     g = b.roller_diameter / b.pitch_diameter
+    width = b.roller_length / slices if np.isscalar(slices) else np.asarray(slices, dtype=float)
     common = (552.0 * b.b_m * b.lambda_nu * g ** (2.0 / 9.0) * b.roller_diameter ** (29.0 / 27.0)
-              * (b.roller_length / slices) ** (7.0 / 9.0) * b.rollers ** -0.25)
+              * width ** (7.0 / 9.0) * b.rollers ** -0.25)
     inner = common * (1.0 - g) ** (29.0 / 27.0) / (1.0 + g) ** 0.25
     outer = common * (1.0 + g) ** (29.0 / 27.0) / (1.0 - g) ** 0.25
     return inner, outer
@@ -216,7 +224,7 @@ def lamina_life_mrev(lamina_loads_inner: np.ndarray, lamina_loads_outer: np.ndar
     ----------
     lamina_loads_inner, lamina_loads_outer : ndarray (..., Z, n_s)
         Load of every lamina (slice) of every roller, N.
-    q_ci, q_ce : float
+    q_ci, q_ce : float or ndarray (n_s,)
         Lamina ratings (:func:`lamina_ratings`), N.
     inner_rotates : bool
         True if the inner raceway turns relative to the load direction.
@@ -353,7 +361,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     prof = b.profile
     geoms = raceways(case)
     slice_loads = [cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache) for g in geoms]
-    x, dx = roller_slices.slice_centres(b.roller_length, prof.slices)
+    x, dx = roller_slices.slice_layout(prof, b.roller_length)
     _, r, k, j, _ = _peak(case, theta, roller_loads, tilts, slice_loads, geoms)
     g = geoms[r]
     q_roller = float(roller_loads[k, j])
@@ -375,7 +383,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     a_iso = lubrication.a_iso_roller(kappa, lubrication.contamination_factor(lub) * cu / equivalent_load_N)
     to_hours = 1.0e6 / (60.0 * bearing_speed_rpm)
     l10h = to_hours * (rating_N / equivalent_load_N) ** ROLLER_LIFE_EXPONENT
-    q_ci, q_ce = lamina_ratings(case, prof.slices)
+    q_ci, q_ce = lamina_ratings(case, dx)
     # the eccentric turns relative to the load (whose direction swings by about 100° in the disc
     # frame but does not follow the crank); the bore stands relative to it
     per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)

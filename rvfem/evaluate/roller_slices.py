@@ -58,8 +58,12 @@ __all__ = [
     "SHEAR_DEPTH_FACTOR",
     "SliceContact",
     "profile_drop",
+    "corner_extent",
     "slice_centres",
+    "slice_layout",
     "rectangle_influence",
+    "section_window",
+    "windowed_peak",
     "solve_slices",
     "hertz_peak_from_line_load",
     "roller_contact",
@@ -110,6 +114,19 @@ class SliceContact:
     edge_factor: float
     max_shear_MPa: float
     max_shear_depth_mm: float
+    peak_x_mm: float = math.nan
+    widths_mm: np.ndarray | None = None
+
+
+def corner_extent(profile) -> float:
+    """Axial length c of each rounded corner beyond the effective length, mm: ``chamfer_length``
+    where given, else ``corner_radius`` (a quarter circle reaching the end face); 0 for a sharp
+    corner."""
+    r = float(getattr(profile, "corner_radius", 0.0) or 0.0)
+    if r <= 0.0:
+        return 0.0
+    c = getattr(profile, "chamfer_length", None)
+    return r if c is None else min(float(c), r)
 
 
 def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: float,
@@ -120,11 +137,12 @@ def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: floa
     ----------
     profile : rvfem.case.definition.RollerProfile
         ``kind`` and its parameters (crown radius R, design load Q_d, modification length a and
-        drop b).
+        drop b), and the corner: radius r (``corner_radius``) and axial length c
+        (``chamfer_length``, default r).
     length_mm : float
-        Effective roller length L, mm.
+        Effective roller length L, mm (the corners lie beyond it).
     x_mm : array_like
-        Positions from the roller centre, |x| ≤ L/2, mm.
+        Positions from the roller centre, |x| ≤ L/2 + c, mm.
     composite_modulus_MPa, reduced_radius_mm : float
         E* and R' of the contact (the logarithmic profile's design load sets its drop through them).
 
@@ -135,22 +153,41 @@ def profile_drop(profile, length_mm: float, x_mm, *, composite_modulus_MPa: floa
 
     Notes
     -----
+    Over the effective length, |x| ≤ l = L/2:
+
     * straight: z = 0 (Zhang et al., eq. 8);
     * arc: z = R − √(R² − x²) (eq. 9);
-    * combined: z = 0 for |x| ≤ l − a, else R − √(R² − (|x| − l + a)²) with l = L/2 and
+    * combined: z = 0 for |x| ≤ l − a, else R − √(R² − (|x| − l + a)²) with
       R = (a² + b²)/(2b), so that z(l) = b (eq. 10, its b = R − √(R² − a²));
     * logarithmic (Johns–Gohar): z = 2Q_d/(π·L·E′)·ln[1/(1 − (1 − b_d²/l²)·(x/l)²)] with
       E′ = 2E* (the plane-strain modulus E/(1 − ν²) of two equal steels), i.e.
       Q_d/(π·L·E*)·ln[…]; b_d the Hertz half-width at Q_d; Lundberg's profile (b_d → 0) with a
       finite drop at the ends. It is the sag of a uniformly loaded strip on the half-space, so
       the pressure is uniform along the roller at Q_d.
+
+    Beyond it, on the rounded corner (Zhang et al.'s "round corners", their Fig. 5), u = |x| − l
+    with 0 < u ≤ c: z = z(l) + z′(l)·u + r − √(r² − u²), the generatrix continued along its end
+    tangent plus a circular arc of radius r tangent to it (exact for the straight roller, to
+    first order in the end slope z′(l) for the crowned ones; z′(l) by a one-sided difference).
+    The surface stays smooth (no kink) where the corner begins, so the edge pressure is finite.
     """
     try:
         drop = PROFILE_DROPS[profile.kind]
     except KeyError:
         raise ValueError(f"unknown roller profile kind {profile.kind!r}; expected one of {tuple(PROFILE_DROPS)}") from None
-    return drop(profile, length_mm, np.abs(np.asarray(x_mm, dtype=float)),
-                composite_modulus_MPa=composite_modulus_MPa, reduced_radius_mm=reduced_radius_mm)
+    x = np.abs(np.asarray(x_mm, dtype=float))
+    half = 0.5 * length_mm
+    contact = dict(composite_modulus_MPa=composite_modulus_MPa, reduced_radius_mm=reduced_radius_mm)
+    z = drop(profile, length_mm, np.minimum(x, half), **contact)
+    c = corner_extent(profile)
+    u = np.clip(x - half, 0.0, c)
+    if c > 0.0 and np.any(u > 0.0):
+        h = 1e-7 * length_mm
+        ends = drop(profile, length_mm, np.array([half - h, half]), **contact)
+        slope = float(ends[1] - ends[0]) / h
+        r = float(profile.corner_radius)
+        z = z + slope * u + (r - np.sqrt(r * r - u * u))
+    return z
 
 
 def _straight_drop(profile, length_mm, x, **contact):
@@ -205,6 +242,92 @@ def slice_centres(length_mm: float, slices: int) -> tuple[np.ndarray, np.ndarray
     if slices < 1 or length_mm <= 0:
         raise ValueError("slice_centres needs a positive length and at least one slice")
     edges = np.linspace(-0.5 * length_mm, 0.5 * length_mm, slices + 1)
+    return 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
+
+
+END_CLUSTER_FRACTION = 0.5
+"""Share of the slices that :func:`slice_layout` gathers at the ends of the effective length (where a
+rounded corner begins, or a sharp roller ends) and at the profile's junctions; the rest are spread
+evenly."""
+
+END_CLUSTER_LENGTH_MM = 0.002
+"""λ of :func:`slice_layout`, mm: the slices are finest within about λ of an end or junction and
+widen in proportion to the distance beyond it (a geometric grading)."""
+
+JUNCTION_WEIGHT = 0.25
+"""Weight of a junction inside the effective length (the combined profile's start of the modified
+segment, a curvature jump of a smooth surface) against an end (1) in :func:`slice_layout`."""
+
+
+def profile_junctions(profile, length_mm: float) -> tuple[tuple[float, float], ...]:
+    """(position from the centre in mm, weight) of every place along the roller where the slices
+    are refined: both ends of the effective length (weight 1) and the junctions of the profile's
+    pieces inside it (the combined profile's ±(L/2 − a), weight :data:`JUNCTION_WEIGHT`)."""
+    half = 0.5 * length_mm
+    out = [(-half, 1.0), (half, 1.0)]
+    if profile.kind == "combined" and profile.modification_drop > 0.0:
+        a = profile.modification_length
+        out += [(-(half - a), JUNCTION_WEIGHT), (half - a, JUNCTION_WEIGHT)]
+    return tuple(out)
+
+
+def slice_layout(profile, length_mm: float, slices: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Slice centres x_j (mm, from the roller centre) and widths Δx_j (mm) of a roller's slice model:
+    the effective length and both rounded corners beyond it, slices refined at the ends and at the
+    profile's junctions.
+
+    The edges are equally spaced in the stretched coordinate s(x) = ∫ρ, with the slice density
+    ρ(x) = 1 + A·Σ_k w_k/(1 + |x − x_k|/λ) (x_k, w_k: :func:`profile_junctions`; λ =
+    :data:`END_CLUSTER_LENGTH_MM`); A puts :data:`END_CLUSTER_FRACTION` of the slices into the
+    clusters. Near x_k the widths are about (s_tot/n)/(1 + A·w_k) and grow in proportion to the
+    distance (a geometric grading); far from them they are s_tot/n. Doubling n halves every width.
+
+    Parameters
+    ----------
+    profile : rvfem.case.definition.RollerProfile
+        Its kind, corner (:func:`corner_extent`) and ``slices``.
+    length_mm : float
+        Effective roller length L, mm.
+    slices : int, optional
+        Number of slices n (default: ``profile.slices``).
+
+    Returns
+    -------
+    x, dx : ndarray (n,)
+        Centres and widths, mm; Σ Δx = L + 2c.
+    """
+    n = profile.slices if slices is None else int(slices)
+    if n < 1 or length_mm <= 0:
+        raise ValueError("slice_layout needs a positive length and at least one slice")
+    end = 0.5 * length_mm + corner_extent(profile)
+    lam = END_CLUSTER_LENGTH_MM
+    junctions = profile_junctions(profile, length_mm)
+    pos = np.array([j[0] for j in junctions])
+    wts = np.array([j[1] for j in junctions])
+
+    def kernel(x):                                     # Σ_k w_k·∫_{x_k}^{x} dt/(1 + |t − x_k|/λ)
+        d = np.asarray(x, dtype=float)[..., None] - pos
+        return np.sum(wts * np.sign(d) * lam * np.log1p(np.abs(d) / lam), axis=-1)
+
+    span = 2.0 * end
+    cluster = float(kernel(end) - kernel(-end))
+    frac = END_CLUSTER_FRACTION
+    amp = frac / (1.0 - frac) * span / cluster
+
+    def stretched(x):
+        return (x + end) + amp * (kernel(x) - kernel(-end))
+
+    targets = np.linspace(0.0, float(stretched(end)), n + 1)
+    lo = np.full(n + 1, -end)
+    hi = np.full(n + 1, end)
+    for _ in range(60):                                # bisection: s is increasing
+        mid = 0.5 * (lo + hi)
+        below = stretched(mid) < targets
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    edges = 0.5 * (lo + hi)
+    edges[0], edges[-1] = -end, end
+    edges = 0.5 * (edges - edges[::-1])               # exactly symmetric
     return 0.5 * (edges[1:] + edges[:-1]), np.diff(edges)
 
 
@@ -478,6 +601,48 @@ def hertz_peak_from_line_load(line_load_N_per_mm, reduced_radius_mm: float, comp
             np.sqrt(4.0 * q * reduced_radius_mm / (math.pi * composite_modulus_MPa)))
 
 
+def section_window(x_mm, widths_mm, half_width_mm: float, at_mm=None) -> np.ndarray:
+    """Averaging matrix W (m, n) of slice line loads over a section's own contact width: (W·q)_i is
+    the mean of the piecewise constant q over [a_i − b, a_i + b], zero beyond the roller's ends.
+
+    A section of a line contact is in plane strain only over lengths of about its half-width b
+    or more: the subsurface stresses under it (the principal shear at 0.786·b) and the contact
+    width are set by the load over about ±b around it. The slice model's line loads resolve much
+    shorter lengths at a roller's ends (slices of a few µm where a rounded corner begins); the
+    Hertz peaks, the contact widths and the lamina loads are taken from W·q. Where a slice is
+    wider than 2b, W·q at its centre is its own q.
+
+    Parameters
+    ----------
+    x_mm, widths_mm : array_like (n,)
+        Slice centres and widths, mm.
+    half_width_mm : float
+        b, mm.
+    at_mm : array_like (m,), optional
+        Where to evaluate (default: the slice centres).
+    """
+    x = np.asarray(x_mm, dtype=float)
+    dx = np.asarray(widths_mm, dtype=float)
+    a = x if at_mm is None else np.asarray(at_mm, dtype=float)
+    lo, hi = x - 0.5 * dx, x + 0.5 * dx
+    overlap = np.clip(np.minimum(hi[None, :], a[:, None] + half_width_mm)
+                      - np.maximum(lo[None, :], a[:, None] - half_width_mm), 0.0, None)
+    return overlap / (2.0 * half_width_mm)
+
+
+def windowed_peak(x_mm, widths_mm, line_load_N_per_mm, half_width_mm: float) -> tuple[float, float]:
+    """Largest section line load (W·q of :func:`section_window`) along the roller and where it is
+    (N/mm, mm): W·q sampled every b/8 along the whole roller, so that the maximum does not depend
+    on where the slice centres fall."""
+    x = np.asarray(x_mm, dtype=float)
+    dx = np.asarray(widths_mm, dtype=float)
+    ends = x[0] - 0.5 * dx[0], x[-1] + 0.5 * dx[-1]
+    at = np.linspace(ends[0], ends[1], int(math.ceil((ends[1] - ends[0]) / (0.125 * half_width_mm))) + 1)
+    qw = section_window(x, dx, half_width_mm, at) @ np.asarray(line_load_N_per_mm, dtype=float)
+    k = int(np.argmax(qw))
+    return float(qw[k]), float(at[k])
+
+
 def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, composite_modulus_MPa: float,
                    profile, *, tilt_rad: float = 0.0, slices: int | None = None,
                    local_width_iterations: int = 8) -> SliceContact:
@@ -510,13 +675,14 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
     -------
     SliceContact
     """
-    n = profile.slices if slices is None else slices
-    x, dx = slice_centres(length_mm, n)
+    x, dx = slice_layout(profile, length_mm, slices)
+    n = x.size
     b_nom = hertz_half_width(load_N, length_mm, reduced_radius_mm, composite_modulus_MPa)
     drop = profile_drop(profile, length_mm, x, composite_modulus_MPa=composite_modulus_MPa,
                         reduced_radius_mm=reduced_radius_mm)
     g = (tilt_rad * x - drop)[None, :]
     widths = np.full(n, b_nom)
+    window = section_window(x, dx, b_nom)
     q: np.ndarray | None = None
     for _ in range(local_width_iterations + 1):
         c = rectangle_influence(x, dx, b_nom, composite_modulus_MPa, half_heights_mm=widths)
@@ -526,16 +692,17 @@ def roller_contact(load_N: float, length_mm: float, reduced_radius_mm: float, co
         q = q_new
         if converged:
             break
-        _, b_local = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
+        _, b_local = hertz_peak_from_line_load(window @ q, reduced_radius_mm, composite_modulus_MPa)
         widths = np.maximum(b_local, 0.2 * b_nom)
     assert q is not None   # the loop runs at least once
-    ph, b = hertz_peak_from_line_load(q, reduced_radius_mm, composite_modulus_MPa)
+    ph, b = hertz_peak_from_line_load(window @ q, reduced_radius_mm, composite_modulus_MPa)
     nominal, _ = hertz_peak_from_line_load(load_N / length_mm, reduced_radius_mm, composite_modulus_MPa)
-    k = int(np.argmax(ph))
+    q_peak, x_peak = windowed_peak(x, dx, q, b_nom)
+    ph_max, b_max = (float(v) for v in hertz_peak_from_line_load(q_peak, reduced_radius_mm, composite_modulus_MPa))
     return SliceContact(x_mm=x, line_load_N_per_mm=q, pressure_MPa=ph, half_width_mm=b,
-                        approach_mm=float(delta[0]), peak_pressure_MPa=float(ph[k]),
-                        edge_factor=float(ph[k] / nominal), max_shear_MPa=SHEAR_FACTOR * float(ph[k]),
-                        max_shear_depth_mm=SHEAR_DEPTH_FACTOR * float(b[k]))
+                        approach_mm=float(delta[0]), peak_pressure_MPa=ph_max,
+                        edge_factor=ph_max / float(nominal), max_shear_MPa=SHEAR_FACTOR * ph_max,
+                        max_shear_depth_mm=SHEAR_DEPTH_FACTOR * b_max, peak_x_mm=x_peak, widths_mm=dx)
 
 
 def rigid_ring_roller_loads(bearing_forces: np.ndarray, roller_angles: np.ndarray, iterations: int = 30, *,

@@ -787,6 +787,23 @@ def test_a_profile_key_of_another_kind_is_refused(case_text, tmp_path, kind, key
                  f"kind = '{kind}' does not use it", f"set crank_bearing.profile.kind = '{uses}'")
 
 
+@pytest.mark.parametrize("kind", ["straight", "arc", "logarithmic", "combined"])
+@pytest.mark.parametrize("keys, bad, words", [
+    ({"corner_radius": "-0.1"}, "corner_radius", "must be non-negative"),
+    ({"corner_radius": "0.2", "chamfer_length": "0.3"}, "chamfer_length", "must not exceed"),
+    ({"corner_radius": "4.5"}, "corner_radius", "shorter than half the roller length (4.5 mm)"),
+    ({"corner_radius": "6.0", "chamfer_length": "5.0"}, "chamfer_length", "shorter than half the roller length"),
+    ({"chamfer_length": "0.0"}, "chamfer_length", "crank_bearing.profile.chamfer_length"),
+])
+def test_a_corner_that_does_not_fit_the_roller_is_refused(case_text, tmp_path, kind, keys, bad, words):
+    # every kind has the corner: a negative radius, a chamfer longer than the arc can reach, or a
+    # corner of half the roller (the effective length L_we = 9 mm of the RV-40E roller)
+    case_text.set("crank_bearing", "profile.kind", f'"{kind}"')
+    for key, value in keys.items():
+        case_text.set("crank_bearing", f"profile.{key}", value)
+    expect_error(tmp_path, case_text, f"crank_bearing.profile.{bad}", words)
+
+
 def test_profile_keys_at_their_defaults_are_what_a_whole_case_holds(case_text, tmp_path):
     """case.json and best.toml hold every key: the shape keys of the other kinds at their defaults
     are taken, and the case round-trips."""
