@@ -170,13 +170,20 @@ def _registry_tables() -> tuple[dict, ...]:
     """The tables a plug-in registers itself in: the crank-bearing and pin models
     (:mod:`rvfem.case.registry`), the writers of a result folder (:mod:`rvfem.outputs.registry`), the
     stage components (:mod:`rvfem.solve.stage_parts`) and their case tables
-    (:func:`rvfem.case.definition.register_component_table`)."""
+    (:func:`rvfem.case.definition.register_component_table`), the result sections
+    (:mod:`rvfem.results.registry`), the subcommands (:func:`rvfem.app.cli.register_subcommand`)
+    and the roller-profile kinds (:func:`rvfem.evaluate.roller_slices.register_profile_kind`)."""
+    from rvfem.app import cli
     from rvfem.case import registry as models
     from rvfem.case import whole_case
+    from rvfem.case.tables import ROLLER_PROFILE_KINDS
+    from rvfem.evaluate.roller_slices import PROFILE_DROPS
     from rvfem.outputs import registry as writers
+    from rvfem.results import registry as sections
     from rvfem.solve import stage_parts
 
-    return models._BEARINGS, models._PINS, writers._WRITERS, stage_parts._REGISTERED, whole_case._COMPONENT_TABLES
+    return (models._BEARINGS, models._PINS, writers._WRITERS, stage_parts._REGISTERED, whole_case._COMPONENT_TABLES,
+            sections._ADDED, cli._ADDED, ROLLER_PROFILE_KINDS, PROFILE_DROPS)
 
 
 @contextmanager

@@ -7,7 +7,8 @@ code 2. Anything else is a bug: one line on stderr asking to report it, with the
 holding the traceback (shown on stderr too with ``-vv``), and exit code 1. Ctrl-C exits with 130.
 
 Adding a subcommand: write ``_add_<name>_arguments(parser)`` and ``_run_<name>(args) -> int`` and
-append one :class:`Subcommand` to :data:`SUBCOMMANDS`.
+append one :class:`Subcommand` to :data:`SUBCOMMANDS`; from outside the package, one
+:func:`register_subcommand` line.
 """
 
 from __future__ import annotations
@@ -47,7 +48,8 @@ from rvfem.mesh import mesh_case
 from rvfem.outputs.plots import mesh_preview
 from rvfem.outputs.summary import check_output_folder, rigid_summary
 
-__all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_INTERNAL_ERROR",
+__all__ = ["main", "build_parser", "register_subcommand", "all_subcommands", "unregister_subcommand", "Subcommand",
+           "SUBCOMMANDS", "EXIT_OK", "EXIT_INTERNAL_ERROR",
            "EXIT_USER_ERROR", "EXIT_INTERRUPTED"]
 
 logger = logging.getLogger(__name__)
@@ -332,9 +334,9 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser(subcommands: tuple[Subcommand, ...] | None = None) -> argparse.ArgumentParser:
     """The argument parser with one sub-parser per entry of ``subcommands`` (default
-    :data:`SUBCOMMANDS`)."""
+    :func:`all_subcommands`: rvfem's own and those registered)."""
     if subcommands is None:
-        subcommands = SUBCOMMANDS
+        subcommands = all_subcommands()
     parser = _Parser(
         prog="rvfem",
         description="Crank-bearing loads of RV reducers with a flexible cycloid disc.",
@@ -466,8 +468,30 @@ def main(argv: list[str] | None = None) -> int:
         remove_notices()
 
 
+SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY, OPTIMISE, HYSTERESIS)
+
+_ADDED: dict[str, Subcommand] = {}
+"""Subcommands added with :func:`register_subcommand` (a test fixture saves and restores it)."""
+
+
+def register_subcommand(command: Subcommand) -> Subcommand:
+    """Add a subcommand from outside the package (after rvfem's own, in ``rvfem --help``); returns
+    it. A name taken raises ValueError."""
+    if any(s.name == command.name for s in all_subcommands()):
+        raise ValueError(f"an rvfem subcommand named {command.name!r} exists already")
+    _ADDED[command.name] = command
+    return command
+
+
+def unregister_subcommand(name: str) -> None:
+    """Remove a subcommand added with :func:`register_subcommand` (rvfem's own stay)."""
+    _ADDED.pop(name, None)
+
+
+def all_subcommands() -> tuple[Subcommand, ...]:
+    """Every subcommand: rvfem's own (:data:`SUBCOMMANDS`), then those registered."""
+    return (*SUBCOMMANDS, *_ADDED.values())
+
+
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(main())
-
-
-SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY, OPTIMISE, HYSTERESIS)

@@ -246,7 +246,7 @@ class RollerProfile:
     roller's edge pressure (docs/theory.md § 12).
     """
 
-    kind: str = param("straight", choices=tuple(ROLLER_PROFILE_KINDS),
+    kind: str = param("straight", choices=lambda: tuple(ROLLER_PROFILE_KINDS),
                       doc="roller generatrix: straight, arc (crown radius), logarithmic (Johns–Gohar) or combined "
                           "(straight centre and a modified end segment)")
     crown_radius: float = param(500.0, unit="mm", low=10.0, high=1.0e6, doc="R of the `arc` profile")

@@ -747,16 +747,18 @@ def _check_roller_profile(case: Case) -> None:
         raise _error(case, key + name, f"({corner:g} mm) must be shorter than half the roller length ({half:g} mm): "
                      "the corner is the short rounded end beyond the effective length")
     defaults = {f.name: f.default for f in dataclasses.fields(RollerProfile)}
-    for name, kind in _PROFILE_KEY_KIND.items():
+    for name, kind in _profile_key_kind().items():
         value = getattr(b.profile, name)
         if b.profile.kind != kind and value != defaults[name]:
             raise _error(case, key + name, f"= {value:g} is given, but kind = {b.profile.kind!r} does not use it "
                          f"(it shapes the {kind!r} profile): set {key}kind = {kind!r}, or leave {name} out")
 
 
-_PROFILE_KEY_KIND = {key: kind for kind, keys in ROLLER_PROFILE_KINDS.items() for key in keys}
-"""The profile keys that only one ``kind`` uses. Given with another kind they are refused, unless
-they hold their default (a case written out whole, as ``case.json``, holds every key)."""
+def _profile_key_kind() -> dict[str, str]:
+    """The profile keys that only one ``kind`` uses (kinds registered since included). Given with
+    another kind they are refused, unless they hold their default (a case written out whole, as
+    ``case.json``, holds every key)."""
+    return {key: kind for kind, keys in ROLLER_PROFILE_KINDS.items() for key in keys}
 
 
 def _check_lubricant(case: Case) -> None:

@@ -41,19 +41,22 @@ Sources
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from rvfem.case.definition import ROLLER_PROFILE_KINDS
+from rvfem.case.definition import ROLLER_PROFILE_KINDS, RollerProfile
 from rvfem.evaluate.hertz import PALMGREN_COEFFICIENT, hertz_half_width
 from rvfem.solve.models import roller_angles
 
 __all__ = [
     "PROFILE_KINDS",
     "PROFILE_DROPS",
+    "register_profile_kind",
     "SHEAR_FACTOR",
     "SHEAR_DEPTH_FACTOR",
     "SliceContact",
@@ -235,6 +238,38 @@ if set(PROFILE_DROPS) != set(ROLLER_PROFILE_KINDS):   # a kind the case accepts 
     raise ImportError("rvfem.evaluate.roller_slices: the roller-profile kinds of the case format "
                       f"({', '.join(ROLLER_PROFILE_KINDS)}) and those with a drop function in PROFILE_DROPS "
                       f"({', '.join(PROFILE_DROPS)}) differ; give every kind its drop function")
+
+
+def register_profile_kind(name: str, drop: Callable[..., np.ndarray], keys: tuple[str, ...] = ()) -> None:
+    """Add a roller-profile kind from outside the package: the case accepts ``kind = name``
+    (:data:`rvfem.case.definition.ROLLER_PROFILE_KINDS`) and its drop is ``drop`` (the signature of
+    :data:`PROFILE_DROPS`), in one call, so the two lists stay one.
+
+    Parameters
+    ----------
+    name : str
+        The kind, as the case names it.
+    drop : callable
+        ``drop(profile, length_mm, |x|, *, composite_modulus_MPa, reduced_radius_mm) -> z``, mm.
+    keys : tuple of str
+        Keys of ``[crank_bearing.profile]`` that shape it: existing keys no other kind uses (a new
+        key needs a field of :class:`rvfem.case.definition.RollerProfile`).
+
+    Raises
+    ------
+    ValueError
+        The kind exists, or a key is not a profile key or is another kind's.
+    """
+    if name in ROLLER_PROFILE_KINDS:
+        raise ValueError(f"the roller-profile kind {name!r} exists already")
+    fields = {f.name for f in dataclasses.fields(RollerProfile)}
+    taken = {k for ks in ROLLER_PROFILE_KINDS.values() for k in ks}
+    bad = [k for k in keys if k not in fields or k in taken]
+    if bad:
+        raise ValueError(f"roller-profile kind {name!r}: {', '.join(bad)} must be keys of [crank_bearing.profile] "
+                         "that no other kind uses")
+    ROLLER_PROFILE_KINDS[name] = tuple(keys)
+    PROFILE_DROPS[name] = drop
 
 
 def slice_centres(length_mm: float, slices: int) -> tuple[np.ndarray, np.ndarray]:

@@ -41,7 +41,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-__all__ = ["OPTIONS", "WRITER_MODULES", "Writer", "register_writer", "writers"]
+from rvfem.results.registry import sections
+
+__all__ = ["OPTIONS", "SECTION_WRITER_ORDER", "WRITER_MODULES", "Writer", "register_writer", "writers"]
 
 WRITER_MODULES = (
     "rvfem.outputs.summary",          # tables, case.json, vtk, plots, images, report, summary.json
@@ -130,9 +132,23 @@ def register_writer(name: str, order: int, *, stage: str | None, options: Iterab
     return register
 
 
+SECTION_WRITER_ORDER = 1000
+"""Order of the first result section's writer (:attr:`rvfem.results.section.Section.writers`): after
+every registered writer, in the sections' order, with the tables' progress stage."""
+
+
+def _section_writers() -> list[Writer]:
+    """The files the result sections write (:attr:`rvfem.results.section.Section.writers`), as writers."""
+    found = [w for s in sections() for w in s.writers]
+    return [Writer(name=w.name, order=SECTION_WRITER_ORDER + i, write=w.write, stage="tables", files=w.files)
+            for i, w in enumerate(found)]
+
+
 def writers(*, images: bool = True) -> tuple[Writer, ...]:
     """The registered writers in their order (those of every module of :data:`WRITER_MODULES`, and
-    any registered since); without those that render if ``images`` is False."""
+    any registered since), then the result sections' writers; without those that render if
+    ``images`` is False."""
     for module in WRITER_MODULES:
         importlib.import_module(module)
-    return tuple(w for w in sorted(_WRITERS.values(), key=lambda w: w.order) if images or not w.renders)
+    every = sorted([*_WRITERS.values(), *_section_writers()], key=lambda w: w.order)
+    return tuple(w for w in every if images or not w.renders)

@@ -30,6 +30,7 @@ from rvfem.case.schema import file_fields, format_quantity
 from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.results.bearing_checks import bearing_check_lines
+from rvfem.results.registry import sections
 from rvfem.results.format import toml_text
 from rvfem.results.mass_strength import mass_strength_report
 from rvfem.solve.models import bearing_model, pin_model
@@ -339,7 +340,9 @@ def _stress_rows(stress: dict) -> list[list]:
 
 
 def _other_results(summary: dict) -> dict:
-    """The table "Other results": stress peaks, largest load, pins in contact, stiffness, solver."""
+    """The table "Other results": stress peaks, largest load, pins in contact, stiffness, solver,
+    then the rows of every result section that has some (:attr:`rvfem.results.section.Section.report`:
+    the accuracy, and those of sections from outside rvfem)."""
     mx, pins = summary["max_bearing_load"], summary["pins_in_contact"]
     rows = _stress_rows(summary["stress"]) + [
         ["largest bearing load", f"{mx['flexible_N']:.0f} N, bearing {mx['bearing']}, θ = {mx['theta_deg']:.1f}°"],
@@ -347,22 +350,12 @@ def _other_results(summary: dict) -> dict:
         ["disc torque / mean carrier rotation (per disc)",
          f"{summary['torsional_stiffness_Nm_per_arcmin']:.2f} N·m/arcmin"],
         ["carrier rotation", f"{summary['carrier_rotation_arcmin']['mean']:.3f} arcmin (mean)"],
-        *_accuracy_rows(summary.get("accuracy")),
         ["equilibrium residual (max)", f"{summary['equilibrium_residual']:.2e}"],
         ["active-set iterations", f"max {summary['active_set_iterations']['max']}, mean "
                                   f"{summary['active_set_iterations']['mean']:.1f}"],
     ]
+    rows += [row for section in sections() if section.report is not None for row in section.report(summary)]
     return _table(["quantity", "value"], rows, left=2)
-
-
-def _accuracy_rows(acc: dict | None) -> list[list[str]]:
-    """Torsional rigidity and lost motion of the stage from the run's few points of the hysteresis
-    loop (docs/theory.md § 9b; ``rvfem hysteresis`` gives the whole loop)."""
-    if not acc:
-        return []
-    where = f"input locked at θ = {acc['crank_angle_deg']:g}°, ±{acc['torque_Nm']:g} N·m, stage only"
-    return [["torsional rigidity (b/a, 3–100 % T)", f"{acc['torsional_rigidity_Nm_per_arcmin']:.1f} N·m/arcmin ({where})"],
-            ["lost motion (±3 % T)", f"{acc['lost_motion_arcmin']:.3f} arcmin ({where})"]]
 
 
 def _attribution(summary: dict) -> dict:

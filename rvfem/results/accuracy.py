@@ -15,7 +15,7 @@ log = logging.getLogger(__name__)
 from rvfem.results import screen_lines
 from rvfem.results.section import KeyRow, Section, SummaryContext
 
-__all__ = ['SECTION', 'compute', 'run_accuracy', 'summary']
+__all__ = ['SECTION', 'accuracy_rows', 'compute', 'run_accuracy', 'summary']
 
 def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
     """Torsional rigidity and lost motion at the case's torque (a few points of the hysteresis loop)."""
@@ -47,6 +47,16 @@ def compute(inputs: Any) -> dict[str, Any] | None:
     return run_accuracy(inputs["system"])
 
 
+def accuracy_rows(acc: dict[str, Any] | None) -> list[list[str]]:
+    """Torsional rigidity and lost motion of the stage from the run's few points of the hysteresis
+    loop (docs/theory.md § 9b; ``rvfem hysteresis`` gives the whole loop)."""
+    if not acc:
+        return []
+    where = f"input locked at θ = {acc['crank_angle_deg']:g}°, ±{acc['torque_Nm']:g} N·m, stage only"
+    return [["torsional rigidity (b/a, 3–100 % T)", f"{acc['torsional_rigidity_Nm_per_arcmin']:.1f} N·m/arcmin ({where})"],
+            ["lost motion (±3 % T)", f"{acc['lost_motion_arcmin']:.3f} arcmin ({where})"]]
+
+
 KEYS = (
     KeyRow('`accuracy`',
            'object',
@@ -64,4 +74,5 @@ KEYS = (
 """Its rows of the key table (docs/outputs.md)."""
 
 SECTION = Section("accuracy", summary, KEYS, requires=("system",), compute=compute, stage="accuracy",
+                  report=lambda s: accuracy_rows(s.get("accuracy")),
                   screen=lambda s: screen_lines.accuracy_lines(s.get("accuracy")), screen_rank=35)

@@ -63,7 +63,7 @@ BUILTIN_SECTIONS: tuple[Section, ...] = (
 )
 """rvfem's own result sections, in the order of their keys in ``summary.json``."""
 
-_ADDED: list[Section] = []
+_ADDED: dict[str, Section] = {}
 """Sections added with :func:`register_section` (a module-level list, like the writer and model
 registries; a test fixture saves and restores it)."""
 
@@ -72,7 +72,7 @@ def sections() -> tuple[Section, ...]:
     """Every section: the built-in ones, then those registered, in the order they were; the
     ``files`` section (the folder's listing and timings) stays last."""
     *front, last = BUILTIN_SECTIONS
-    return (*front, *_ADDED, last)
+    return (*front, *_ADDED.values(), last)
 
 
 def section(name: str) -> Section:
@@ -88,13 +88,13 @@ def register_section(new: Section) -> Section:
     raises ValueError."""
     if any(s.name == new.name for s in sections()):
         raise ValueError(f"a result section named {new.name!r} is already registered")
-    _ADDED.append(new)
+    _ADDED[new.name] = new
     return new
 
 
 def unregister_section(name: str) -> None:
     """Remove a section added with :func:`register_section` (built-in ones stay)."""
-    _ADDED[:] = [s for s in _ADDED if s.name != name]
+    _ADDED.pop(name, None)
 
 
 def key_table() -> str:

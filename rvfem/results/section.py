@@ -24,9 +24,10 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, NamedTuple
 
-__all__ = ["KeyRow", "Section", "SummaryContext", "SectionInputs"]
+__all__ = ["KeyRow", "Section", "SectionWriter", "SummaryContext", "SectionInputs"]
 
 
 class KeyRow(NamedTuple):
@@ -62,6 +63,25 @@ class SummaryContext:
 
     files: tuple[str, ...] = ()
     timings: Mapping[str, float] = dataclasses.field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SectionWriter:
+    """A file a section writes into the result folder (a table of its own).
+
+    Attributes
+    ----------
+    name : str
+        The writer's name among the run's writers (:func:`rvfem.outputs.registry.writers`).
+    files : tuple of str
+        The files it writes, relative to the folder (patterns).
+    write : callable
+        ``write(analysis, folder) -> list of Path``.
+    """
+
+    name: str
+    files: tuple[str, ...]
+    write: Callable[[Any, Path], list[Path]]
 
 
 SectionInputs = Mapping[str, Any]
@@ -105,10 +125,11 @@ class Section:
     screen_rank : float
         Where the lines go among the other sections' (smaller first).
     report : callable or None
-        ``report(summary) -> list of [label, value]``: its rows in the report's "Other results"
-        table (the report's partial ``section_rows.html.j2`` renders them), from the summary.
-    writers : tuple of str
-        Names of the registered writers of its files (:func:`rvfem.outputs.registry.writers`).
+        ``report(summary) -> list of [quantity, value]``: its rows of the report's "Other results"
+        table, from the summary.
+    writers : tuple of SectionWriter
+        The files it writes; a run calls them with the tables (:func:`rvfem.outputs.registry.writers`
+        lists them after the registered writers).
     """
 
     name: str
@@ -122,7 +143,7 @@ class Section:
     screen: Callable[[dict[str, Any]], list[str]] | None = None
     screen_rank: float = 100.0
     report: Callable[[dict[str, Any]], list[list[str]]] | None = None
-    writers: tuple[str, ...] = ()
+    writers: tuple[SectionWriter, ...] = ()
 
     def __post_init__(self) -> None:
         if self.executor not in ("inline", "thread"):
