@@ -190,3 +190,14 @@ def test_the_atomic_text_writer_replaces_a_file_whole(tmp_path):
         write_text_atomic(path, b"bytes are not text")
     assert path.read_text(encoding="utf-8") == "new\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["study.csv"]
+
+
+def test_the_analysis_scheduler_takes_at_most_eight_parameters_per_function():
+    """The analysis is a scheduler over the result sections: what varies between analyses is an
+    AnalysisOptions, not a long list of arguments (a ``**choices`` counts as one)."""
+    tree = ast.parse((ROOT / "rvfem" / "app" / "analysis.py").read_text(encoding="utf-8"))
+    for f in _functions(tree):
+        a = f.args
+        count = (len(a.posonlyargs) + len(a.args) + len(a.kwonlyargs) + (a.vararg is not None)
+                 + (a.kwarg is not None) - (1 if a.args and a.args[0].arg in ("self", "cls") else 0))
+        assert count <= 8, f"rvfem/app/analysis.py: {f.name} takes {count} parameters"

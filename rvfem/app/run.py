@@ -340,7 +340,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
 
     def attribute() -> None:
         t = stages.start("attribution")
-        computed.append(_analysis._timed(_analysis.attribution_of, result.system, result.theta, result.cycle))
+        computed.append(_analysis.timed(_analysis.attribution_of, result.system, result.theta, result.cycle))
         stages.end("attribution", t)
 
     registered = outputs.writers(images=worker is not None)

@@ -11,8 +11,6 @@ import math
 from rvfem.results import registry
 from rvfem.results.bearing_checks import bearing_check_lines
 from rvfem.results.screen_lines import (
-    bearing_lines,
-    header_lines,
     life,
     num,
     reference_lines,

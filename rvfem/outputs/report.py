@@ -27,7 +27,6 @@ import jinja2
 import rvfem.geometry  # noqa: F401  (registers the hole shapes Case.hole_shapes looks up)
 from rvfem.case.definition import ROLLER_PROFILE_KINDS, Case
 from rvfem.case.schema import file_fields, format_quantity
-from rvfem.errors import CaseError
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.results.bearing_checks import bearing_check_lines
 from rvfem.results.registry import sections

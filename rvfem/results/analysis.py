@@ -51,10 +51,15 @@ def rigid_bearing_forces(rigid_analysis: RigidAnalysis, theta: np.ndarray) -> np
 
 @dataclass(frozen=True)
 class AnalysisOptions:
-    """What an analysis computes besides the load cycle (the choices of :func:`rvfem.app.analysis.analyse`).
+    """What an analysis computes and how (the choices of :func:`rvfem.app.analysis.analyse`).
 
     Attributes
     ----------
+    angle_step_deg, bearing_model, order : optional
+        Override ``analysis.angle_step_deg`` (degrees), ``crank_bearing.model`` and
+        ``analysis.element_order`` (:func:`rvfem.app.analysis.resolve_case`); None keeps the case's.
+    field_step_deg : float, optional
+        Also keep the fields every ``field_step_deg`` degrees.
     recover_stress : bool
         Re-solve the structural peak on P2 (stage ``stress``).
     duty_fe : bool
@@ -63,6 +68,10 @@ class AnalysisOptions:
         Compute the attribution (stage ``attribution``).
     """
 
+    angle_step_deg: float | None = None
+    bearing_model: str | None = None
+    order: int | None = None
+    field_step_deg: float | None = None
     recover_stress: bool = True
     duty_fe: bool = True
     attribute: bool = True

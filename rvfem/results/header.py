@@ -4,7 +4,6 @@ in, and where the case comes from (file, checksum, overrides, defaults used)."""
 from __future__ import annotations
 
 import datetime
-import os
 import platform
 import shlex
 import sys

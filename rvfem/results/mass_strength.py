@@ -8,7 +8,6 @@ with the smallest factor), and the details under ``mass_strength`` (docs/outputs
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none

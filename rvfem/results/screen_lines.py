@@ -6,7 +6,6 @@ significant figures."""
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from rvfem.evaluate.rigid import REFERENCE_NAMES
 from rvfem.results.format import toml_text

@@ -736,7 +736,7 @@ def test_p2_model_in_its_child_process_gives_what_it_gives_here(coarse_case_file
     (rvfem.solve.cycle.AngleLoads); the same re-solve with the P2 model built in this process, from the
     cycle's results themselves, gives the same peak (to round-off: the two factorisations may
     round differently) and the same P1 value."""
-    from rvfem.app.analysis import _recover_structural_peak
+    from rvfem.app.p2_model import recover_structural_peak as _recover_structural_peak
 
     a = analyse(coarse_case_file, cache_dir=cache_dir, attribute=False)
     here = _recover_structural_peak(a.system, a.cycle, a.mesh, a.stress.band_mm, a.stress.away_from_contacts)
