@@ -215,7 +215,7 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None,
 
 
 
-def repository_path(relative: str | os.PathLike, start: str | os.PathLike | None = None) -> Path:
+def repository_path(relative: str | os.PathLike[str], start: str | os.PathLike[str] | None = None) -> Path:
     """Find a repository file (e.g. ``cases/rv40e_fanholes.toml``) from wherever Python runs.
 
     Jupyter, nbconvert and editors start a notebook's kernel in the notebook's folder, not in the
@@ -275,8 +275,8 @@ def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, 
     return saved
 
 
-def analyse(case: Case | str | os.PathLike, options: AnalysisOptions | None = None, *,
-            overrides: tuple[str, ...] = (), cache_dir: str | os.PathLike | None = None,
+def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None = None, *,
+            overrides: tuple[str, ...] = (), cache_dir: str | os.PathLike[str] | None = None,
             progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
             on_model: Callable[[Any], None] | None = None, **choices: Any) -> Analysis:
     """Analyse a case completely, in memory.
@@ -376,7 +376,7 @@ class _CheckedCase:
     saved: tuple[float, ...]
 
 
-def _checked_case(case: Case | str | os.PathLike, provenance: CaseProvenance | None, stages: Stages,
+def _checked_case(case: Case | str | os.PathLike[str], provenance: CaseProvenance | None, stages: Stages,
                   overrides: tuple[str, ...], options: AnalysisOptions) -> _CheckedCase:
     """The ``check`` stage of :func:`analyse`: the case resolved with its options and its angles
     checked; without the stage when ``provenance`` is given (``case`` is then resolved already)."""
@@ -406,7 +406,7 @@ class _DiscModel:
     saved: tuple[float, ...]
 
 
-def _disc_model(case: Case, stages: Stages, cache_dir: str | os.PathLike | None, checked: _CheckedCase) -> _DiscModel:
+def _disc_model(case: Case, stages: Stages, cache_dir: str | os.PathLike[str] | None, checked: _CheckedCase) -> _DiscModel:
     """The ``mesh`` and ``model`` stages of :func:`analyse`: the disc geometry, its mesh (cached in
     ``cache_dir``, default :func:`default_cache_dir`) and the assembled, factorised disc model
     (:class:`rvfem.solve.cycle.DiscSystem`), with the angles of ``checked``."""

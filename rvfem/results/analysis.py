@@ -89,7 +89,7 @@ class CaseProvenance:
         sha256 of the case file's bytes.
     matches_file : bool
         True if the analysed case is exactly the file's (no overrides, not modified in code).
-    overrides : dict
+    overrides : dict[str, Any]
         Dotted case key → value, for every value set on top of the file: ``KEY=VALUE`` overrides
         (:attr:`rvfem.case.definition.Case.overrides`, ``rvfem ... --set``) and the options
         ``angle_step_deg``, ``bearing_model``, ``order`` (``--step``, ``--bearing-model``,
@@ -101,7 +101,7 @@ class CaseProvenance:
     file: str | None
     sha256: str | None
     matches_file: bool
-    overrides: dict = field(default_factory=dict)
+    overrides: dict[str, Any] = field(default_factory=dict[str, Any])
     defaults_used: tuple[tuple[str, Any], ...] = ()
 
 
@@ -209,7 +209,7 @@ class StressResult:
         Largest vertex von Mises stress over every solved crank angle (the cycle's envelope).
     away_from_contacts : rvfem.evaluate.postprocess.PeakStress or None
         The same ignoring a band along the tooth profile and the bores (the structural peak).
-    band_mm : dict
+    band_mm : dict[str, Any]
         Boundary name → width of the ignored band, mm.
     snapshots : tuple of rvfem.evaluate.postprocess.FieldSnapshot
         The kept fields (saved angles, largest bearing load, the two peaks, ``field_step_deg``).
@@ -326,7 +326,7 @@ class Analysis:
         Disc torque / mean carrier rotation.
     duty_cycle : DutyCycleResult or None
         None if the case has no duty cycle.
-    timings : dict
+    timings : dict[str, Any]
         Wall time per stage of :data:`STAGES` (s), the model set-up details ``model_*``,
         ``cycle_per_angle`` and, with the attribution, ``attribution_compute`` (its own wall time;
         the stage ``attribution`` is the wait for it when :func:`analyse` computes it beside other
@@ -374,12 +374,12 @@ class Analysis:
     hertz: dict[str, hertz.RollerHertz]
     torsional_stiffness_Nm_per_arcmin: float
     duty_cycle: DutyCycleResult | None = None
-    timings: dict = field(default_factory=dict)
+    timings: dict[str, Any] = field(default_factory=dict[str, Any])
     attribution: Attribution | None = None
     references: References | None = None
     warnings: tuple[ResultWarning, ...] = ()
     roller_depth: CrankBearingDepth | None = None
-    accuracy: dict | None = None
+    accuracy: dict[str, Any] | None = None
     bearing_checks: BearingChecks | None = None
     mass_strength: DesignChecks | None = None
     extra: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))

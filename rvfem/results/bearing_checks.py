@@ -14,7 +14,7 @@ from rvfem.results.section import KeyRow, Section, SummaryContext
 
 __all__ = ['SECTION', 'bearing_check_lines', 'bearing_checks_dict', 'compute', 'summary']
 
-def bearing_checks_dict(checks) -> dict | None:
+def bearing_checks_dict(checks: Any) -> dict[str, Any] | None:
     """The ``bearing_checks`` object of summary.json and ``rvfem rigid --json``
     (:class:`rvfem.evaluate.bearing_checks.BearingChecks`)."""
     if checks is None:
@@ -44,14 +44,14 @@ def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
     return {"bearing_checks": bearing_checks_dict(getattr(a, "bearing_checks", None))}
 
 
-def _fmt(value, fmt: str) -> str:
+def _fmt(value: Any, fmt: str) -> str:
     """A number for a line, a dash for None, ``inf`` for infinity."""
     if value is None:
         return "–"
     return format(float(value), fmt) if math.isfinite(float(value)) else "inf"
 
 
-def bearing_check_lines(checks: dict | None) -> list[str]:
+def bearing_check_lines(checks: dict[str, Any] | None) -> list[str]:
     """The crank bearing's static safety S0 and minimum load (rigid and flexible, where there) and the
     support bearings' loads and lives (the ``bearing_checks`` object of summary.json or ``rvfem rigid
     --json``)."""

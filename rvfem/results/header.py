@@ -57,7 +57,7 @@ def command_line() -> str | None:
     return None
 
 
-def environment() -> dict:
+def environment() -> dict[str, Any]:
     """When, how and with what a result was computed: UTC date and time, the command line
     (:func:`command_line`), Python, the platform and the versions of
     :data:`VERSIONED_PACKAGES` (None if not installed)."""

@@ -17,7 +17,7 @@ from rvfem.results.section import KeyRow, Section, SummaryContext
 
 __all__ = ['SECTION', 'compute', 'summary']
 
-def _hertz_dict(h) -> dict:
+def _hertz_dict(h: Any) -> dict[str, Any]:
     return {
         "roller_load_N": h.roller_load_N,
         "bearing": None if h.bearing is None else h.bearing + 1,

@@ -25,7 +25,7 @@ def _where(peak: PeakStress) -> dict[str, Any]:
             "feature_label": None if peak.feature is None else feature_label(peak.feature)}
 
 
-def mass_strength_dict(checks: DesignChecks, material) -> dict[str, Any]:
+def mass_strength_dict(checks: DesignChecks, material: Any) -> dict[str, Any]:
     """The keys of the piece from a :class:`~rvfem.evaluate.design_checks.DesignChecks`."""
     m = checks.mass
     gov = checks.fatigue_governing
@@ -71,7 +71,7 @@ def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
     return mass_strength_dict(checks, a.case.material)
 
 
-def _words(at: dict) -> str:
+def _words(at: dict[str, Any]) -> str:
     """The feature of a location in words (``bore 1``; from its ``feature`` in a summary written
     before ``feature_label`` was), or ``?``."""
     if at.get("feature_label"):
@@ -83,7 +83,7 @@ def _factor(x: float | None) -> str:
     return "–" if x is None else f"{x:.3g}"
 
 
-def mass_strength_lines(summary: dict) -> list[str]:
+def mass_strength_lines(summary: dict[str, Any]) -> list[str]:
     """The screen lines of the mass-and-strength keys of a ``summary.json`` (none where absent)."""
     ms = summary.get("mass_strength")
     if not ms:
@@ -107,7 +107,7 @@ def mass_strength_lines(summary: dict) -> list[str]:
     return lines
 
 
-def mass_strength_report(summary: dict) -> list[str]:
+def mass_strength_report(summary: dict[str, Any]) -> list[str]:
     """The paragraphs of the report's "Mass, inertia and strength" section (none where absent):
     the screen lines and one line per hot spot."""
     ms = summary.get("mass_strength")
@@ -124,7 +124,7 @@ def mass_strength_report(summary: dict) -> list[str]:
     return lines
 
 
-def fatigue_point_data(analysis) -> dict:
+def fatigue_point_data(analysis: Any) -> dict[str, Any]:
     """The envelope's fatigue field: ``fatigue_safety_factor_P<order>`` (the Goodman safety factor
     of every vertex from the cycle's own vertex stresses, not scaled to P2; capped at 1000 for
     the colour scale), empty where the cycle has no signed von Mises envelope."""

@@ -10,7 +10,7 @@ from rvfem.results.section import KeyRow, Section, SummaryContext
 
 __all__ = ['SECTION', 'references_dict', 'summary']
 
-def references_dict(refs) -> dict:
+def references_dict(refs: Any) -> dict[str, Any]:
     """The ``references`` object of ``summary.json`` and ``rvfem rigid --json``."""
     return {
         "bearing_loads": refs.bearing_loads,

@@ -15,7 +15,7 @@ from rvfem.results.section import KeyRow, Section, SummaryContext
 
 __all__ = ['SECTION', 'compute', 'depth_life_dict', 'summary']
 
-def depth_life_dict(d) -> dict | None:
+def depth_life_dict(d: Any) -> dict[str, Any] | None:
     """κ, a_ISO and the lives of one BearingDepth (``rvfem rigid --json``'s bearings)."""
     if d is None:
         return None
@@ -23,7 +23,7 @@ def depth_life_dict(d) -> dict | None:
             "film_thickness_min_um": d.film_thickness_min_um, "roller_peak_pressure_MPa": d.roller_peak_pressure_MPa}
 
 
-def _depth_dict(d) -> dict:
+def _depth_dict(d: Any) -> dict[str, Any]:
     return {
         "roller_peak_pressure_MPa": d.roller_peak_pressure_MPa,
         "roller_edge_factor": d.roller_edge_factor,

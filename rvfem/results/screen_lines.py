@@ -5,6 +5,8 @@ significant figures."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import math
 
 from rvfem.evaluate.rigid import REFERENCE_NAMES
@@ -63,7 +65,7 @@ def life(value: float | None, width: int = 0) -> str:
 
 
 
-def header_lines(summary: dict) -> list[str]:
+def header_lines(summary: dict[str, Any]) -> list[str]:
     """The case, the model, the torque and the rating, and the head of the bearing table."""
     c, m = summary["case"], summary["model"]
     return [
@@ -80,7 +82,7 @@ def header_lines(summary: dict) -> list[str]:
 
 
 
-def bearing_lines(summary: dict, handbook: bool) -> list[str]:
+def bearing_lines(summary: dict[str, Any], handbook: bool) -> list[str]:
     """Per bearing: the loads and life by each model, then the deltas and the life ratio."""
     rows = ("rigid", "flexible") if handbook else ("rigid", "equal_share", "flexible")
     names = {"rigid": "rigid", "flexible": "flexible", "equal_share": "eq. share"}
@@ -102,7 +104,7 @@ def bearing_lines(summary: dict, handbook: bool) -> list[str]:
 
 
 
-def stage_lines(summary: dict, handbook: bool) -> list[str]:
+def stage_lines(summary: dict[str, Any], handbook: bool) -> list[str]:
     """The reducer stage and what the delta of bearing 1 is made of, step by step."""
     rs = summary["reducer_stage"]
     lines = ["", f"  reducer stage: {rs['model']}"]
@@ -119,7 +121,7 @@ def stage_lines(summary: dict, handbook: bool) -> list[str]:
 
 
 
-def hertz_line(h: dict) -> str:
+def hertz_line(h: dict[str, Any]) -> str:
     """The Hertz pressures of the most loaded roller: rigid Stribeck, then the FE roller load (or
     Stribeck with the FE bearing load where there are no FE roller loads)."""
     sr, fe = h["stribeck_rigid"], h.get("fe_rollers")
@@ -138,7 +140,7 @@ def hertz_line(h: dict) -> str:
 
 
 
-def duty_lines(duty: dict | None) -> list[str]:
+def duty_lines(duty: dict[str, Any] | None) -> list[str]:
     """The duty-cycle service lives and their check by the flexible model; none without a duty cycle."""
     if not duty:
         return []
@@ -158,7 +160,7 @@ def duty_lines(duty: dict | None) -> list[str]:
 
 
 
-def drawing_text(t: dict, files) -> str:
+def drawing_text(t: dict[str, Any], files: Any) -> str:
     """The drawing's part of the wall-time line: with a render worker (``drawing_background`` in
     the timings) the plots and images are drawn by a child process while the tables and VTK files
     are written, so its time is the span from handing them over to having them all, of which this
@@ -172,7 +174,7 @@ def drawing_text(t: dict, files) -> str:
 
 
 
-def bearing_depth_lines(b: dict) -> list[str]:
+def bearing_depth_lines(b: dict[str, Any]) -> list[str]:
     """One bearing's lines of :func:`roller_depth_lines` without its name (``{name}`` in front)."""
     lines = []
     for model in ("rigid", "flexible"):
@@ -190,7 +192,7 @@ def bearing_depth_lines(b: dict) -> list[str]:
 
 
 
-def roller_depth_lines(depth: dict | None) -> list[str]:
+def roller_depth_lines(depth: dict[str, Any] | None) -> list[str]:
     """The crank bearing in depth: per bearing the pressure along the roller, film, κ and the three
     lives (basic L10h, modified L_nm, lamina L10r) rigid and flexible with the flexible/rigid ratio.
     Neighbouring bearings whose lines read the same (N-fold symmetry: every crank bearing carries the
@@ -213,7 +215,7 @@ def roller_depth_lines(depth: dict | None) -> list[str]:
 
 
 
-def warning_lines(warnings: list[dict], prefix: str = "  warning: ") -> list[str]:
+def warning_lines(warnings: list[dict[str, Any]], prefix: str = "  warning: ") -> list[str]:
     """The ``warnings`` of ``summary.json`` or ``rvfem rigid --json`` as screen lines, one each
     (:mod:`rvfem.evaluate.validity`), preceded by an empty line; none when there are none."""
     if not warnings:
@@ -222,7 +224,7 @@ def warning_lines(warnings: list[dict], prefix: str = "  warning: ") -> list[str
 
 
 
-def reference_lines(references: dict) -> list[str]:
+def reference_lines(references: dict[str, Any]) -> list[str]:
     """What a run or the rigid evaluation is compared with, and why (the ``references`` object of
     ``summary.json`` or ``rvfem rigid --json``), as screen lines."""
 
@@ -239,7 +241,7 @@ def reference_lines(references: dict) -> list[str]:
 
 
 
-def stress_lines(stress: dict) -> list[str]:
+def stress_lines(stress: dict[str, Any]) -> list[str]:
     """The disc-stress lines of the screen summary (the ``stress`` object of ``summary.json``):
     the structural peak away from contacts first, with its convergence check, then the
     contact-zone peak, labelled as such."""
@@ -270,7 +272,7 @@ def stress_lines(stress: dict) -> list[str]:
 
 
 
-def accuracy_lines(acc: dict | None) -> list[str]:
+def accuracy_lines(acc: dict[str, Any] | None) -> list[str]:
     """The transmission-accuracy line of ``rvfem run``: rigidity and lost motion of the stage."""
     if not acc:
         return []
@@ -280,12 +282,12 @@ def accuracy_lines(acc: dict | None) -> list[str]:
 
 
 
-def handbook_reference(summary: dict) -> bool:
+def handbook_reference(summary: dict[str, Any]) -> bool:
     """True when the bearing loads of a summary are compared with the handbook (else the equal share)."""
     return bool(summary["references"]["bearing_loads"] == "handbook")
 
 
-def cycle_lines(summary: dict) -> list[str]:
+def cycle_lines(summary: dict[str, Any]) -> list[str]:
     """Pins in contact, the disc's torsional stiffness and the equilibrium residual of the cycle."""
     pins = summary["pins_in_contact"]
     return [f"  pins in contact {pins['min']}–{pins['max']} of {pins['of']}; disc torque / mean carrier rotation "
@@ -293,7 +295,7 @@ def cycle_lines(summary: dict) -> list[str]:
             f"{summary['equilibrium_residual']:.1e}"]
 
 
-def wall_time_lines(summary: dict) -> list[str]:
+def wall_time_lines(summary: dict[str, Any]) -> list[str]:
     """The run's wall time and number of files."""
     t = summary["timings_s"]
     return [f"  wall time {t['total']:.1f} s (cycle {t['cycle']:.1f} s, {drawing_text(t, summary['files'])}); "

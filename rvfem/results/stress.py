@@ -56,7 +56,7 @@ def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
     }
 
 
-def _hot_spot_dict(h, j: int) -> dict:
+def _hot_spot_dict(h: Any, j: int) -> dict[str, Any]:
     vm, sd = h.von_mises[:, j], h.dominant[:, j]
     return {
         "name": h.names[j],
