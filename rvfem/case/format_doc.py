@@ -8,11 +8,10 @@ are stale; a test fails when they are).
 
 from __future__ import annotations
 
-import argparse
 import re
 import sys
-from pathlib import Path
 
+from rvfem._files import regenerate_document
 from rvfem.case.definition import table_class
 from rvfem.case.schema import markdown_table
 
@@ -34,22 +33,7 @@ def render_case_format(text: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m rvfem.case.format_doc [--check] DOC``: regenerate (or check) the tables of DOC."""
-    parser = argparse.ArgumentParser(prog="python -m rvfem.case.format_doc", description=main.__doc__)
-    parser.add_argument("doc", help="the case-format document, e.g. docs/case-format.md")
-    parser.add_argument("--check", action="store_true", help="only report whether the tables are stale")
-    args = parser.parse_args(argv)
-    path = Path(args.doc)
-    text = path.read_text(encoding="utf-8")
-    new = render_case_format(text)
-    if new == text:
-        print(f"{path}: up to date")
-        return 0
-    if args.check:
-        print(f"{path}: stale; regenerate with: python -m rvfem.case.format_doc {path}")
-        return 1
-    path.write_text(new, encoding="utf-8")
-    print(f"{path}: tables regenerated")
-    return 0
+    return regenerate_document("rvfem.case.format_doc", "tables", render_case_format, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -15,10 +15,10 @@ rewrites it; a test fails when it is stale).
 
 from __future__ import annotations
 
-import argparse
 import re
 import sys
-from pathlib import Path
+
+from rvfem._files import regenerate_document
 
 from rvfem.results import (
     accuracy,
@@ -118,21 +118,7 @@ def render_outputs_doc(text: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m rvfem.results.registry [--check] DOC``: regenerate (or check) the key table of DOC."""
-    parser = argparse.ArgumentParser(prog="python -m rvfem.results.registry", description=main.__doc__)
-    parser.add_argument("doc", help="the outputs document, e.g. docs/outputs.md")
-    parser.add_argument("--check", action="store_true", help="only report whether the table is stale")
-    args = parser.parse_args(argv)
-    path = Path(args.doc)
-    text = path.read_text(encoding="utf-8")
-    new = render_outputs_doc(text)
-    if args.check:
-        if new != text:
-            print(f"{path}: the key table is stale; regenerate it with python -m rvfem.results.registry {path}")
-            return 1
-        return 0
-    path.write_text(new, encoding="utf-8")
-    return 0
-
+    return regenerate_document("rvfem.results.registry", "key table", render_outputs_doc, argv)
 
 if __name__ == "__main__":
     sys.exit(main())
