@@ -39,10 +39,10 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
 
 from rvfem.app import analysis as _analysis
 from rvfem.app.analysis import (
+    Analysis,
     CONTACT_BAND_ELEMENTS,
     CaseProvenance,
     ProgressCallback,
@@ -142,7 +142,7 @@ class RunSummary:
 
     out_dir: Path
     summary: dict
-    analysis: Any
+    analysis: Analysis
     files: tuple[str, ...]
 
     @property
