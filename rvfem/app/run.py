@@ -39,6 +39,7 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from rvfem.app import analysis as _analysis
 from rvfem.app.analysis import (
