@@ -67,11 +67,14 @@ def rigid_limit_section(discs: _Discs) -> Section:
     case = _case("rv40e_solid", "analysis.friction=0")
     system = dataclasses.replace(discs.system("rv40e_solid", **stiff), case=case)
     one = cycle.load_cycle(system, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
-    hb = rigid.handbook_bearing_loads(case, theta)
+    # the carrier torque is about the reducer axis: the handbook's torque about the disc centre is T·Zc/Zp
+    hb_case = case.replace(loads=dataclasses.replace(case.loads, torque_Nm=case.loads.torque_Nm
+                                                     * case.cycloid.teeth / case.pins.count))
+    hb = rigid.handbook_bearing_loads(hb_case, theta)
     f_max = hb.magnitude.max()
     hb_vec = np.stack([hb.fx, hb.fy], axis=-1).transpose(1, 0, 2)
     e_vec = np.abs(one.bearing_forces - hb_vec).max() / f_max
-    pins = rigid.classical_pin_forces(case, theta, exact_moment=True).magnitude.T
+    pins = rigid.classical_pin_forces(hb_case, theta, exact_moment=True).magnitude.T
     e_pin = np.abs(one.pin_forces - pins).max() / pins.max()
     loaded = set(int(n) for n in one.pins_in_contact)
     pair_stage = cycle.build_stage(system, discs=2, influence=None)
@@ -87,7 +90,8 @@ def rigid_limit_section(discs: _Discs) -> Section:
     lin = cycle.load_cycle(lin_system, theta, saved_angles_deg=(), stage=cycle.single_disc_stage(lin_system))
     e_share = (np.abs(lin.bearing_forces - compare.equal_share_forces(lin_case, lin)).max()
                / lin.bearing_loads.max())
-    hand = "handbook model, Gao et al. eqs. 4-10 (rigid disc, T/2 per disc)"
+    hand = ("handbook model, Gao et al. eqs. 4-10 (rigid disc, T/2 per disc about its centre) at T·Zc/Zp: the "
+            "output torque about the reducer axis")
     classical = "classical rigid pin-force distribution F_i = F_max·sin φ_i/√(1 + K1² − 2K1 cos φ_i)"
     checks = (
         Check("one disc 10⁶× stiffer, rigid bores: bearing force vectors vs handbook", hand, "handbook",
