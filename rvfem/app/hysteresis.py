@@ -44,8 +44,8 @@ def left_out() -> str:
     leaves = (", ".join(parts[:-1]) + " and " + parts[-1]) if len(parts) > 1 else "".join(parts)
     return (f"The stage model holds {held_in_words()}. "
             + (f"It leaves out {leaves}. " if parts else "")
-            + "The output rotation is the carrier rotation of the stage model's torque convention (each disc's "
-            "torque about its own centre, the eccentrics turning about the disc centre). Pin friction is Coulomb "
+            + "The output rotation is the carrier's rotation about the reducer axis (the discs, stiff, turning with "
+            "it), under the output torque about that axis. Pin friction is Coulomb "
             "with full sliding at every step: it vanishes with the load, so without a clearance the loop has no "
             "width at zero torque. Catalogue rigidity and lost motion are measured on the whole reducer: this "
             "model's rigidity is an upper bound and its lost motion a lower bound.")

@@ -644,6 +644,10 @@ class CrankSupport:
         Basic dynamic load rating C of one support bearing, N (None: loads only, no life).
     support_bearing_life_exponent : float
         Its life exponent p (10/3 roller, 3 ball bearings).
+    radial_clearance : float
+        Radial internal clearance of the support bearings (the crankshaft's total free radial
+        movement in them), mm; each eccentric may move by half of it relative to the carrier before
+        the supports carry.
     """
 
     span: float | None = param(None, unit="mm", low=1.0, high=5000.0,
@@ -675,6 +679,13 @@ class CrankSupport:
     support_bearing_life_exponent: float = param(
         10.0 / 3.0, low=1.0, high=10.0, default_doc="10/3 (roller bearings)",
         doc="life exponent p of the support bearings, L10 = (C/P)^p: 10/3 roller, 3 ball bearings")
+    radial_clearance: float = param(
+        0.0, unit="mm", low=0.0, high=0.2,
+        default_doc="0 (tapered roller support bearings mounted with axial preload, as RV reducers are: no play; "
+                    "Harris & Kotzalas, *Rolling Bearing Analysis*, on preloaded tapered roller pairs)",
+        doc="radial internal clearance of the support bearings (the crankshaft's total free radial movement in "
+            "them): each eccentric moves by half of it relative to the carrier before the supports carry; adds "
+            "to the crank bearing's clearance (needs the `rollers` bearing model)")
 
     @staticmethod
     def _pair(value: float | tuple[float, ...] | None) -> tuple[float | None, float | None]:

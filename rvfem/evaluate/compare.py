@@ -90,15 +90,17 @@ def equal_share_forces(case: Case, result: CycleResult) -> np.ndarray:
 
     F_i = −P/N + T_disc/(N·r0)·t_i with P the pin-force resultant on the disc (= −Σ bearing forces)
     and t_i the unit tangent of the crank circle at bearing i (counter-clockwise): the resultant
-    is shared equally and the torque is carried by equal tangential forces. T_disc is the disc's
-    own torque at each angle (T/discs, or its share when two discs share the carrier).
+    is shared equally and the torque is carried by equal tangential forces. T_disc is the bearing
+    forces' moment about the disc centre at each angle (the carrier torque is a moment about the
+    reducer axis, docs/theory.md § 6: about the disc centre the same forces give about Zc/Zp of the
+    disc's share).
     """
     c = crank_centres(case)
     n = len(c)
     t = np.stack([-c[:, 1], c[:, 0]], axis=1) / np.linalg.norm(c, axis=1)[:, None]
-    minus_p = result.bearing_forces.sum(axis=1)          # −P
-    torque = (np.full(len(result.theta), case.loads.disc_torque_Nmm) if result.disc_torque_Nmm is None
-              else result.disc_torque_Nmm[:, 0])
+    f = result.bearing_forces
+    minus_p = f.sum(axis=1)          # −P
+    torque = (c[None, :, 0] * f[..., 1] - c[None, :, 1] * f[..., 0]).sum(axis=1)
     share = torque / (n * case.cranks.circle_radius)
     return minus_p[:, None, :] / n + share[:, None, None] * t[None, :, :]
 

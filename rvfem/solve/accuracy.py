@@ -6,12 +6,12 @@ left out): the stage is held at one crank angle θ and only the torque on the ca
 load step is one contact solve of the stage (:func:`rvfem.solve.cycle.solve_pair`) on the same
 factorised discs and lazily filled column compliance, started from the step before it. The
 output rotation is the carrier rotation φ of that solve (plus the rotation of the stage's series
-output compliances under the output torque, where a component adds one), in the torque convention of
-:mod:`rvfem.solve.cycle` (each disc's torque about its own centre, the eccentrics turning about the
-disc centre: the handbook's and Liu et al.'s convention).
+output compliances under the output torque, where a component adds one): the carrier turning about
+the reducer axis, conjugate to the output torque as a moment about that axis
+(:mod:`rvfem.solve.cycle_stage`), so every figure is in the output's arcmin.
 
 **Friction.** A pin's friction opposes its sliding in the load step. At a held crank angle the
-disc turns with the carrier, so a pin slides along the flank by the rotation increment: loading
+disc turns with the carrier about the reducer axis, so a pin slides along the flank by the rotation increment: loading
 towards +T and unloading from −T slide one way (``slip = +1`` of
 :class:`rvfem.solve.cycle.OperatingPoint`), unloading from +T and loading towards −T the other way
 (``slip = −1``). Full sliding is assumed at every step (Coulomb, no sticking phase): at a reversal
@@ -348,14 +348,17 @@ def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float
 
 def rigid_kinematic_te(geometry, thetas: np.ndarray) -> np.ndarray:
     """The kinematic TE of a rigid stage (rad): the carrier rotation, positive, at which the first
-    pin gap closes with the disc turning rigidly with the carrier about its centre (the eccentrics
-    held): min over the pins with a positive lever of gap_j / ((ẑ × x_j)·n_j), x_j the contact point,
-    n_j the flank's outward normal. The independent reference of :func:`transmission_error` at no
-    load in the stiff limit (no clearance in the bearings)."""
+    pin gap closes with the disc turning rigidly with the carrier about the reducer axis O (at
+    −e·u(θ) in the disc frame; the eccentrics held): min over the pins with a positive lever of
+    gap_j / ((ẑ × (x_j − O))·n_j), x_j the contact point, n_j the flank's outward normal. The
+    independent reference of :func:`transmission_error` at no load in the stiff limit (no clearance
+    in the bearings)."""
+    e = geometry.case.cycloid.eccentricity
     out = []
     for theta in np.asarray(thetas, dtype=float):
         pc = pin_profile_contacts(geometry, float(theta))
-        x, n = np.asarray(pc.point), np.asarray(pc.normal)
+        axis = -e * np.array([math.cos(theta), math.sin(theta)])
+        x, n = np.asarray(pc.point) - axis, np.asarray(pc.normal)
         lever = x[:, 0] * n[:, 1] - x[:, 1] * n[:, 0]
         ok = lever > 1e-9 * np.abs(lever).max()
         out.append(float(np.min(np.asarray(pc.gap)[ok] / lever[ok])))

@@ -23,10 +23,12 @@ The model (docs/theory.md) in the disc's body frame:
   linear stiffness; the approach is the radial relative displacement of eccentric and bore minus
   half the radial clearance.
 * The carrier with its eccentrics is one rigid body that can only rotate. **Torque convention**:
-  its rotation φ turns the eccentric centres c_i about the *disc centre* (eccentric displacement
-  φ·ẑ×c_i) and its conjugate load is the disc torque T_disc = T_out/discs as a moment about the
-  disc centre. This is the handbook's convention (ΣP_x·e·Zc = T_disc, Gao et al. eq. 4); about the
-  reducer axis the same pin forces give a moment larger by Zp/Zc.
+  its rotation φ turns the eccentric centres c_i about the *reducer axis* O (eccentric
+  displacement φ·ẑ×(c_i − O), O at −e·u(θ) in the disc frame: the contact set's levers) and its
+  conjugate load is the carrier torque as a moment about O (T_out/discs for one disc). Every pin
+  normal passes through the pitch point, e·Zp from O and e·Zc from the disc centre, so the same pin
+  forces have a moment about the disc centre smaller by Zc/Zp: the handbook's ΣP_x·e·Zc = T/2
+  (Gao et al. eq. 4) takes T/2 about the disc centre.
 
 Per crank angle the unknowns are the contact forces λ (pins and rollers), the rigid motion ``a``
 and φ; the equations are the contact laws, the disc's equilibrium Rᵀλ = 0 and the carrier's
@@ -111,7 +113,7 @@ def solve_contact(cset: ContactSet, iface: Interface, compliance: Compliance, to
     compliance : Compliance
         Lazily filled column compliance C (filled further as contacts become active).
     torque : float or None
-        Disc torque T_disc, N·mm (moment about the disc centre, see module docstring). None: no
+        Carrier torque, N·mm (moment about the reducer axis, see module docstring). None: no
         carrier (the body is loaded by the contacts' prescribed gaps alone).
     start : AngleSolution, optional
         Warm start (usually the previous crank angle). Without one, a first solve with secant

@@ -40,7 +40,7 @@ class AngleResult:
     pin_gaps : ndarray (Zp,)
         Final pin gaps (rigid pins) or −approach (compliant pins), mm.
     carrier_rotation : float
-        φ, rad (carrier relative to the pin housing, about the disc centre).
+        φ, rad (carrier relative to the pin housing, about the reducer axis).
     solution : contact.AngleSolution
     contacts : contact.ContactSet
     origin : (AngleResult, int) or None

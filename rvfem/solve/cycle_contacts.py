@@ -62,9 +62,10 @@ def pin_contacts_many(system: DiscSystem, pcs, friction: float, slip: int = 0) -
         # the disc drags its surface along with the pin: μ·λ·sign(v·t)·t, t the profile tangent
         h = 1e-6
         if slip:
-            # a load step at a held crank angle: the disc turns with the carrier about its centre
-            # (the torque convention), so a pin moves relative to the disc by −slip·ẑ × c
-            c = np.concatenate([pin_centres(case, pc.theta) for pc in pcs])
+            # a load step at a held crank angle: the disc turns with the carrier about the reducer
+            # axis O (at −e·u(θ) in the disc frame), so a pin moves relative to the disc by
+            # −slip·ẑ × (c − O)
+            c = np.concatenate([pin_centres(case, pc.theta) - reducer_axis(case, pc.theta) for pc in pcs])
             vel = -float(np.sign(slip)) * np.stack([-c[:, 1], c[:, 0]], axis=1)
         else:
             vel = np.concatenate([(pin_centres(case, pc.theta + h) - pin_centres(case, pc.theta - h)) / (2 * h)
@@ -119,8 +120,8 @@ def contact_sets(system: DiscSystem, thetas, op: OperatingPoint) -> list[tuple[C
         angles = list(missing.values())
         pins = pin_contacts_many(system, pin_profile_contacts_many(system.geometry, angles), op.friction, op.slip)
         bearings = bearing_contacts_many(system.bearings, system.interface, crank_centres(system.case), angles)
-        for key, p, b in zip(missing, pins, bearings):
-            system.contact_sets[key] = _contact_set(system, p, b)
+        for (key, theta), p, b in zip(missing.items(), pins, bearings):
+            system.contact_sets[key] = _contact_set(system, p, b, theta)
     return [system.contact_sets[key] for key in keys]
 
 
@@ -133,9 +134,19 @@ def contact_model_key(system: DiscSystem) -> tuple:
             system.pin_stiffness_N_per_mm)
 
 
-def _contact_set(system: DiscSystem, pins, bearings) -> tuple[ContactSet, list[str]]:
-    """One angle's contact set from its pin and bearing contacts (:class:`rvfem.solve.models.ContactGroup`)."""
-    centres = crank_centres(system.case)
+def reducer_axis(case, theta: float) -> np.ndarray:
+    """The reducer axis O (the carrier's and the pin circle's centre) in the disc frame at crank
+    angle θ (rad): −e·u(θ), mm (docs/theory.md § 1)."""
+    e = case.cycloid.eccentricity
+    return np.array([-e * np.cos(theta), -e * np.sin(theta)])
+
+
+def _contact_set(system: DiscSystem, pins, bearings, theta: float) -> tuple[ContactSet, list[str]]:
+    """One angle's contact set from its pin and bearing contacts (:class:`rvfem.solve.models.ContactGroup`)
+    at crank angle θ (rad). The lever of a bearing contact is the approach per unit carrier rotation
+    about the reducer axis O: m_c = ((c_i − O) × d_c)·ẑ, c_i its bore centre, d_c its unit force on
+    the disc (the carrier with its eccentrics turns about O, docs/theory.md § 6)."""
+    centres = crank_centres(system.case) - reducer_axis(system.case, theta)
     zp = pins.size
     W = _hstack_csc(pins.W, bearings.W)
     W_load = None

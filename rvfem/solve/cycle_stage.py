@@ -34,9 +34,19 @@ tooth pitch from disc A's against the bores and holes. Two ways to model it:
 The difference between the two on the shipped RV-40E pair is measured in
 ``benchmarks/bench_reducer.py`` (see docs/theory.md).
 
-**Torque convention.** As for one disc (docs/theory.md), each disc's torque is the moment of its
-pin forces about its own centre, and the carrier rotation turns each disc's eccentric centres about
-the disc centre; the handbook's ΣP_x·e·Zc = T/2 per disc is the equal split of this total.
+**Torque convention.** The carrier with its eccentrics (and, with the input locked, the discs in
+the stiff limit) turns about the **reducer axis** O, which sits at −e·u(θ) in the disc frame: its
+rotation φ moves eccentric i by φ·ẑ×(c_i − O), and its conjugate load is the output torque as a
+moment about O (T_out for two discs, T_out/discs for one). Every pin normal passes through the
+pitch point, e·Zp from O and e·Zc from the disc centre, so the pins' moment about each disc's own
+centre is Zc/Zp of that disc's share of T_out (each disc's ``torque_Nmm``, a moment about O): the
+pin and bearing forces are Zc/Zp of the handbook's, which takes T/2 about the disc centre
+(docs/theory.md § 6).
+
+**Support-bearing clearance.** ``eccentric_play_mm`` (half of ``crank_support.radial_clearance``)
+lets each crankshaft translate in its support bearings before they carry: in the stiff limit each
+eccentric may move by that much more relative to the carrier, which the stage adds to every
+roller's clearance (:func:`stage_contact_set`).
 
 The crankshaft influence matrix comes from :func:`rvfem.fem.crankshaft.crankshaft_influence`.
 """
@@ -104,6 +114,11 @@ class ReducerStage:
         contact problem (a stage component, :mod:`rvfem.solve.stage_parts`) whose rotation under
         the output torque adds to the carrier rotation (:attr:`PairResult.output_rotation`). They
         change no contact force: the output torque passes through them whole. Empty by default.
+    eccentric_play_mm : float
+        Radial play of each crankshaft in its support bearings, mm (half their radial clearance,
+        ``crank_support.radial_clearance``): added to the clearance of every roller of the crank
+        bearings (:func:`stage_contact_set`), so that in the stiff limit each eccentric moves that
+        much relative to the carrier before the load path closes. 0 by default.
 
     A new part of the stage is a new field with a default: the stage is changed by
     :func:`dataclasses.replace` (never rebuilt positionally), so every other field is carried
@@ -115,14 +130,16 @@ class ReducerStage:
     second_phase: float
     influence: np.ndarray | None
     output_compliances: tuple[tuple[str, float], ...] = ()
+    eccentric_play_mm: float = 0.0
 
     @property
     def discs(self) -> int:
         return 1 if self.second is None else 2
 
     def carrier_torque_Nmm(self, op: OperatingPoint) -> float:
-        """Torque on the carrier from the discs modelled here at the operating point, N·mm: T_out
-        for two discs, T_out/discs for one disc (the handbook's equal share)."""
+        """Torque on the carrier from the discs modelled here at the operating point, a moment about
+        the reducer axis, N·mm: T_out for two discs, T_out/discs for one disc (the handbook's equal
+        share)."""
         return nmm_from_nm(op.torque_Nm) * self.discs / self.first.case.loads.discs
 
     @property
@@ -167,6 +184,8 @@ class ReducerStage:
                        else "with its teeth half a pitch from disc A's against the bores and holes"))
         crank = ("crank support rigid: upper bound of the flexibility effect" if self.influence is None
                  else "crankshafts as beams on elastic support bearings")
+        if self.eccentric_play_mm > 0:
+            crank += f" with {1e3 * self.eccentric_play_mm:.3g} µm radial play in the support bearings"
         springs = "".join(f"; {name} in series with the output ({1.0 / c if c > 0 else math.inf:.4g} N·mm/rad)"
                           for name, c in self.output_compliances)
         return f"{disc}; {crank}{springs}"
@@ -270,11 +289,28 @@ def _disc_angles(stage: ReducerStage, theta: float) -> list[float]:
     return [theta] if stage.second is None else [theta, theta + math.pi - stage.second_phase]
 
 
+def stage_contact_set(stage: ReducerStage, system, theta: float, op: OperatingPoint
+                      ) -> tuple[ContactSet, list[str]]:
+    """The contacts of ``system`` (one of the stage's discs) at crank angle θ (rad) as the stage
+    solves them: :func:`rvfem.solve.cycle_contacts.contact_set` with the stage's support-bearing
+    play (:attr:`ReducerStage.eccentric_play_mm`) added to every roller's clearance. The play of
+    a crankshaft in its supports and that of a bore on its eccentric add up (the set of positions
+    of each is a disc of its radius, their sum a disc of the sum of the radii)."""
+    cset, names = contact_set(system, theta, op)
+    play = stage.eccentric_play_mm
+    if play == 0.0:
+        return cset, names
+    zp = system.case.pins.count
+    offset = np.array(cset.offset, dtype=float)
+    offset[zp:] -= play
+    return dataclasses.replace(cset, offset=offset), names
+
+
 def _bodies(stage: ReducerStage, theta: float, op: OperatingPoint):
     systems = [stage.first] if stage.second is None else [stage.first, stage.second]
     thetas = _disc_angles(stage, theta)
     phases = [0.0, stage.second_phase][:len(systems)]
-    sets = [contact_set(s, th, op) for s, th in zip(systems, thetas)]
+    sets = [stage_contact_set(stage, s, th, op) for s, th in zip(systems, thetas)]
     return systems, thetas, phases, sets
 
 
@@ -402,7 +438,7 @@ def _stage_angle(stage: ReducerStage, pair: PairResult, swap: int, k: int, theta
     try:
         step = 2.0 * math.pi / order
         turned_theta = src[0].theta + k * step
-        first = turn_result(system, src[0], k, contact_set(system, turned_theta, op)[0], op)
+        first = turn_result(system, src[0], k, stage_contact_set(stage, system, turned_theta, op)[0], op)
         loads = _stage_loads(stage, [first.bearing_forces] + [_turned_bearing_forces(r, k, order) for r in src[1:]],
                              [r.solution.residual["torque_Nmm"] for r in src])     # turning keeps torques
     except ValueError as exc:

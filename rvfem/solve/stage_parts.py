@@ -274,8 +274,26 @@ class SupportBearings(StageComponent):
     held = "their support bearings"
     step = "crankshafts"
 
+    def build(self, stage: ReducerStage) -> ReducerStage:
+        """The support bearings' radial clearance (``crank_support.radial_clearance``): each
+        crankshaft's radial play in them, half the clearance, as the stage's eccentric play
+        (:attr:`~rvfem.solve.cycle_stage.ReducerStage.eccentric_play_mm`; their stiffness is in the
+        crankshaft influence matrix, :class:`Crankshafts`). Not for one disc carrying T/discs with
+        ``loads.torque_split = "equal"`` (the handbook's model, on rigid eccentrics)."""
+        case = stage.first.case
+        cs = case.crank_support
+        if cs is None or cs.radial_clearance == 0.0:
+            return stage
+        if stage.discs == 1 and case.loads.discs > 1 and case.loads.torque_split == "equal":
+            return stage
+        if stage.first.bearing_model != "rollers":
+            raise CaseError("crank_support.radial_clearance needs the 'rollers' crank-bearing model (the "
+                            "'rigid_bore' bore has no clearance to add it to): set crank_bearing.model = \"rollers\" "
+                            "or crank_support.radial_clearance = 0")
+        return dataclasses.replace(stage, eccentric_play_mm=0.5 * float(cs.radial_clearance))
+
     def stiffen(self, stage: ReducerStage) -> ReducerStage:
-        """The support bearings' (and the carrier's) stiffness × STIFFEN."""
+        """The support bearings' (and the carrier's) stiffness × STIFFEN (their clearance kept)."""
         cs = _beam_support(stage, self.name)
 
         def scale(v: float | tuple[float, ...] | None) -> float | tuple[float, ...] | None:

@@ -2,12 +2,12 @@
 
 * the linear limit (no clearance, linear pins and rollers): the loop is the existing solve scaled,
   T/φ at every step equal to T_R/φ(T_R) of one :func:`rvfem.solve.cycle.solve_pair`;
-* an equidistant modification ΔR_rp as the only backlash, stiff limit: lost motion against the
-  closed form 2·ΔR_rp/(e·Zc) (Liu et al., ΔB_c = (180·60/π)·ΔE/(e·Zc) with ΔE = 2·ΔR_rp, the normal
-  clearance of both flanks; e·Zc because the carrier rotation turns the eccentrics about the
-  disc centre, docs/theory.md);
-* a crank-bearing clearance as the only backlash, stiff limit: lost motion against 2·g/r0 (Liu et
-  al.'s ΔB_tb = (180·60/π)·Δu/a_sp with Δu = 2g the diametral play, a_sp = r0 the crank circle);
+* the profile modifications (Liu et al.'s equidistant ΔR_rp and pin-circle shift ΔR_p, each alone
+  and together), stiff limit: lost motion and backlash against the rigid kinematics of the carrier
+  and discs turning about the reducer axis, 2·(ΔR_rp − ΔR_p·√(1 − K1²))/(e·Zp) (or
+  2·√(ΔR_rp² − ΔR_p²)/Rp when the first contact is between tip and pitch point), docs/theory.md;
+* a crank-bearing clearance and a support-bearing clearance, each alone, stiff limit: lost motion
+  against 2·g·Zc/(r0·Zp) (g the radial play, half the clearance; r0 the crank circle);
 * friction: the unloading branch lies outside the loading branch by the friction's work, and
   without a clearance the loop closes at zero torque (Coulomb friction vanishes with the load).
 """
@@ -75,29 +75,87 @@ def test_linear_limit_is_the_existing_solve_scaled(mesh_dir):
     assert fig.backlash_arcmin == pytest.approx(eps * (1 / k[0] + 1 / k[1]), rel=1e-6)
 
 
-def test_equidistant_modification_lost_motion_against_closed_form(mesh_dir):
-    dr = 0.01                                                     # ΔR_rp, mm
-    stage = _stiff_stage(mesh_dir, cycloid={"modification": {"equidistant": dr}})
+def _play_closed_form(case, equidistant: float = 0.0, shift: float = 0.0) -> float:
+    """Lost motion = backlash of the rigid stage, rad, for an equidistant modification ΔR_rp and a
+    pin-circle shift ΔR_p (Liu et al.'s signs: ΔR_rp > 0 and ΔR_p < 0 open the flanks), the carrier
+    and the stiff discs turning about the reducer axis (docs/theory.md § 9b): the flank gap of the
+    pin whose normal meets the radius to it at γ is ΔR_rp − ΔR_p·cos γ, its lever about the axis
+    Rp·sin γ ≤ Rp·K1 = e·Zp; the first pin to close, both ways, gives
+    2·(ΔR_rp − ΔR_p·√(1 − K1²))/(e·Zp) if ΔR_p ≤ ΔR_rp·√(1 − K1²), else 2·√(ΔR_rp² − ΔR_p²)/Rp."""
+    e, zp, rp = case.cycloid.eccentricity, case.pins.count, case.pins.circle_radius
+    root = math.sqrt(1.0 - (e * zp / rp) ** 2)
+    if shift <= equidistant * root:
+        return 2.0 * (equidistant - shift * root) / (e * zp)
+    return 2.0 * math.sqrt(equidistant ** 2 - shift ** 2) / rp
+
+
+@pytest.mark.parametrize("modification", [{"equidistant": 0.01}, {"shift": -0.01},
+                                          {"equidistant": 0.004, "shift": -0.017},
+                                          {"equidistant": 0.01, "shift": 0.008}],
+                         ids=["equidistant", "shift", "both_open", "both_interior"])
+def test_profile_modification_lost_motion_against_closed_form(mesh_dir, modification):
+    """Each modification alone and both together, stiff limit, θ = 0 (a pin sits where the lever
+    about the axis is largest): lost motion and backlash within 0.5 % of the rigid kinematics."""
+    stage = _stiff_stage(mesh_dir, cycloid={"modification": modification})
     case = stage.first.case
-    closed = 2.0 * dr / (case.cycloid.eccentricity * case.cycloid.teeth) * ARCMIN_PER_RAD
-    for theta in np.radians([0.0, 4.5]):
-        loop = hysteresis_loop(stage, theta, T_R, steps=8)
-        fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
-        assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.02)
-        assert fig.backlash_arcmin == pytest.approx(closed, rel=0.02)
-        # e·Zp would be 2.6 % below: the model is on the e·Zc side of it
-        assert fig.backlash_arcmin > 2.0 * dr / (case.cycloid.eccentricity * case.pins.count) * ARCMIN_PER_RAD * 1.015
+    closed = _play_closed_form(case, **modification) * ARCMIN_PER_RAD
+    loop = hysteresis_loop(stage, 0.0, T_R, steps=8)
+    fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
+    assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.005)
+    assert fig.backlash_arcmin == pytest.approx(closed, rel=0.005)
+    if modification == {"equidistant": 0.01}:
+        # about the disc centre (rvfem ≤ 0.3's convention) the lever was e·Zc, 40/39 larger a play
+        zc = case.cycloid.teeth
+        assert fig.backlash_arcmin < 2.0 * 0.01 / (case.cycloid.eccentricity * zc) * ARCMIN_PER_RAD * 0.985
+
+
+def test_shift_lost_motion_goes_with_the_root_not_the_shift(mesh_dir):
+    """A pin-circle shift opens the flanks by |ΔR_p|·cos γ, not |ΔR_p|: at the pin of the largest
+    lever about the axis cos γ = √(1 − K1²) (0.583 for the RV-40E), so the lost motion is well
+    below the 2|ΔR_p|/(e·Zp) of an equidistant modification of the same size."""
+    stage = _stiff_stage(mesh_dir, cycloid={"modification": {"shift": -0.01}})
+    case = stage.first.case
+    k1 = case.cycloid.eccentricity * case.pins.count / case.pins.circle_radius
+    loop = hysteresis_loop(stage, 0.0, T_R, steps=8)
+    fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
+    equidistant = 2.0 * 0.01 / (case.cycloid.eccentricity * case.pins.count) * ARCMIN_PER_RAD
+    assert fig.lost_motion_arcmin / equidistant == pytest.approx(math.sqrt(1.0 - k1 ** 2), rel=0.005)
 
 
 def test_crank_bearing_clearance_lost_motion_against_closed_form(mesh_dir):
+    """A crank-bearing radial play g (clearance 2g) alone, stiff limit: the pins let the disc turn
+    about the pitch point only; turning it by −φ/Zc while the carrier turns φ about the axis leaves
+    the eccentrics a rotation φ·Zp/Zc about the disc centre relative to it, which moves every bore by
+    the same φ·r0·Zp/Zc (the smallest largest one, docs/theory.md § 9b): lost motion
+    2g·Zc/(r0·Zp)."""
     clearance = 0.01                                              # diametral, mm: play g = 5 µm
     stage = _stiff_stage(mesh_dir, crank_bearing={"radial_clearance": clearance})
     case = stage.first.case
-    closed = clearance / case.cranks.circle_radius * ARCMIN_PER_RAD     # 2·g/r0
+    closed = clearance * case.cycloid.teeth / (case.cranks.circle_radius * case.pins.count) * ARCMIN_PER_RAD
     loop = hysteresis_loop(stage, 0.0, T_R, steps=8)
     fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
-    assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.02)
-    assert fig.backlash_arcmin == pytest.approx(closed, rel=0.02)
+    assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.005)
+    assert fig.backlash_arcmin == pytest.approx(closed, rel=0.005)
+
+
+def test_support_bearing_clearance_lost_motion_against_closed_form(mesh_dir):
+    """The support bearings' radial clearance alone (crank_support.radial_clearance, stiff
+    crankshaft and supports): each crankshaft's play in its supports moves the eccentrics like the
+    crank bearing's play, lost motion 2g_s·Zc/(r0·Zp); with both clearances the plays add."""
+    clearance = 0.01
+    tables = dict(crank_support={"span": 33.0, "eccentric_positions": [11.5, 21.5],
+                                 "journal_diameter": 500.0,
+                                 "support_stiffness_N_per_mm": 1e10, "radial_clearance": clearance})
+    stage = _stiff_stage(mesh_dir, **tables)
+    from rvfem.solve.stage_parts import build_components
+    stage = build_components(stage)
+    assert stage.eccentric_play_mm == pytest.approx(0.5 * clearance) and stage.influence is not None
+    case = stage.first.case
+    closed = clearance * case.cycloid.teeth / (case.cranks.circle_radius * case.pins.count) * ARCMIN_PER_RAD
+    loop = hysteresis_loop(stage, 0.0, T_R, steps=8)
+    fig = accuracy_figures(loop.torque_Nm, loop.rotation_rad, loop.branch, T_R)
+    assert fig.lost_motion_arcmin == pytest.approx(closed, rel=0.005)
+    assert fig.backlash_arcmin == pytest.approx(closed, rel=0.005)
 
 
 def test_friction_opens_the_loop_and_closes_it_at_zero_torque(mesh_dir):

@@ -6,6 +6,7 @@ with the default sizes lives in ``benchmarks/bench_convergence.py``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -55,6 +56,11 @@ def test_rigid_limit_reproduces_handbook_and_classical_pin_forces(solid):
                                 bearing_stiffness_scale=1e3, pin_model="linear",
                                 pin_stiffness_N_per_mm=3e5)
     result = cycle.load_cycle(system, THETA, saved_angles_deg=(), stage=cycle.single_disc_stage(system))
+    # the carrier torque is a moment about the reducer axis; every pin normal passes through the
+    # pitch point, e·Zp from the axis and e·Zc from the disc centre: the handbook's T/2 about the
+    # disc centre is T/2·Zc/Zp
+    case = case.replace(loads=dataclasses.replace(case.loads, torque_Nm=case.loads.torque_Nm
+                                                  * case.cycloid.teeth / case.pins.count))
     hb = rigid.handbook_bearing_loads(case, THETA)
     f_max = hb.magnitude.max()
     assert np.abs(result.bearing_loads.T - hb.magnitude).max() <= 0.03 * f_max
@@ -105,9 +111,12 @@ def solid_cycle(solid):
 def test_equilibrium_closes_to_round_off(solid_cycle):
     case, system, result = solid_cycle
     assert result.equilibrium_residual.max() < 1e-9
-    # carrier: the bearings' moment about the disc centre is the disc torque at every angle
-    c = cycle.crank_centres(case)
-    moment = (c[None, :, 0] * result.bearing_forces[..., 1] - c[None, :, 1] * result.bearing_forces[..., 0]).sum(axis=1)
+    # carrier: the bearings' moment about the reducer axis (at −e·u(θ) in the disc frame) is the
+    # disc's torque share at every angle
+    e = case.cycloid.eccentricity
+    c = cycle.crank_centres(case)[None] + e * np.stack([np.cos(THETA), np.sin(THETA)], axis=-1)[:, None]
+    f = result.bearing_forces
+    moment = (c[..., 0] * f[..., 1] - c[..., 1] * f[..., 0]).sum(axis=1)
     assert np.allclose(moment, case.loads.disc_torque_Nmm, rtol=1e-9)
     # pins + bearings of one solution: no net force and no net moment on the disc
     for th in THETA[::6]:

@@ -3,6 +3,7 @@ discs on one carrier against the rigid limit, equilibrium, symmetry and their ow
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -135,10 +136,13 @@ def test_pair_equilibrium_of_both_discs_and_the_carrier(fan_pair_cycle):
     assert np.allclose(result.disc_torque_Nmm.sum(axis=1), T, rtol=1e-12)
     # each disc: pins and bearings balance (force residual relative to the contact forces)
     assert result.equilibrium_residual.max() < 1e-12     # measured 4e-16
-    c = cycle.crank_centres(case)
+    e = case.cycloid.eccentricity
     for k in range(2):
+        # about the reducer axis, at −e·u(θ_k) from disc k's centre (disc B at θ + π)
+        th = result.theta + k * math.pi
+        c = cycle.crank_centres(case)[None] + e * np.stack([np.cos(th), np.sin(th)], axis=-1)[:, None]
         f = result.disc_bearing_forces[:, k]
-        moment = (c[None, :, 0] * f[..., 1] - c[None, :, 1] * f[..., 0]).sum(axis=1)
+        moment = (c[..., 0] * f[..., 1] - c[..., 1] * f[..., 0]).sum(axis=1)
         assert np.allclose(moment, result.disc_torque_Nmm[:, k], rtol=1e-9)
     # the torque swings about T/2 (the stiffness of each disc changes as its loaded flank passes
     # bores, spokes and holes) by several per cent on the fan-hole disc
@@ -209,6 +213,9 @@ def test_stiff_discs_share_the_torque_equally_and_give_the_handbook_loads(tmp_pa
     T = case.loads.torque_Nm * 1000.0
     share = result.disc_torque_Nmm / (T / 2)
     assert np.abs(share - 1).max() < 0.005
+    # the output torque about the reducer axis is T·Zc/Zp about the disc centres (the handbook's)
+    case = case.replace(loads=dataclasses.replace(case.loads, torque_Nm=case.loads.torque_Nm
+                                                  * case.cycloid.teeth / case.pins.count))
     hb = rigid.handbook_bearing_loads(case, THETA)
     assert np.abs(result.bearing_loads.T - hb.magnitude).max() <= 0.03 * hb.magnitude.max()
 
