@@ -196,10 +196,17 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
 
 def lamina_ratings(case, slices):
     """Basic dynamic load ratings of the laminae on the inner and outer raceway, N (ISO/TS 16281,
-    line contact): q_c = 552·b_m·λν·γ^(2/9)·(1 ∓ γ)^(29/27)/(1 ± γ)^(1/4)·D_we^(29/27)·
-    w^(7/9)·Z^(−1/4), upper signs for the inner raceway, w the lamina width (L_we/n_s for n_s
-    equal laminae). b_m and λν as in the case's basic rating C (ISO 281), so that the two lives
-    rest on the same material and edge factors.
+    line contact): q_c = 552·b_m·γ^(2/9)·(1 ∓ γ)^(29/27)/(1 ± γ)^(1/4)·D_we^(29/27)·w^(7/9)·Z^(−1/4),
+    upper signs for the inner raceway, w the lamina width (L_we/n_s for n_s equal laminae).
+
+    b_m as in the case's basic rating C (ISO 281). λν is **not** in the lamina ratings: ISO/TS
+    16281 derives the rolling-element ratings of the raceways from C divided by λν (Q_c =
+    C/(λν·0.378·Z·cos α·i^(7/9))·[1 + (1.038·((1 ∓ γ)/(1 ± γ))^(143/108))^(±9/2)]^(2/9), λν = 0.83
+    for radial roller bearings; q_c = Q_c·(1/n_s)^(7/9)), because λν stands in ISO 281 for the
+    edge stresses and the non-uniform stress along a real roller (ISO/TR 1281-1), which the lamina
+    loads compute explicitly — here the half-space slice model with the roller's profile and
+    tilt. 552 ≈ 208/0.378. So at P = C on rigid rings L10r = λν^(−4)·10⁶ revolutions (line
+    contact); with λν = 1 it is C's 10⁶.
 
     ``slices`` is the number n_s of equal laminae over L_we (two floats returned), or the widths of
     unequal laminae in mm (two arrays): the rating of a lamina scales with its width^(7/9), so
@@ -209,7 +216,7 @@ def lamina_ratings(case, slices):
     b = case.crank_bearing
     g = b.roller_diameter / b.pitch_diameter
     width = b.roller_length / slices if np.isscalar(slices) else np.asarray(slices, dtype=float)
-    common = (552.0 * b.b_m * b.lambda_nu * g ** (2.0 / 9.0) * b.roller_diameter ** (29.0 / 27.0)
+    common = (552.0 * b.b_m * g ** (2.0 / 9.0) * b.roller_diameter ** (29.0 / 27.0)
               * width ** (7.0 / 9.0) * b.rollers ** -0.25)
     inner = common * (1.0 - g) ** (29.0 / 27.0) / (1.0 + g) ** 0.25
     outer = common * (1.0 + g) ** (29.0 / 27.0) / (1.0 - g) ** 0.25
