@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from rvfem.evaluate import roller_life
 from rvfem.results.analysis import rigid_bearing_forces
 from rvfem.results.screen_lines import sig
@@ -34,7 +36,9 @@ def compute(inputs: Any) -> tuple[roller_life.L10rSteps, ...] | None:
     if case.analysis.friction > 0.0:
         op = OperatingPoint(float(case.loads.torque_Nm), 0.0)
         forces = load_cycle(inputs["system"], theta, op=op, saved_angles_deg=()).bearing_forces
-    return roller_life.l10r_steps(case, theta, cycle, rigid_bearing_forces(rigid, theta), forces,
+    handbook = rigid_bearing_forces(rigid, theta)
+    assert isinstance(handbook, np.ndarray)           # the handbook is defined (checked above)
+    return roller_life.l10r_steps(case, theta, cycle, handbook, forces,
                                   rigid.bearing_speed_rpm,
                                   bearings=[b.loads.bearing for b in rigid.bearings if b.depth is not None])
 
