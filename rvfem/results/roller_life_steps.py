@@ -12,6 +12,7 @@ from rvfem.evaluate import roller_life
 from rvfem.results.analysis import rigid_bearing_forces
 from rvfem.results.screen_lines import sig
 from rvfem.results.section import KeyRow, Section, SummaryContext
+from rvfem.solve.cycle import OperatingPoint, load_cycle
 
 __all__ = ["SECTION", "FACTORS", "compute", "summary", "screen", "report"]
 
@@ -26,8 +27,6 @@ def compute(inputs: Any) -> tuple[roller_life.L10rSteps, ...] | None:
     """The steps of every bearing: the handbook forces and the flexible cycle's forces and rollers,
     and the flexible cycle solved again without pin friction (on the background thread, beside the
     other stages; not solved when the case has no friction)."""
-    from rvfem.solve.cycle import OperatingPoint, load_cycle
-
     case, cycle, rigid = inputs["case"], inputs["cycle"], inputs["rigid"]
     if not rigid.defined or not any(b.depth is not None for b in rigid.bearings):
         return None
