@@ -48,6 +48,10 @@ __all__ = [
     "CrankBearingDepth",
     "crank_bearing_depth",
     "rigid_bearing_depths",
+    "cycle_l10r_h",
+    "L10R_STEPS",
+    "L10rSteps",
+    "l10r_steps",
 ]
 
 log = logging.getLogger(__name__)
@@ -192,10 +196,17 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
 
 def lamina_ratings(case, slices):
     """Basic dynamic load ratings of the laminae on the inner and outer raceway, N (ISO/TS 16281,
-    line contact): q_c = 552·b_m·λν·γ^(2/9)·(1 ∓ γ)^(29/27)/(1 ± γ)^(1/4)·D_we^(29/27)·
-    w^(7/9)·Z^(−1/4), upper signs for the inner raceway, w the lamina width (L_we/n_s for n_s
-    equal laminae). b_m and λν as in the case's basic rating C (ISO 281), so that the two lives
-    rest on the same material and edge factors.
+    line contact): q_c = 552·b_m·γ^(2/9)·(1 ∓ γ)^(29/27)/(1 ± γ)^(1/4)·D_we^(29/27)·w^(7/9)·Z^(−1/4),
+    upper signs for the inner raceway, w the lamina width (L_we/n_s for n_s equal laminae).
+
+    b_m as in the case's basic rating C (ISO 281). λν is **not** in the lamina ratings: ISO/TS
+    16281 derives the rolling-element ratings of the raceways from C divided by λν (Q_c =
+    C/(λν·0.378·Z·cos α·i^(7/9))·[1 + (1.038·((1 ∓ γ)/(1 ± γ))^(143/108))^(±9/2)]^(2/9), λν = 0.83
+    for radial roller bearings; q_c = Q_c·(1/n_s)^(7/9)), because λν stands in ISO 281 for the
+    edge stresses and the non-uniform stress along a real roller (ISO/TR 1281-1), which the lamina
+    loads compute explicitly — here the half-space slice model with the roller's profile and
+    tilt. 552 ≈ 208/0.378. So at P = C on rigid rings L10r = λν^(−4)·10⁶ revolutions (line
+    contact); with λν = 1 it is C's 10⁶.
 
     ``slices`` is the number n_s of equal laminae over L_we (two floats returned), or the widths of
     unequal laminae in mm (two arrays): the rating of a lamina scales with its width^(7/9), so
@@ -205,7 +216,7 @@ def lamina_ratings(case, slices):
     b = case.crank_bearing
     g = b.roller_diameter / b.pitch_diameter
     width = b.roller_length / slices if np.isscalar(slices) else np.asarray(slices, dtype=float)
-    common = (552.0 * b.b_m * b.lambda_nu * g ** (2.0 / 9.0) * b.roller_diameter ** (29.0 / 27.0)
+    common = (552.0 * b.b_m * g ** (2.0 / 9.0) * b.roller_diameter ** (29.0 / 27.0)
               * width ** (7.0 / 9.0) * b.rollers ** -0.25)
     inner = common * (1.0 - g) ** (29.0 / 27.0) / (1.0 + g) ** 0.25
     outer = common * (1.0 + g) ** (29.0 / 27.0) / (1.0 - g) ** 0.25
@@ -321,6 +332,28 @@ class BearingDepth:
     max_roller: int = -1
 
 
+def _cycle_damage(case, slice_loads, dx) -> float:
+    """Palmgren–Miner damage per million revolutions over a cycle, mean_θ 1/L10r(θ), from the slice
+    loads per length of both raceways (N/mm, (n, Z, n_s) each) and the slice widths dx (mm)."""
+    q_ci, q_ce = lamina_ratings(case, dx)
+    # the eccentric turns relative to the load (whose direction swings by about 100° in the disc
+    # frame but does not follow the crank); the bore stands relative to it
+    per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
+    return float(np.mean(1.0 / per_angle))
+
+
+def cycle_l10r_h(case, roller_loads: np.ndarray, tilts: np.ndarray, bearing_speed_rpm: float,
+                 cache: dict | None = None) -> float:
+    """ISO/TS 16281 L10r (h) of one bearing over a load cycle from its roller loads and tilts,
+    (n, Z) each: the slices of both raceways (:func:`cycle_slices`) and Palmgren–Miner over the
+    cycle, exactly as :func:`bearing_depth` computes its ``L10r_h``."""
+    b = case.crank_bearing
+    slice_loads = [cycle_slices(roller_loads, tilts, b.roller_length, g, b.profile, cache=cache) for g in raceways(case)]
+    _, dx = roller_slices.slice_layout(b.profile, b.roller_length)
+    damage = _cycle_damage(case, slice_loads, dx)
+    return math.inf if damage == 0 else 1.0e6 / (60.0 * bearing_speed_rpm) / damage
+
+
 def _peak(case, theta, loads, tilts, slice_loads, geoms):
     """(raceway index, angle, roller, p(x) array) of the largest slice pressure of one bearing."""
     best = None
@@ -383,11 +416,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     a_iso = lubrication.a_iso_roller(kappa, lubrication.contamination_factor(lub) * cu / equivalent_load_N)
     to_hours = 1.0e6 / (60.0 * bearing_speed_rpm)
     l10h = to_hours * (rating_N / equivalent_load_N) ** ROLLER_LIFE_EXPONENT
-    q_ci, q_ce = lamina_ratings(case, dx)
-    # the eccentric turns relative to the load (whose direction swings by about 100° in the disc
-    # frame but does not follow the crank); the bore stands relative to it
-    per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
-    damage = float(np.mean(1.0 / per_angle))
+    damage = _cycle_damage(case, slice_loads, dx)
     k_max, j_max = np.unravel_index(int(np.argmax(roller_loads)), roller_loads.shape)
     return BearingDepth(
         bearing=bearing, model=model, roller_peak_pressure_MPa=worst.peak_pressure_MPa,
@@ -410,8 +439,10 @@ class CrankBearingDepth:
     flexible : tuple of BearingDepth
         From the FE roller loads, the crankshaft's tilt and the extra misalignment.
     rigid : tuple of BearingDepth
-        From the handbook bearing forces on rigid rings without clearance and untilted rollers
-        (empty where the handbook is not defined).
+        From the handbook bearing forces on rigid rings with the case's clearance or preload and
+        the same roller law as the FE's rigid-disc limit (Palmgren's two contacts), rollers
+        untilted but for the extra misalignment (:func:`rigid_bearing_depths`; empty where the
+        handbook is not defined).
     max_slope_mrad : float
         Largest crankshaft slope at an eccentric over the cycle, mrad (0 with rigid support).
     seconds : float
@@ -512,3 +543,92 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
         if progress is not None:
             progress(len(depths), len(equivalent_loads_N))
     return tuple(depths)
+
+
+L10R_STEPS = ("handbook", "flexible_forces_frictionless", "flexible_forces", "flexible_rollers_untilted", "flexible")
+"""The load models of :func:`l10r_steps`, from the rigid reference to the flexible column."""
+
+
+@dataclass(frozen=True)
+class L10rSteps:
+    """The flexible/rigid L10r ratio of one bearing as a product of factors (:func:`l10r_steps`).
+
+    Attributes
+    ----------
+    bearing : int
+        0-based bearing.
+    L10r_h : dict of str to float
+        L10r (h) of every load model of :data:`L10R_STEPS`: ``handbook`` the handbook forces on
+        rigid rings (the in-depth rigid column); ``flexible_forces_frictionless`` and
+        ``flexible_forces`` the FE bearing forces without and with the pin friction on the same
+        rigid rings; ``flexible_rollers_untilted`` the FE roller loads, rollers untilted;
+        ``flexible`` the FE roller loads with the crankshaft's tilt (the flexible column). Every
+        model has the case's clearance or preload and its extra misalignment.
+    factors : dict of str to float
+        ``pin_friction`` = flexible_forces / flexible_forces_frictionless, ``bearing_forces`` =
+        flexible_forces_frictionless / handbook, ``load_sharing`` = flexible_rollers_untilted /
+        flexible_forces, ``tilt`` = flexible / flexible_rollers_untilted.
+    ratio : float
+        flexible / handbook, the product of the factors.
+    """
+
+    bearing: int
+    L10r_h: dict
+    factors: dict
+    ratio: float
+
+
+def l10r_steps(case, theta: np.ndarray, cycle, handbook_forces: np.ndarray, frictionless_forces: np.ndarray,
+               bearing_speed_rpm: float, bearings=None) -> tuple[L10rSteps, ...]:
+    """The flexible/rigid L10r ratio of every bearing taken apart in steps: handbook → pin friction →
+    flexible bearing forces → load sharing → tilt, each a factor, their product the ratio.
+
+    Every step is one load model of :data:`L10R_STEPS` through the same slices and lamina life
+    (:func:`cycle_l10r_h`); the rigid rings are those of the rigid column (the case's clearance or
+    preload, Palmgren's two contacts, :func:`rvfem.evaluate.roller_slices.case_rigid_roller_loads`).
+    The handbook has no pin friction, so the friction's factor is measured on the flexible disc:
+    its bearing forces with the case's μ against the same cycle solved with μ = 0.
+
+    Parameters
+    ----------
+    case : Case
+    theta : ndarray (n,)
+        Crank angles, rad.
+    cycle : rvfem.solve.cycle.CycleResult
+        The case's flexible cycle (bearing model ``rollers``).
+    handbook_forces, frictionless_forces : ndarray (n, N, 2)
+        The handbook bearing forces and the flexible ones with μ = 0 (the cycle's own where the case
+        has no friction), N.
+    bearing_speed_rpm : float
+    bearings : iterable of int, optional
+        0-based bearings (default all).
+    """
+    theta = np.asarray(theta, dtype=float)
+    misalignment = 1e-3 * case.crank_bearing.profile.misalignment_mrad
+    angles = roller_slices.roller_angles(case, theta)
+    slopes = eccentric_slopes(case, cycle)
+    tilted = roller_tilts(slopes, cycle.roller_angles, cycle.bearing_forces, misalignment)
+    untilted = roller_tilts(np.zeros_like(slopes), cycle.roller_angles, cycle.bearing_forces, misalignment)
+    rings = {}
+    for key, forces in (("handbook", handbook_forces), ("flexible_forces_frictionless", frictionless_forces),
+                        ("flexible_forces", cycle.bearing_forces)):
+        forces = np.asarray(forces, dtype=float)
+        rings[key] = (roller_slices.case_rigid_roller_loads(case, theta, forces),
+                      roller_tilts(np.zeros(forces.shape), angles, forces, misalignment))
+    models = {**rings, "flexible_rollers_untilted": (cycle.roller_loads, untilted),
+              "flexible": (cycle.roller_loads, tilted)}
+    cache: dict = {}
+    out = []
+    for i in (range(cycle.bearing_forces.shape[1]) if bearings is None else bearings):
+        life = {key: cycle_l10r_h(case, models[key][0][:, i], models[key][1][:, i], bearing_speed_rpm, cache)
+                for key in L10R_STEPS}
+
+        def ratio(a, b):
+            return life[a] / life[b] if life[b] and math.isfinite(life[b]) else math.nan
+
+        factors = {"pin_friction": ratio("flexible_forces", "flexible_forces_frictionless"),
+                   "bearing_forces": ratio("flexible_forces_frictionless", "handbook"),
+                   "load_sharing": ratio("flexible_rollers_untilted", "flexible_forces"),
+                   "tilt": ratio("flexible", "flexible_rollers_untilted")}
+        out.append(L10rSteps(bearing=i, L10r_h=life, factors=factors, ratio=ratio("flexible", "handbook")))
+    return tuple(out)

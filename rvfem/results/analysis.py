@@ -29,7 +29,7 @@ if TYPE_CHECKING:  # the heavier modules are imported where used
     from rvfem.evaluate.design_checks import DesignChecks
     from rvfem.evaluate.postprocess import FieldSnapshot, HotSpotHistory, PeakStress, RecoveredPeak
     from rvfem.evaluate.rigid import PinForces, References
-    from rvfem.evaluate.roller_life import BearingDepth, CrankBearingDepth
+    from rvfem.evaluate.roller_life import BearingDepth, CrankBearingDepth, L10rSteps
     from rvfem.evaluate.validity import ResultWarning
     from rvfem.geometry import DiscGeometry
     from rvfem.mesh import DiscMesh
@@ -346,6 +346,10 @@ class Analysis:
     roller_depth : rvfem.evaluate.roller_life.CrankBearingDepth or None
         The crank bearing in depth (slice pressures, film, κ, a_ISO, L_nm, L10r; rigid and flexible);
         None for a bearing model without discrete rollers.
+    roller_life_steps : tuple of rvfem.evaluate.roller_life.L10rSteps or None
+        The flexible/rigid L10r ratio of every bearing in steps (handbook → pin friction → flexible
+        bearing forces → load sharing → tilt), each a factor; None without discrete rollers or
+        without the handbook.
     accuracy : dict or None
         Torsional rigidity (N·m/arcmin) and lost motion (arcmin) of the stage at the case's torque
         from a few points of the hysteresis loop at crank angle 0 (:func:`run_accuracy`); None when
@@ -379,6 +383,7 @@ class Analysis:
     references: References | None = None
     warnings: tuple[ResultWarning, ...] = ()
     roller_depth: CrankBearingDepth | None = None
+    roller_life_steps: tuple[L10rSteps, ...] | None = None
     accuracy: dict[str, Any] | None = None
     bearing_checks: BearingChecks | None = None
     mass_strength: DesignChecks | None = None

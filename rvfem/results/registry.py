@@ -35,6 +35,7 @@ from rvfem.results import (
     reducer_stage,
     references,
     roller_depth,
+    roller_life_steps,
     stress,
     warnings,
 )
@@ -57,6 +58,7 @@ BUILTIN_SECTIONS: tuple[Section, ...] = (
     reducer_stage.SECTION,
     attribution.SECTION,
     roller_depth.SECTION,
+    roller_life_steps.SECTION,
     bearing_checks.SECTION,
     accuracy.SECTION,
     files.SECTION,

@@ -60,6 +60,8 @@ from rvfem.solve.contact_laws import (
     hertz_pin_law,
     linear_law,
     palmgren_law,
+    roller_bore_approach,
+    roller_bore_law,
 )
 from rvfem.solve.contact_newton import (
     OPEN_SPRING_FRACTION,
@@ -90,6 +92,8 @@ __all__ = [
     "AngleSolution",
     "build_interface",
     "palmgren_law",
+    "roller_bore_approach",
+    "roller_bore_law",
     "linear_law",
     "hertz_pin_approach",
     "hertz_pin_law",

@@ -203,3 +203,121 @@ def hertz_pin_law(**params):
         return q, dq
 
     return law
+
+
+def roller_bore_approach(Q, *, length: float, reduced_radius_bore: float, disc_modulus: float,
+                         disc_poisson: float, footprint_half_width: float, disc_stiffness_scale: float = 1.0):
+    """Approach δ (mm) of a crank-bearing roller between eccentric and bore at the force Q (N), and
+    dδ/dQ (mm/N): Palmgren's two line contacts less the bore's local contact compliance that the FE
+    bore footprint already holds (:func:`roller_bore_law`).
+
+    Parameters
+    ----------
+    Q : array_like
+        Roller force, N (≥ 0).
+    length : float
+        Effective roller length L, mm.
+    reduced_radius_bore : float
+        R' of roller and bore (1/R' = 1/R_roller − 1/R_bore), mm.
+    disc_modulus, disc_poisson : float
+        E (MPa) and ν of the disc (the bore's body; the roller and the eccentric of the same steel
+        in Palmgren's law).
+    footprint_half_width : float
+        Half-width w of the elliptical footprint over which the FE model spreads a roller's force
+        on the bore, mm.
+    disc_stiffness_scale : float
+        The factor on the disc's Young's modulus in the FE model (1; 10³ in the rigid-limit checks):
+        the FE bore then holds 1/scale of the local compliance, and the law gives back the rest.
+
+    Returns
+    -------
+    delta, ddelta_dQ : ndarray
+
+    Notes
+    -----
+    Palmgren's law, δ_P = 2·c₁·Q^0.9 with c₁ = 3.84·10⁻⁵/L^0.8 ([HK]), is the approach of the
+    roller between two rigid ring bodies: each of its two contacts holds the local compliance of the
+    roller's side and of the ring's. On the FE disc the bore is the ring, and its footprint (an
+    elliptical pressure of half-width w, Bᵀu the pressure-weighted mean displacement) already
+    deforms the bore locally. On a half-plane (plane strain) the approach of a surface under an
+    elliptical pressure of half-width c, referred to a point at depth z ≫ c, is
+    K·Q·[ln(2z/c) + const] with K = 2(1 − ν²)/(π·E·L) (Johnson, *Contact Mechanics*, § 2.8 and
+    § 4.2); the constant is the same for every c. With the bore's half of one Palmgren contact,
+    c₁·Q^0.9/2 (two steel bodies of the same law), as its Hertz part (c = a, the Hertz
+    half-width a = √(4·Q·R'/(π·E*·L))), the part the footprint holds at the same depth is
+
+        δ_loc = c₁·Q^0.9/2 − K·Q·ln(w/a),
+
+    the depth cancels (as in the pin law, :func:`hertz_pin_approach`). The roller's spring is
+    δ = δ_P − δ_loc/s (s the disc's stiffness scale), so that spring + FE footprint = Palmgren's
+    law for a disc that deforms only locally: the bore's local compliance counted once. s → ∞ (a
+    rigid disc) gives Palmgren's law; w → a (a footprint as narrow as the contact) gives
+    1.5·c₁·Q^0.9 (the eccentric's contact and the roller's side of the bore's). Where a would
+    pass w (a footprint narrower than the contact; some 10⁴ N per mm of roller for the shipped
+    bearings, far beyond any roller load, but a trial approach of the solver may get there) δ is
+    continued linearly with its tangent (dδ/dQ > 0 there for s ≥ 1).
+    """
+    Q = np.maximum(np.asarray(Q, dtype=float), 0.0)
+    c1 = PALMGREN_COEFFICIENT / length**0.8
+    k = 2.0 * (1.0 - disc_poisson**2) / (np.pi * disc_modulus * length)
+    e_star = disc_modulus / (2.0 * (1.0 - disc_poisson**2))             # two bodies of the disc's steel
+    w, s = float(footprint_half_width), float(disc_stiffness_scale)
+    q_lim = np.pi * e_star * length * w * w / (4.0 * reduced_radius_bore)   # a = w
+
+    def parts(q):
+        q = np.maximum(q, 1e-300)
+        ln_wa = np.log(w) - 0.5 * np.log(4.0 * q * reduced_radius_bore / (np.pi * e_star * length))
+        d = 2.0 * c1 * q**0.9 - (0.5 * c1 * q**0.9 - k * q * ln_wa) / s
+        dd = 1.8 * c1 * q**-0.1 - (0.45 * c1 * q**-0.1 - k * (ln_wa - 0.5)) / s
+        return d, dd
+
+    beyond = Q > q_lim
+    d, dd = parts(np.where(beyond, q_lim, Q))
+    delta = np.where(beyond, d + dd * (Q - q_lim), d)
+    return np.where(Q > 0.0, delta, 0.0), dd
+
+
+def roller_bore_law(*, length: float, reduced_radius_bore: float, disc_modulus: float, disc_poisson: float,
+                    footprint_half_width: float, disc_stiffness_scale: float = 1.0):
+    """Force–approach law of a crank-bearing roller on the FE bore: Palmgren's two line contacts with
+    the bore's local contact compliance counted once (:func:`roller_bore_approach`), inverted:
+    ``law(delta) -> (Q, dQ/dδ)``. δ ≤ 0 gives Q = 0 and dQ/dδ = 0 (compression only).
+
+    The inversion interpolates ln Q against ln δ on a table of δ(Q) (ln δ is increasing in ln Q,
+    400 points from 10⁻⁶ N to the continuation point) and polishes the result with one Newton step
+    on ln Q (to about 10⁻¹⁰ relative); beyond the tangent continuation of
+    :func:`roller_bore_approach` it is linear.
+    """
+    params = dict(length=length, reduced_radius_bore=reduced_radius_bore, disc_modulus=disc_modulus,
+                  disc_poisson=disc_poisson, footprint_half_width=footprint_half_width,
+                  disc_stiffness_scale=disc_stiffness_scale)
+    e_star = disc_modulus / (2.0 * (1.0 - disc_poisson**2))
+    w = float(footprint_half_width)
+    q_lim = np.pi * e_star * length * w * w / (4.0 * reduced_radius_bore)
+    d_lim, slope_lim = (float(v) for v in roller_bore_approach(q_lim, **params))
+    table_q = np.geomspace(1e-6, q_lim, 400)
+    table_ln_d = np.log(roller_bore_approach(table_q, **params)[0])
+    table_ln_q = np.log(table_q)
+
+    def law(delta):
+        d = np.asarray(delta, dtype=float)
+        q = np.zeros(d.shape)
+        dq = np.zeros(d.shape)
+        pos = d > 0.0
+        if not np.any(pos):
+            return q, dq
+        dp = d[pos]
+        lin = dp > d_lim
+        target = np.log(np.minimum(dp, d_lim))
+        # below the table: δ ∝ Q^0.9 to within the ln term's change, extrapolated so
+        ln_q = np.where(target < table_ln_d[0], table_ln_q[0] + (target - table_ln_d[0]) / 0.9,
+                        np.interp(target, table_ln_d, table_ln_q))
+        d_, dd_ = roller_bore_approach(np.exp(ln_q), **params)
+        ln_q = ln_q - (np.log(d_) - target) * d_ / (np.exp(ln_q) * dd_)     # f = ln δ(Q) − ln δ*
+        qp = np.where(lin, q_lim + (dp - d_lim) / slope_lim, np.exp(ln_q))
+        _, slope = roller_bore_approach(qp, **params)
+        q[pos] = qp
+        dq[pos] = 1.0 / slope
+        return q, dq
+
+    return law

@@ -170,7 +170,11 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     pin_model = pin_model or case.pins.model
     try:
         pins = models.pin_model(pin_model)(case, pin_stiffness_N_per_mm)
-        bearings = models.bearing_model(bearing_model)(case, bearing_stiffness_scale)
+        bearing_class = models.bearing_model(bearing_model)
+        # a model whose law complements the FE bore's own compliance is told the disc's stiffness scale
+        bearings = (bearing_class(case, bearing_stiffness_scale, disc_stiffness_scale=stiffness_scale)
+                    if getattr(bearing_class, "takes_disc_stiffness_scale", False)
+                    else bearing_class(case, bearing_stiffness_scale))
     except KeyError as exc:
         raise CaseError(exc.args[0]) from None
     times = {}

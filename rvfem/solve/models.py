@@ -220,24 +220,38 @@ class RollerBearing:
 
     The approach of a roller is the radial relative displacement of eccentric and bore minus half
     the radial clearance; its law is Palmgren's line contact for both raceways (Harris & Kotzalas,
-    *Rolling Bearing Analysis*) or a linear stiffness. Rollers sit at their cage positions
-    (:func:`roller_angles`); each roller's force is shared by the two nearest bore columns.
+    *Rolling Bearing Analysis*) less the bore's local contact compliance that the FE bore footprint
+    already holds (:func:`rvfem.solve.contact_laws.roller_bore_law`: the bore's compliance counted
+    once, as the Hertz pin law does for the flank), or a linear stiffness. Rollers sit at their cage
+    positions (:func:`roller_angles`); each roller's force is shared by the two nearest bore columns.
+
+    ``disc_stiffness_scale`` is the factor on the disc's Young's modulus of the FE model it loads
+    (:func:`rvfem.solve.cycle_system.build_system` passes it, :attr:`takes_disc_stiffness_scale`):
+    a stiffened disc holds that much less of the bore's local compliance, and the law gives it back
+    (Palmgren's law in the rigid-disc limit).
     """
 
     name = "rollers"
+    takes_disc_stiffness_scale: ClassVar[bool] = True
 
-    def __init__(self, case: Case, stiffness_scale: float = 1.0) -> None:
+    def __init__(self, case: Case, stiffness_scale: float = 1.0, *, disc_stiffness_scale: float = 1.0) -> None:
         self.case = case
         b = case.crank_bearing
         if b.stiffness_law == "palmgren":
-            self._law = contact.palmgren_law(b.roller_length, contacts=2)
+            r = 0.5 * b.roller_diameter
+            self._law = contact.roller_bore_law(
+                length=b.roller_length, reduced_radius_bore=r * b.bore_radius / (b.bore_radius - r),
+                disc_modulus=case.material.youngs_modulus, disc_poisson=case.material.poissons_ratio,
+                footprint_half_width=FOOTPRINT_ELEMENTS * case.mesh.size_bore,
+                disc_stiffness_scale=disc_stiffness_scale)
         else:
             assert b.linear_stiffness_N_per_mm is not None      # the case requires it with the linear law
             self._law = contact.linear_law(b.linear_stiffness_N_per_mm)
 
     def describe(self) -> str:
         b = self.case.crank_bearing
-        law = ("Palmgren line contact on both raceways" if b.stiffness_law == "palmgren"
+        law = ("Palmgren line contact on both raceways, the bore's local compliance left to the FE bore"
+               if b.stiffness_law == "palmgren"
                else f"a linear stiffness of {b.linear_stiffness_N_per_mm:g} N/mm")
         return (f"crank bearings: {b.rollers} discrete rollers per bearing at their cage positions, "
                 f"each a compression-only spring ({law}), radial clearance {b.radial_clearance:g} mm")

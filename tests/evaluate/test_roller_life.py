@@ -3,6 +3,7 @@ calculations with the standards' formulas, the rating's own definition and the b
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -123,9 +124,15 @@ def _uniform_life(case, force, slices=30, phases=8):
 def test_lamina_life_is_one_million_revolutions_at_the_rating(case):
     # C is the load for 10⁶ revolutions: the lamina ratings (552·…, ISO/TS 16281) and ISO 281's
     # C (207.9·…) rest on the same Lundberg–Palmgren integrals, with the rigid-ring load zone of
-    # ±90° that C assumes
+    # ±90° that C assumes. ISO/TS 16281 rates the laminae from C/λν (λν, ISO 281's allowance for
+    # edge stresses and non-uniform stress, is what the lamina loads compute): with λν = 1 the
+    # lamina life at P = C is C's 10⁶ revolutions, with the default 0.83 it is 0.83^−4 of it
+    exact = dataclasses.replace(case, crank_bearing=dataclasses.replace(case.crank_bearing, lambda_nu=1.0))
+    assert _uniform_life(exact, iso281.crank_bearing_rating(exact.crank_bearing)) == pytest.approx(1.0, rel=0.01)
     c = iso281.crank_bearing_rating(case.crank_bearing)
-    assert _uniform_life(case, c) == pytest.approx(1.0, rel=0.01)
+    assert case.crank_bearing.lambda_nu == 0.83
+    assert _uniform_life(case, c) == pytest.approx(0.83**-4, rel=0.01)
+    assert _uniform_life(case, c / 0.83) == pytest.approx(1.0, rel=0.01)
     # line contact: L ∝ P^−4 (ISO 281's 10/3 is a compromise for all roller bearings)
     assert _uniform_life(case, c / 8) == pytest.approx(8.0**4 * _uniform_life(case, c), rel=1e-9)
     # independent of the number of laminae
@@ -238,3 +245,47 @@ def test_roller_depth_warnings_one_line_each():
     assert codes == ["roller_pressure", "kappa_range"]
     high = validity.roller_depth_warnings(depth(1000.0, 6.0))
     assert [w.code for w in high] == ["kappa_range"] and "\n" not in high[0].message
+
+
+# --------------------------------------------------------------------------------------------
+# The flexible/rigid L10r ratio in steps
+# --------------------------------------------------------------------------------------------
+
+
+def _steps_cycle(case, theta, forces, scale_rollers=1.0):
+    """A cycle whose bearing forces are ``forces`` and whose rollers carry the rigid rings' loads of
+    them (× ``scale_rollers`` on the most loaded roller of each angle and bearing)."""
+    import types
+
+    loads = rs.case_rigid_roller_loads(case, theta, forces)
+    if scale_rollers != 1.0:
+        top = loads == loads.max(axis=-1, keepdims=True)
+        loads = np.where(top, scale_rollers * loads, loads)
+    return types.SimpleNamespace(bearing_forces=forces, roller_loads=loads, disc_bearing_forces=None,
+                                 roller_angles=rs.roller_angles(case, theta))
+
+
+def test_l10r_steps_multiply_to_the_ratio_and_are_one_where_nothing_changes(case):
+    from rvfem.evaluate import rigid
+
+    theta = np.radians(np.arange(0.0, 360.0, 10.0))
+    hb = rigid.handbook_bearing_loads(case, theta)
+    handbook = np.stack([hb.fx.T, hb.fy.T], axis=2)
+    speed = iso281.case_bearing_speed_rpm(case)
+    # the flexible disc's forces are the handbook's and its rollers carry the rigid rings' loads:
+    # the force, friction and sharing factors are exactly 1; the tilt is the crankshaft's
+    same = rl.l10r_steps(case, theta, _steps_cycle(case, theta, handbook), handbook, handbook, speed, bearings=[0])[0]
+    assert same.factors["pin_friction"] == same.factors["bearing_forces"] == same.factors["load_sharing"] == 1.0
+    assert 0.9 < same.factors["tilt"] <= 1.0
+    # the handbook step is the in-depth rigid column
+    column = rl.rigid_bearing_depths(case, theta, handbook, {0: 2500.0}, 20000.0, speed)[0]
+    assert same.L10r_h["handbook"] == pytest.approx(column.L10r_h, rel=1e-12)
+    # larger forces, friction and a heavier most loaded roller: each factor below 1, their product the ratio
+    frictionless = 1.05 * handbook
+    steps = rl.l10r_steps(case, theta, _steps_cycle(case, theta, 1.1 * handbook, 1.2), handbook, frictionless,
+                          speed, bearings=[0])[0]
+    assert all(steps.factors[k] < 1.0 for k in ("pin_friction", "bearing_forces", "load_sharing"))
+    assert math.prod(steps.factors.values()) == pytest.approx(steps.ratio, rel=1e-12)
+    assert steps.ratio == pytest.approx(steps.L10r_h["flexible"] / steps.L10r_h["handbook"], rel=1e-12)
+    # line contact: L10r ∝ load^−4 when every roller load scales (rigid rings without clearance)
+    assert steps.factors["bearing_forces"] == pytest.approx(1.05**-4, rel=0.02)

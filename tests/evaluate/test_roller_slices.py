@@ -279,3 +279,16 @@ def test_round_cornered_roller_against_an_independent_strip_solve(load):
     assert mid == pytest.approx(float(mid_ref), rel=0.02)
     # the corner bounds the edge: the peak stays within twice the nominal Hertz pressure
     assert c.edge_factor < 2.0
+
+
+def test_rigid_ring_roller_loads_balance_a_light_force_within_a_wide_clearance():
+    """12.5 N within 20 µm of radial play (a light phase of a bearing on the flexible disc): the rings
+    close the play and the rollers balance the force (Newton's step once overshot without bound
+    there, giving 10¹³ N)."""
+    z, length = 14, 9.0
+    psi = 0.3 + 2 * np.pi * np.arange(z) / z
+    for force in (np.array([-11.83, -4.05]), np.array([0.5, 0.0]), np.array([2500.0, -900.0])):
+        q = rs.rigid_ring_roller_loads(force, psi, radial_clearance_mm=0.02, roller_length_mm=length)
+        e = np.stack([np.cos(psi), np.sin(psi)], axis=-1)
+        assert q @ e == pytest.approx(force, abs=1e-9 * np.linalg.norm(force))
+        assert q.max() <= np.linalg.norm(force)       # one roller can carry at most the force
