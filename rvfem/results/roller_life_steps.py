@@ -53,13 +53,13 @@ def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
     }}
 
 
-def _line(b: dict) -> str:
+def _line(b: dict[str, Any]) -> str:
     f = b["factors"]
     return (f"L10r flexible/rigid {sig(b['L10r_ratio'], '.3f')} = "
             + " × ".join(f"{_WORDS[k]} {sig(f[k], '.3f')}" for k in FACTORS))
 
 
-def screen(s: dict) -> list[str]:
+def screen(s: dict[str, Any]) -> list[str]:
     """One line per group of bearings whose factors read the same."""
     steps = s.get("crank_bearing_l10r_steps")
     if not steps:
@@ -78,7 +78,7 @@ def screen(s: dict) -> list[str]:
     return out
 
 
-def report(s: dict) -> list[list[str]]:
+def report(s: dict[str, Any]) -> list[list[str]]:
     """The report's rows: one per bearing."""
     steps = s.get("crank_bearing_l10r_steps")
     if not steps:
