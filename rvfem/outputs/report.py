@@ -233,13 +233,14 @@ def assumptions(summary: dict, case: Case) -> list[str | list]:
         f"P{m['element_order']} triangles; the disc stiffness is factorised once and each crank angle is "
         "solved on the condensed contact and roller unknowns.",
         _stage_assumption(summary),
-        ["Torque convention: a disc's torque is the moment of its pin forces about the ", _b("disc centre"),
-         " (the handbook's ΣP_x = T/(2·e·Zc) for T/2). About the reducer axis the moment differs by Zp/Zc "
-         f"({100 * (case.pins.count / case.cycloid.teeth - 1):.1f} % here)."],
+        ["Torque convention: the carrier (the output) turns about the ", _b("reducer axis"), " and carries the "
+         "output torque; a disc's pin forces have the moment T/discs about that axis, Zc/Zp of it about the disc "
+         "centre. The handbook's ΣP_x = T/(2·e·Zc) takes T/2 about the disc centre: its loads are Zp/Zc "
+         f"({100 * (case.pins.count / case.cycloid.teeth - 1):.1f} % here) above a rigid disc's under this convention."],
         _pin_assumption(m, case),
         _bearing_assumption(m, case),
-        "Carrier: one rigid body that only rotates, about the disc centre in the disc frame; its rotation is the "
-        "unknown conjugate to the disc torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
+        "Carrier: one rigid body that only rotates, about the reducer axis; its rotation is the unknown conjugate to "
+        "the output torque (torsional stiffness = T_disc / rotation, mean over the cycle).",
         _reference_assumption(m, handbook),
         *_life_and_hertz_assumptions(summary, handbook),
         _stress_assumption(summary["stress"]),

@@ -28,8 +28,9 @@ def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
         "output_torque_Nm": case.loads.torque_Nm,
         "discs": case.loads.discs,
         "disc_torque_Nmm": case.loads.disc_torque_Nmm,
-        "torque_convention": "disc torque T_out/discs = moment of the pin forces about the disc centre "
-                             "(handbook: sum P_x = T/(2 e Zc))",
+        "torque_convention": "the carrier (output) turns about the reducer axis and carries T_out; a disc's pin "
+                             "forces have the moment T_out/discs about that axis, T_out/discs·Zc/Zp about the disc "
+                             "centre (the handbook's sum P_x = T/(2 e Zc) takes T/2 about the disc centre)",
         "radial_clearance_mm": case.crank_bearing.radial_clearance,
         "equivalent_load_exponent": c.exponent,
         "dynamic_load_rating_N": c.rating_N,
@@ -75,7 +76,7 @@ KEYS = (
            'torque of the reducer, number of discs, torque per disc'),
     KeyRow('`model.torque_convention`',
            'str',
-           'the disc torque is the moment of the pin forces about the disc centre (handbook convention)'),
+           'the output torque is carried by the carrier turning about the reducer axis: a disc\'s pin forces have the moment T_out/discs about that axis, Zc/Zp of it about the disc centre (docs/theory.md § 6; the handbook takes T/2 about the disc centre, Zp/Zc more)'),
     KeyRow('`model.radial_clearance_mm`',
            'float',
            'crank-bearing radial clearance'),

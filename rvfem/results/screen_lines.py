@@ -75,7 +75,7 @@ def header_lines(summary: dict[str, Any]) -> list[str]:
         f"  model: bearings '{m['bearing_model']}', P{m['element_order']}, {m['nodes']} nodes, {m['dofs']} dofs, "
         f"{m['elements']} elements; {m['angles']} crank angles (step {m['angle_step_deg']:g}°)",
         f"  torque {m['output_torque_Nm']:g} N·m on {m['discs']} discs = {nm_from_nmm(m['disc_torque_Nmm']):g} N·m per disc "
-        f"about the disc centre; C = {m['dynamic_load_rating_N']:.0f} N, n_b = {m['bearing_speed_rpm']:g} rpm",
+        f"about the reducer axis; C = {m['dynamic_load_rating_N']:.0f} N, n_b = {m['bearing_speed_rpm']:g} rpm",
         "",
         f"  {'bearing':>7} {'model':<9} {'max N':>8} {'at °':>6} {'min N':>8} {'at °':>6} {'F_m N':>8} {'L10h h':>9}",
     ]
