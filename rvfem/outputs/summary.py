@@ -57,7 +57,7 @@ from rvfem.outputs.roller_outputs import roller_pressure_calls
 from rvfem.results import registry as sections_registry
 from rvfem.results.bearing_checks import bearing_checks_dict
 from rvfem.results.files import stress_image_name
-from rvfem.results.format import angle, json_ready
+from rvfem.results.format import ANGLE_DECIMALS, angle, json_ready
 from rvfem.results.header import CLI_MODULES, CLI_SCRIPTS, SCHEMA_VERSION, VERSIONED_PACKAGES, command_line, environment
 from rvfem.results.mass_strength import fatigue_point_data
 from rvfem.results.references import references_dict
@@ -67,6 +67,7 @@ from rvfem.results.section import SummaryContext
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "ANGLE_DECIMALS",
     "SCHEMA_VERSION",
     "RIGID_SCHEMA_VERSION",
     "VERSIONED_PACKAGES",

@@ -202,11 +202,14 @@ def test_the_cycle_is_in_equilibrium(coarse):
     assert cyc.equilibrium_residual.max() < 1e-12
     # the carrier: the two discs' torques add up to the output torque at every angle
     np.testing.assert_allclose(cyc.disc_torque_Nmm.sum(axis=1), case.loads.torque_Nm * 1000.0, rtol=1e-12)
-    # each disc: its bearings' moment about the disc centre is its torque
-    c = cycle_module.crank_centres(case)
+    # each disc: its bearings' moment about the reducer axis is its torque (the carrier turns about the
+    # axis; the bores are at c_i + e·u(θ) from it, disc B at θ + 180°)
+    c, e = cycle_module.crank_centres(case), case.cycloid.eccentricity
     for k in range(case.loads.discs):
+        th = a.theta + k * math.pi
+        r = c[None, :, :] + e * np.stack([np.cos(th), np.sin(th)], axis=1)[:, None, :]
         f = cyc.disc_bearing_forces[:, k]
-        moment = (c[None, :, 0] * f[..., 1] - c[None, :, 1] * f[..., 0]).sum(axis=1)
+        moment = (r[..., 0] * f[..., 1] - r[..., 1] * f[..., 0]).sum(axis=1)
         np.testing.assert_allclose(moment, cyc.disc_torque_Nmm[:, k], rtol=1e-9)
 
 

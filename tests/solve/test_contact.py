@@ -196,6 +196,8 @@ def test_reverse_torque_is_the_mirror_image_of_forward_torque(tmp_path, pin_mode
     np.testing.assert_allclose(fb[..., 1], -fa[..., 1], rtol=0, atol=1e-9 * scale)
     zp = forward.pins.count
     pins = (zp - np.arange(zp)) % zp
-    np.testing.assert_allclose(b.pin_forces[:, pins], a.pin_forces, rtol=0, atol=1e-9 * a.pin_forces.max())
+    # each solve stops when its spring laws hold to 1e-8 of the force scale (NewtonOptions): the two
+    # mirror images agree to that, not to round-off (Hertz pins are springs; rigid pins are exact)
+    np.testing.assert_allclose(b.pin_forces[:, pins], a.pin_forces, rtol=0, atol=1e-8 * a.pin_forces.max())
     np.testing.assert_allclose(b.carrier_rotation, -a.carrier_rotation, rtol=1e-9)
     assert dataclasses.asdict(forward.loads)["torque_Nm"] > 0 > reverse.loads.torque_Nm

@@ -2,8 +2,8 @@
 
 Two conservation laws the solver does not impose in this form: the discs sharing the carrier
 carry the output torque between them (Σ T_disc = T_out at every crank angle), and the crank
-bearings' forces on disc A balance its torque about the disc centre (Σ r_i × F_i = T_A, the rollers
-push through the bore centres r_i). It adds a key to summary.json, a line to the screen, a row to
+bearings' forces on disc A balance its torque about the reducer axis, about which the carrier turns
+(Σ r_i × F_i = T_A, the rollers push through the bore centres r_i = c_i + e·u(θ) from the axis). It adds a key to summary.json, a line to the screen, a row to
 the report and a CSV file; a test registers it with one line (``register_section(SECTION)``).
 """
 
@@ -31,7 +31,7 @@ class TorqueBalance:
     disc_torque_Nmm : ndarray (n, discs)
         Each disc's torque, N·mm.
     bearing_moment_Nmm : ndarray (n,)
-        Moment of disc A's bearing forces about its centre, N·mm.
+        Moment of disc A's bearing forces about the reducer axis, N·mm.
     output_torque_error : float
         max |Σ T_disc − T_out| / T_out.
     bearing_moment_error : float
@@ -52,8 +52,10 @@ def compute(inputs: Any) -> TorqueBalance:
              else np.asarray(cycle.disc_torque_Nmm))
     if discs.shape[1] < case.loads.discs:          # one disc modelled: it carries its share
         discs = np.repeat(discs, case.loads.discs, axis=1)
-    c, f = crank_centres(case), np.asarray(cycle.bearing_forces)
-    moment = np.sum(c[None, :, 0] * f[..., 1] - c[None, :, 1] * f[..., 0], axis=1)
+    u = np.stack([np.cos(cycle.theta), np.sin(cycle.theta)], axis=1)
+    r = crank_centres(case)[None, :, :] + case.cycloid.eccentricity * u[:, None, :]
+    f = np.asarray(cycle.bearing_forces)
+    moment = np.sum(r[..., 0] * f[..., 1] - r[..., 1] * f[..., 0], axis=1)
     return TorqueBalance(theta_deg=np.degrees(cycle.theta), disc_torque_Nmm=discs, bearing_moment_Nmm=moment,
                          output_torque_error=float(np.max(np.abs(discs.sum(axis=1) - t_out)) / t_out),
                          bearing_moment_error=float(np.max(np.abs(moment - discs[:, 0])) / t_out))
