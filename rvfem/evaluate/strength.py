@@ -216,9 +216,10 @@ def _planes(psi: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     return n, a, b
 
 
-def _findley_planes(v: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray, k: float):
+def _findley_planes(v: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray,
+                    k: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """F, τ_a, σ_n,max of every plane for the hull vertices v (m_v, 3: σxx, σyy, τxy)."""
-    def traction_dot(u, w):   # u·σ·w for plane stress, (planes, m_v)
+    def traction_dot(u: np.ndarray, w: np.ndarray) -> np.ndarray:   # u·σ·w for plane stress, (planes, m_v)
         c = np.stack([u[:, 0] * w[:, 0], u[:, 1] * w[:, 1], u[:, 0] * w[:, 1] + u[:, 1] * w[:, 0]], axis=1)
         return c @ v.T
     sn = traction_dot(n, n)
@@ -255,13 +256,13 @@ def findley(sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray, fatigue_limit: fl
     step = math.radians(3.0)
     psi = np.linspace(0.0, 0.5 * math.pi, 31)
     phi = np.arange(0.0, math.pi, step)
-    best = None
+    best: tuple[float, float, float, tuple[float, float, float]] | None = None
     for _ in range(4):   # a grid, then three finer grids around its best plane
         n, a, b = _planes(psi, phi)
         F, amp, smax = _findley_planes(v, n, a, b, k)
         j = int(np.argmax(F))
         if best is None or F[j] > best[0]:
-            best = (float(F[j]), float(amp[j]), float(smax[j]), tuple(float(x) for x in n[j]))
+            best = (float(F[j]), float(amp[j]), float(smax[j]), (float(n[j, 0]), float(n[j, 1]), float(n[j, 2])))
         p0, f0 = math.acos(min(1.0, abs(best[3][2]))), math.atan2(best[3][1], best[3][0])
         psi = np.clip(p0 + np.linspace(-step, step, 13), 0.0, 0.5 * math.pi)
         phi = f0 + np.linspace(-step, step, 13)
@@ -341,9 +342,9 @@ def hot_spot_fatigue(history: HotSpotHistory, material: Material) -> tuple[HotSp
         fin, safety, assessed = None, None, None
         if name == "contact_zone":
             assessed = _assessed_as(history.peaks[j])
-        elif history.sxx is not None and history.syy is not None and history.sxy is not None:
-            fin = findley(f * history.sxx[:, j], f * history.syy[:, j], f * history.sxy[:, j],
-                          material.fatigue_limit)
+        elif all(getattr(history, c, None) is not None for c in ("sxx", "syy", "sxy")):
+            sxx, syy, sxy = (np.asarray(getattr(history, c)) for c in ("sxx", "syy", "sxy"))
+            fin = findley(f * sxx[:, j], f * syy[:, j], f * sxy[:, j], material.fatigue_limit)
             safety = fin.safety_factor
         out.append(HotSpotFatigue(
             name=name, peak=history.peaks[j], amplitude_MPa=float(a), mean_MPa=float(m),
