@@ -23,7 +23,7 @@ S_H = p_lim / p_H,max (on load it is S_H² for a line contact). The pin and the 
 bearing steel in an RV reducer; for another disc material the allowable has to be checked.
 
 The contact points and curvatures are those of the rigid kinematics at each crank angle
-(:func:`rvfem.geometry.pin_profile_contacts`), the ones the pin law of the load cycle uses.
+(:func:`rvfem.geometry.pin_profile_contacts_many`), the ones the pin law of the load cycle uses.
 """
 
 from __future__ import annotations
@@ -33,7 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rvfem.geometry import pin_profile_contacts, profile_curvature
+from rvfem.evaluate.hertz import composite_modulus
+from rvfem.geometry import pin_profile_contacts_many, profile_curvature
 
 __all__ = ["CONTACT_FATIGUE_PRESSURE_MPa", "SUBSURFACE_SHEAR", "PinFlankHertz", "pin_flank_pressure",
            "pin_flank_hertz"]
@@ -157,8 +158,6 @@ def pin_flank_hertz(case, geometry, theta: np.ndarray, pin_forces: np.ndarray, f
     allowable_MPa : float
         Contact-fatigue allowable, MPa.
     """
-    from rvfem.evaluate.hertz import composite_modulus
-
     mu = case.analysis.friction if friction is None else friction
     q_all = np.asarray(pin_forces, dtype=float) / math.sqrt(1.0 + mu * mu)
     e_star = composite_modulus(case.material.youngs_modulus, case.material.poissons_ratio,
@@ -167,12 +166,13 @@ def pin_flank_hertz(case, geometry, theta: np.ndarray, pin_forces: np.ndarray, f
     n = len(theta)
     per_angle = np.zeros(n)
     best: tuple | None = None
+    contacts = pin_profile_contacts_many(geometry, np.asarray(theta, dtype=float))   # one vectorised search
     for k in range(n):
         q = q_all[k]
         loaded = np.flatnonzero(q > 0.0)
         if loaded.size == 0:
             continue
-        pc = pin_profile_contacts(geometry, float(theta[k]))
+        pc = contacts[k]
         kappa = profile_curvature(geometry.profile, pc.segment[loaded], pc.param[loaded])
         p, b, r = pin_flank_pressure(q[loaded], L, rp, kappa, e_star)
         p = np.where(np.isnan(p), -np.inf, p)

@@ -27,8 +27,8 @@ Fatigue: Findley's critical-plane criterion
     2012, the material table of chapter 2/4): k = 0.157, f = 0.585·σ_W; for σ_W = 960 MPa (the
     default 100Cr6) τ_W = 554 MPa, f = 561 MPa. The parameter scales with a proportional load
     factor, so the safety factor is S = f / F. Planes are searched over the hemisphere of normals
-    (σ_zz = 0: the planes tilted out of the disc plane count), on a grid refined around its best
-    plane; only the vertices of the convex hull of the stress history enter (the amplitude and
+    (σ_zz = 0: the planes tilted out of the disc plane count), on a 6° grid refined six times
+    around its best plane (7 × 7 planes, each grid three times finer); only the vertices of the convex hull of the stress history enter (the amplitude and
     σ_n,max are linear functionals of the stress, so their extremes over the cycle lie there).
 
     Unlike the FKM signed von Mises stress, F does not change sign near pure shear (the sign of
@@ -62,6 +62,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, overload
 
 import numpy as np
+from scipy.spatial import ConvexHull, QhullError
 
 from rvfem.case.definition import Material
 
@@ -189,7 +190,6 @@ class FindleyResult:
 def _hull_vertices(points: np.ndarray) -> np.ndarray:
     """The vertices of the convex hull of stress points (n, 3), in the affine hull of the points:
     a flat (biaxial-proportional) history gives its 2D hull, a proportional one its two ends."""
-    from scipy.spatial import ConvexHull, QhullError
     centre = points.mean(axis=0)
     _, sv, vt = np.linalg.svd(points - centre, full_matrices=False)
     rank = int(np.count_nonzero(sv > 1e-9 * max(float(sv[0]), 1e-300))) if sv.size else 0
@@ -216,18 +216,29 @@ def _planes(psi: np.ndarray, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     return n, a, b
 
 
+_COARSE_DIRECTIONS = np.linspace(0.0, math.pi, 36, endpoint=False)
+"""Directions within a plane on which the coarse plane grid measures the shear path's width (5°:
+the largest width is the longest chord to within 1 − cos 2.5° = 10⁻³; it only locates the plane)."""
+
+
 def _findley_planes(v: np.ndarray, n: np.ndarray, a: np.ndarray, b: np.ndarray,
-                    k: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """F, τ_a, σ_n,max of every plane for the hull vertices v (m_v, 3: σxx, σyy, τxy)."""
+                    k: float, exact: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """F, τ_a, σ_n,max of every plane for the hull vertices v (m_v, 3: σxx, σyy, τxy); τ_a exactly
+    (the longest chord over pairs of vertices) or, with ``exact=False``, as the largest width of
+    the shear path over :data:`_COARSE_DIRECTIONS` (for the coarse grid)."""
     def traction_dot(u: np.ndarray, w: np.ndarray) -> np.ndarray:   # u·σ·w for plane stress, (planes, m_v)
         c = np.stack([u[:, 0] * w[:, 0], u[:, 1] * w[:, 1], u[:, 0] * w[:, 1] + u[:, 1] * w[:, 0]], axis=1)
         return c @ v.T
     sn = traction_dot(n, n)
     ta, tb = traction_dot(n, a), traction_dot(n, b)
-    # τ_a: half the longest chord of the shear path (its diameter), over pairs of hull vertices
-    da = ta[:, :, None] - ta[:, None, :]
-    db = tb[:, :, None] - tb[:, None, :]
-    amp = 0.5 * np.sqrt(np.max(da * da + db * db, axis=(1, 2)))
+    if exact:   # half the longest chord of the shear path (its diameter), over pairs of hull vertices
+        da = ta[:, :, None] - ta[:, None, :]
+        db = tb[:, :, None] - tb[:, None, :]
+        amp = 0.5 * np.sqrt(np.max(da * da + db * db, axis=(1, 2)))
+    else:       # half the largest width over a fan of directions
+        proj = (ta[:, None, :] * np.cos(_COARSE_DIRECTIONS)[None, :, None]
+                + tb[:, None, :] * np.sin(_COARSE_DIRECTIONS)[None, :, None])
+        amp = 0.5 * np.max(proj.max(axis=2) - proj.min(axis=2), axis=1)
     smax = np.max(sn, axis=1)
     return amp + k * smax, amp, smax
 
@@ -253,25 +264,29 @@ def findley(sxx: np.ndarray, syy: np.ndarray, sxy: np.ndarray, fatigue_limit: fl
     k, f = findley_constants(fatigue_limit, tau_w)
     pts = np.stack([np.ravel(sxx), np.ravel(syy), np.ravel(sxy)], axis=1).astype(float)
     v = _hull_vertices(pts)
-    step = math.radians(3.0)
-    psi = np.linspace(0.0, 0.5 * math.pi, 31)
+    step = math.radians(6.0)
+    psi = np.linspace(0.0, 0.5 * math.pi, 16)
     phi = np.arange(0.0, math.pi, step)
     best: tuple[float, float, float, tuple[float, float, float]] | None = None
-    for _ in range(4):   # a grid, then three finer grids around its best plane
+    for stage in range(7):   # a 6° grid, then six grids of 7 × 7 planes around its best plane, each 3× finer
         n, a, b = _planes(psi, phi)
-        F, amp, smax = _findley_planes(v, n, a, b, k)
+        F, amp, smax = _findley_planes(v, n, a, b, k, exact=stage > 0)
         j = int(np.argmax(F))
+        if stage == 0:   # the coarse grid only locates the plane (its widths are a hair short)
+            n, a, b = n[j:j + 1], a[j:j + 1], b[j:j + 1]
+            F, amp, smax = _findley_planes(v, n, a, b, k)
+            j = 0
         if best is None or F[j] > best[0]:
             best = (float(F[j]), float(amp[j]), float(smax[j]), (float(n[j, 0]), float(n[j, 1]), float(n[j, 2])))
         p0, f0 = math.acos(min(1.0, abs(best[3][2]))), math.atan2(best[3][1], best[3][0])
-        psi = np.clip(p0 + np.linspace(-step, step, 13), 0.0, 0.5 * math.pi)
-        phi = f0 + np.linspace(-step, step, 13)
-        step /= 6.0
+        psi = np.clip(p0 + np.linspace(-step, step, 7), 0.0, 0.5 * math.pi)
+        phi = f0 + np.linspace(-step, step, 7)
+        step /= 3.0
     assert best is not None
-    F_max, amp, smax, normal = best
+    F_max, amp_max, smax_max, normal = best
     safety = math.inf if F_max <= 0.0 else f / F_max
-    return FindleyResult(safety_factor=safety, parameter_MPa=F_max, shear_amplitude_MPa=amp,
-                         normal_max_MPa=smax, normal=normal, k=k, f_MPa=f)
+    return FindleyResult(safety_factor=safety, parameter_MPa=F_max, shear_amplitude_MPa=amp_max,
+                         normal_max_MPa=smax_max, normal=normal, k=k, f_MPa=f)
 
 
 def static_safety_factor(von_mises_MPa: float | None, yield_strength: float) -> float | None:
