@@ -590,8 +590,9 @@ class Analysis:
 class MeshSettings:
     """Target element sizes (mm) and the thinnest wall the geometry check accepts.
 
-    ``size_hole`` is the size on the central hole and the lightening holes (their fillets carry
-    the structural stress peaks); None means twice ``size_bore``, capped by ``size_interior``.
+    ``size_hole`` is the size on the central hole and the lightening holes; None means twice
+    ``size_bore``, capped by ``size_interior``. ``size_fillet`` is the size on the corner fillets
+    of the lightening holes, which carry the structural stress peak; None means half the hole size.
     ``symmetric`` lets the mesher build an exactly N-fold symmetric mesh from one sector when the
     disc is N-fold symmetric (see :func:`rvfem.mesh.symmetry_order`).
     """
@@ -604,6 +605,11 @@ class MeshSettings:
                                     default_doc="2 × `size_bore` (≤ `size_interior`)",
                                     doc="element size on the central hole and the lightening holes (their "
                                         "fillets carry the structural stress peaks)")
+    size_fillet: float | None = param(None, unit="mm", low=0.01, high=100.0,
+                                      default_doc="½ × the hole size (`size_hole` or its default)",
+                                      doc="element size on the corner fillets of the lightening holes, where the "
+                                          "structural stress peak is (a local refinement: the rest of the hole "
+                                          "keeps `size_hole`)")
     symmetric: bool = param(True, doc="mesh one 360°/N sector and copy it by rotation when the disc is N-fold "
                                       "symmetric (exactly symmetric mesh; the load cycle then solves one sector "
                                       "of crank angles)")

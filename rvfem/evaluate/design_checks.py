@@ -49,8 +49,10 @@ class DesignChecks:
 
     @property
     def fatigue_governing(self):
-        """The hot spot with the smallest fatigue safety factor, or None."""
-        return min(self.fatigue, key=lambda f: f.safety_factor, default=None)
+        """The assessed hot spot (a fatigue factor: the structural one) with the smallest fatigue
+        safety factor, or None."""
+        return min((f for f in self.fatigue if f.safety_factor is not None), key=lambda f: f.safety_factor,
+                   default=None)
 
     @property
     def fatigue_safety_factor(self) -> float | None:

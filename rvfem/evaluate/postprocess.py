@@ -525,6 +525,8 @@ class HotSpotHistory:
     p2_factor : tuple of float
         P2/P1 ratio of the von Mises stress at the hot spot at the recovery's angle (1 where not
         re-solved): multiply the P1 history by it for an estimate of the P2 history.
+    sxx, syy, sxy : ndarray (n, hot spots) or None
+        The Cartesian components of the same stresses (the fatigue criterion's tensor history), MPa.
     """
 
     names: tuple[str, ...]
@@ -535,6 +537,9 @@ class HotSpotHistory:
     s1: np.ndarray
     s2: np.ndarray
     p2_factor: tuple[float, ...]
+    sxx: np.ndarray | None = None
+    syy: np.ndarray | None = None
+    sxy: np.ndarray | None = None
 
     @property
     def dominant(self) -> np.ndarray:
@@ -583,4 +588,5 @@ def hot_spot_history(system, cycle, spots: dict[str, PeakStress],
     factors = tuple(float((p2_factor or {}).get(n, 1.0)) for n in names)
     return HotSpotHistory(names=names, vertices=vertices, peaks=tuple(spots[n] for n in names),
                           theta=np.asarray(cycle.theta), von_mises=np.asarray(state.von_mises),
-                          s1=np.asarray(state.s1), s2=np.asarray(state.s2), p2_factor=factors)
+                          s1=np.asarray(state.s1), s2=np.asarray(state.s2), p2_factor=factors,
+                          sxx=np.asarray(state.sxx), syy=np.asarray(state.syy), sxy=np.asarray(state.sxy))

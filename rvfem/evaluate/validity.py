@@ -344,15 +344,22 @@ def _fatigue_warnings(analysis) -> tuple[ResultWarning, ...]:
     history = getattr(analysis.stress, "history", None)
     if history is None:
         return ()
-    worst = min(hot_spot_fatigue(history, analysis.case.material), key=lambda f: f.safety_factor, default=None)
-    if worst is None or not worst.safety_factor < FATIGUE_SAFETY_LIMIT:
+    assessed = [(f.safety_factor, f) for f in hot_spot_fatigue(history, analysis.case.material)
+                if f.safety_factor is not None]
+    if not assessed:
+        return ()
+    factor, worst = min(assessed, key=lambda sf: sf[0])
+    if not factor < FATIGUE_SAFETY_LIMIT:
         return ()
     where = f"{worst.name} hot spot at ({worst.peak.x_mm:.2f}, {worst.peak.y_mm:.2f}) mm"
+    crit = worst.findley
+    detail = ("" if crit is None else f"τ_a = {crit.shear_amplitude_MPa:.0f} MPa, σ_n,max = "
+              f"{crit.normal_max_MPa:.0f} MPa on the critical plane, ")
     return (ResultWarning(
         "fatigue_safety",
-        f"fatigue safety factor {_sig(worst.safety_factor)} < 1 ({where}; σ_a = {worst.amplitude_MPa:.0f} MPa, "
-        f"σ_m = {worst.mean_MPa:.0f} MPa, {FATIGUE_CRITERION}): the disc does not have infinite life there",
-        float(worst.safety_factor), FATIGUE_SAFETY_LIMIT, ""),)
+        f"fatigue safety factor {_sig(factor)} < 1 ({where}; {detail}{FATIGUE_CRITERION}): "
+        "the disc does not have infinite life there",
+        float(factor), FATIGUE_SAFETY_LIMIT, ""),)
 
 
 def rigid_warnings(rigid_analysis) -> tuple[ResultWarning, ...]:

@@ -15,7 +15,7 @@ from rvfem.case.definition import Case, case_to_dict, registered_hole_shapes
 from rvfem.errors import OutputError
 from rvfem.geometry import SPLINE_POINTS_PER_SEGMENT
 
-MESHER_VERSION = 3
+MESHER_VERSION = 4
 """Bumped whenever a change here changes the mesh for the same inputs (invalidates caches)."""
 
 
@@ -37,7 +37,7 @@ def mesh_key(case: Case) -> str:
         "cranks": d["cranks"],
         "bore_radius": d["crank_bearing"]["bore_radius"],
         "mesh": {k: d["mesh"].get(k) for k in ("size_flank", "size_bore", "size_interior", "size_hole",
-                                               "symmetric")},
+                                               "size_fillet", "symmetric")},
         "mesher": MESHER_VERSION,
         "spline_points": SPLINE_POINTS_PER_SEGMENT,
         "gmsh": gmsh.__version__,

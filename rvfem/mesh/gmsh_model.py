@@ -9,17 +9,19 @@ import numpy as np
 
 from rvfem.errors import MeshError
 from rvfem.geometry import Arc, DiscGeometry, Feature, LineSegment
-from rvfem.mesh.sizes import _size_field
+from rvfem.mesh.sizes import _size_field, is_fillet
 from rvfem.mesh.symmetry import _Cut
 
 def _add_point(g, xy) -> int:
     return g.model.occ.addPoint(float(xy[0]), float(xy[1]), 0.0)
 
 
-def _add_outline(g, feature: Feature) -> list[int]:
+def _add_outline(g, feature: Feature, fillets: list[int] | None = None) -> list[int]:
     """Curves of one hole outline (:meth:`~rvfem.geometry.Feature.outline`); returns the curve tags
     in order. A full circle becomes one OCC circle; otherwise consecutive primitives share their
-    end points, and arcs are split into pieces below 135° (OCC arcs must be below π)."""
+    end points, and arcs are split into pieces below 135° (OCC arcs must be below π). The curves
+    of the outline's corner fillets (:func:`rvfem.mesh.sizes.is_fillet`) are appended to
+    ``fillets`` when it is given."""
     occ = g.model.occ
     prims = feature.outline()
     if len(prims) == 1 and isinstance(prims[0], Arc) and prims[0].sweep >= 2 * math.pi:
@@ -37,19 +39,23 @@ def _add_outline(g, feature: Feature) -> list[int]:
             n = max(1, int(math.ceil(abs(p.sweep) / (0.75 * math.pi))))  # arcs below π
             c = _add_point(g, p.centre)
             prev = a
+            first = len(tags)
             for k in range(1, n + 1):
                 nxt = b if k == n else _add_point(g, p.point(p.start_angle + p.sweep * k / n))
                 tags.append(occ.addCircleArc(prev, c, nxt))
                 prev = nxt
+            if fillets is not None and is_fillet(p, prims):
+                fillets.extend(tags[first:])
         else:
             raise MeshError(f"{feature.name}: cannot mesh an outline piece of type {type(p).__name__}")
     return tags
 
 
 
-def _add_geometry(g, geom: DiscGeometry) -> tuple[list[int], dict[str, list[int]]]:
+def _add_geometry(g, geom: DiscGeometry) -> tuple[list[int], dict[str, list[int]], list[int]]:
     """Every curve of the disc: one spline per tooth space and the outline of every feature.
-    Returns the tip point tags and name → curve tags (``profile`` and the feature names)."""
+    Returns the tip point tags, name → curve tags (``profile`` and the feature names) and the
+    curve tags of the lightening holes' corner fillets."""
     occ = g.model.occ
     spl = geom.profile.spline_points
     zc = spl.shape[0]
@@ -59,16 +65,18 @@ def _add_geometry(g, geom: DiscGeometry) -> tuple[list[int], dict[str, list[int]
         inner = [_add_point(g, xy) for xy in spl[j, 1:-1]]
         profile_curves.append(occ.addSpline([tips[j]] + inner + [tips[(j + 1) % zc]]))
     groups: dict[str, list[int]] = {"profile": profile_curves}
+    fillets: list[int] = []
+    holes = {id(h) for h in geom.holes}
     for feat in geom.features:
-        groups[feat.name] = _add_outline(g, feat)
-    return tips, groups
+        groups[feat.name] = _add_outline(g, feat, fillets if id(feat) in holes else None)
+    return tips, groups, fillets
 
 
 def _build_model(g, geom: DiscGeometry) -> dict[str, list[int]]:
     """Create the OCC geometry of the whole disc, physical groups and size fields; return name →
     curve tags."""
     occ = g.model.occ
-    _, groups = _add_geometry(g, geom)
+    _, groups, fillets = _add_geometry(g, geom)
     loops = [occ.addCurveLoop(curves) for curves in groups.values()]
     surface = occ.addPlaneSurface(loops)
     occ.synchronize()
@@ -76,7 +84,7 @@ def _build_model(g, geom: DiscGeometry) -> dict[str, list[int]]:
     for name, curves in groups.items():
         g.model.addPhysicalGroup(1, curves, name=name)
     g.model.addPhysicalGroup(2, [surface], name="disc")
-    _size_field(g, geom, groups)
+    _size_field(g, geom, groups, fillets)
     return groups
 
 
@@ -99,7 +107,7 @@ def _build_sector_model(g, geom: DiscGeometry, cut: _Cut) -> tuple[int, dict[str
     the central hole out to the tip.
     """
     occ = g.model.occ
-    tips, groups = _add_geometry(g, geom)
+    tips, groups, fillets = _add_geometry(g, geom)
     zc, n = len(tips), cut.order
     m = zc // n
     sweep = 2 * math.pi / n
@@ -129,5 +137,5 @@ def _build_sector_model(g, geom: DiscGeometry, cut: _Cut) -> tuple[int, dict[str
     occ.synchronize()
     c, s = math.cos(sweep), math.sin(sweep)
     g.model.mesh.setPeriodic(1, [cut1], [cut0], [c, -s, 0, 0, s, c, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])
-    _size_field(g, geom, groups)
+    _size_field(g, geom, groups, fillets)
     return surface, sector, cut0, cut1

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from rvfem.geometry import DiscGeometry, Feature
+from rvfem.geometry import Arc, DiscGeometry, Feature
 from rvfem.mesh.session import _file_options
 
 SIZE_GROWTH = 0.25
@@ -18,6 +18,27 @@ HOLE_SIZE_FACTOR = 2.0
 
 BAND_FACTOR = 2.0
 """Width of the band held at the fine size next to a refined curve, in elements."""
+
+FILLET_SIZE_FACTOR = 0.5
+"""Element size on the corner fillets of the lightening holes, as a multiple of the hole size
+(``mesh.size_fillet`` when not given). The structural stress peak of a disc with fan holes sits
+on a fillet: with the holes at 0.5 mm and the fillets at 0.25 mm the P2 peak of the default case
+is within 3 % of its converged value (docs/outputs.md, "The structural stress peak"), for a
+fraction of the vertices that refining the whole hole outlines costs."""
+
+
+def is_fillet(arc: Arc, outline: tuple) -> bool:
+    """Whether an arc of a hole outline is a corner fillet (or a rounded end): an arc of an outline
+    made of several pieces, not centred on the disc centre (the fan holes' inner and outer arcs
+    are)."""
+    return len(outline) > 1 and math.hypot(*arc.centre) > 1e-9
+
+
+def _fillet_size(ms) -> float:
+    """Element size on the corner fillets of the lightening holes, mm."""
+    if ms.size_fillet is not None:
+        return ms.size_fillet
+    return FILLET_SIZE_FACTOR * _hole_size(ms)
 
 
 def _feature_size(geom: DiscGeometry, f: Feature) -> float:
@@ -51,9 +72,10 @@ def _threshold(g, curves: list[int], size: float, size_max: float, sampling: int
     return th
 
 
-def _size_field(g, geom: DiscGeometry, groups: dict[str, list[int]]) -> None:
-    """Background size field (fine on the profile, the bores and the holes, growing inwards) and
-    the meshing options; ``groups`` holds the curves of the whole disc."""
+def _size_field(g, geom: DiscGeometry, groups: dict[str, list[int]], fillets: list[int] | None = None) -> None:
+    """Background size field (fine on the profile, the bores and the holes, finer on the holes'
+    corner fillets, growing inwards) and the meshing options; ``groups`` holds the curves of the
+    whole disc, ``fillets`` the curves of the lightening holes' corner fillets."""
     ms = geom.case.mesh
     spl = geom.profile.spline_points
     hmax = ms.size_interior
@@ -67,6 +89,10 @@ def _size_field(g, geom: DiscGeometry, groups: dict[str, list[int]]) -> None:
     other = [c for f in (geom.central_hole,) + geom.holes for c in groups[f.name]]
     longest = max(f.sampling_length for f in (geom.central_hole,) + geom.holes)
     fields.append(_threshold(g, other, h_hole, hmax, max(20, int(math.ceil(4 * longest / h_hole)))))
+    h_fillet = _fillet_size(ms)
+    if fillets and h_fillet < h_hole:
+        arc = max(g.model.occ.getMass(1, c) for c in fillets)      # the longest fillet curve, mm
+        fields.append(_threshold(g, fillets, h_fillet, hmax, max(20, int(math.ceil(4 * arc / h_fillet)))))
     fmin = g.model.mesh.field.add("Min")
     g.model.mesh.field.setNumbers(fmin, "FieldsList", fields)
     g.model.mesh.field.setAsBackgroundMesh(fmin)

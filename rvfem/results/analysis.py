@@ -27,6 +27,7 @@ if TYPE_CHECKING:  # the heavier modules are imported where used
     from rvfem.evaluate.bearing_checks import BearingChecks
     from rvfem.evaluate.compare import Comparison
     from rvfem.evaluate.design_checks import DesignChecks
+    from rvfem.evaluate.pin_flank import PinFlankHertz
     from rvfem.evaluate.postprocess import FieldSnapshot, HotSpotHistory, PeakStress, RecoveredPeak
     from rvfem.evaluate.rigid import PinForces, References
     from rvfem.evaluate.roller_life import BearingDepth, CrankBearingDepth, L10rSteps
@@ -359,6 +360,9 @@ class Analysis:
         bearings' loads and lives.
     mass_strength : rvfem.evaluate.design_checks.DesignChecks or None
         Disc mass and inertia, static and fatigue safety (None until computed).
+    pin_flank : rvfem.evaluate.pin_flank.PinFlankHertz or None
+        The pin–flank Hertz contact over the cycle: its peak pressure, where, the subsurface shear
+        and the contact-fatigue safety (None until computed).
     extra : mapping of str to object
         The results of sections registered from outside rvfem (:func:`rvfem.results.registry.register_section`),
         by section name; read-only.
@@ -387,6 +391,7 @@ class Analysis:
     accuracy: dict[str, Any] | None = None
     bearing_checks: BearingChecks | None = None
     mass_strength: DesignChecks | None = None
+    pin_flank: PinFlankHertz | None = None
     extra: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
 
     @property

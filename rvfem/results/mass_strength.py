@@ -12,7 +12,7 @@ from typing import Any
 
 from rvfem.evaluate.design_checks import DesignChecks, design_checks, finite_or_none
 from rvfem.evaluate.postprocess import PeakStress, feature_label, user_feature_label, user_feature_name
-from rvfem.evaluate.strength import FATIGUE_CRITERION, fatigue_field
+from rvfem.evaluate.strength import FATIGUE_CRITERION, SHEAR_FATIGUE_FACTOR, fatigue_field, findley_constants
 from rvfem.results.section import KeyRow, Section, SummaryContext
 
 __all__ = ["SECTION", "fatigue_point_data", "mass_strength_dict", "mass_strength_lines", "mass_strength_report",
@@ -25,10 +25,20 @@ def _where(peak: PeakStress) -> dict[str, Any]:
             "feature_label": None if peak.feature is None else feature_label(peak.feature)}
 
 
+def _findley_dict(f: Any) -> dict[str, Any] | None:
+    c = f.findley
+    if c is None:
+        return None
+    return {"parameter_MPa": c.parameter_MPa, "shear_amplitude_MPa": c.shear_amplitude_MPa,
+            "normal_stress_max_MPa": c.normal_max_MPa, "plane_normal": list(c.normal)}
+
+
 def mass_strength_dict(checks: DesignChecks, material: Any) -> dict[str, Any]:
     """The keys of the piece from a :class:`~rvfem.evaluate.design_checks.DesignChecks`."""
     m = checks.mass
     gov = checks.fatigue_governing
+    tau_w = SHEAR_FATIGUE_FACTOR * material.fatigue_limit
+    k, f_findley = findley_constants(material.fatigue_limit, tau_w)
     return {
         "disc_mass_kg": m.mass_kg,
         "disc_polar_inertia_kg_mm2": m.polar_inertia_kg_mm2,
@@ -50,10 +60,16 @@ def mass_strength_dict(checks: DesignChecks, material: Any) -> dict[str, Any]:
             "static_peak_von_mises_MPa": checks.static_peak_MPa,
             "static_peak_at": None if checks.static_peak is None else _where(checks.static_peak),
             "fatigue_criterion": FATIGUE_CRITERION,
+            "shear_fatigue_limit_MPa": tau_w,
+            "findley_k": k,
+            "findley_f_MPa": f_findley,
             "fatigue_hot_spots": [{
                 "name": f.name, "at": _where(f.peak), "amplitude_MPa": f.amplitude_MPa, "mean_MPa": f.mean_MPa,
                 "signed_von_mises_max_MPa": f.max_MPa, "signed_von_mises_min_MPa": f.min_MPa,
                 "p2_factor": f.p2_factor, "safety_factor": finite_or_none(f.safety_factor),
+                "findley": _findley_dict(f),
+                "goodman_safety_factor": finite_or_none(f.goodman_safety_factor),
+                "assessed_as": f.assessed_as,
             } for f in checks.fatigue],
         },
     }
@@ -99,9 +115,11 @@ def mass_strength_lines(summary: dict[str, Any]) -> list[str]:
     where = summary.get("fatigue_safety_factor_at") or {}
     fat = ""
     if where:
+        tau = ms.get("shear_fatigue_limit_MPa")
         fat = (f"; fatigue safety {_factor(summary.get('fatigue_safety_factor'))} ({where['hot_spot']} hot spot, "
                f"{_words(where)} at ({where['x_mm']:.1f}, {where['y_mm']:.1f}) mm; "
-               f"{ms['fatigue_criterion']}, σ_W = {ms['fatigue_limit_MPa']:g} MPa)")
+               f"{ms['fatigue_criterion']}, σ_W = {ms['fatigue_limit_MPa']:g} MPa"
+               + ("" if tau is None else f", τ_W = {tau:.0f} MPa") + ")")
     lines.append(f"  static safety against yield {_factor(summary.get('static_safety_factor'))} "
                  f"(R_p0.2 = {ms['yield_strength_MPa']:g} MPa at the structural peak){fat}")
     return lines
@@ -120,13 +138,19 @@ def mass_strength_report(summary: dict[str, Any]) -> list[str]:
                      f"{at.get('y_mm', 0.0):.1f}) mm): signed von Mises {f['signed_von_mises_min_MPa']:.1f} … "
                      f"{f['signed_von_mises_max_MPa']:.1f} MPa (P1 history × {f['p2_factor']:.3f}), σ_a = "
                      f"{f['amplitude_MPa']:.1f} MPa, σ_m = {f['mean_MPa']:.1f} MPa, fatigue safety factor "
-                     f"{_factor(f['safety_factor'])}.")
+                     f"{_factor(f['safety_factor'])}"
+                     + (f" (Findley: τ_a = {f['findley']['shear_amplitude_MPa']:.1f} MPa, σ_n,max = "
+                        f"{f['findley']['normal_stress_max_MPa']:.1f} MPa on the critical plane; the signed von Mises "
+                        f"stress on the Goodman line gives {_factor(f.get('goodman_safety_factor'))})"
+                        if f.get("findley") else "")
+                     + (f"; assessed as {f['assessed_as']}" if f.get("assessed_as") else "") + ".")
     return lines
 
 
 def fatigue_point_data(analysis: Any) -> dict[str, Any]:
-    """The envelope's fatigue field: ``fatigue_safety_factor_P<order>`` (the Goodman safety factor
-    of every vertex from the cycle's own vertex stresses, not scaled to P2; capped at 1000 for
+    """The envelope's fatigue field: ``fatigue_safety_factor_P<order>`` (the former criterion's
+    Goodman safety factor of the signed von Mises stress of every vertex, from the cycle's own vertex
+    stresses, not scaled to P2; capped at 1000 for
     the colour scale), empty where the cycle has no signed von Mises envelope."""
     cy = analysis.cycle
     if getattr(cy, "signed_von_mises_max", None) is None:
@@ -147,7 +171,7 @@ KEYS = (
            '**static safety against yield** R_p0.2/σ_vM at the structural peak (`peak_von_mises_MPa`, P2 away from contacts); null without a structural peak'),
     KeyRow('`fatigue_safety_factor`',
            'float or null',
-           '**fatigue safety factor**, the smallest over the hot spots (`mass_strength.fatigue_hot_spots[]`): the FKM guideline\'s signed von Mises stress over the cycle, its amplitude and mean on the Goodman line of σ_W and R_m (docs/theory.md, "Mass and strength"); null if infinite or without hot spots'),
+           '**fatigue safety factor** of the disc at its structural hot spot (`mass_strength.fatigue_hot_spots[]` with a factor; P2-consistent stresses away from the contact footprints): Findley\'s critical-plane criterion on the stress-tensor history over the cycle, f/max(τ_a + k·σ_n,max) with k and f from σ_W and τ_W = 0.577·σ_W (docs/theory.md, "Mass and strength"); the contact zones are assessed as what they are (`mass_strength.fatigue_hot_spots[].assessed_as`, `pin_flank`); null if infinite or without a structural hot spot'),
     KeyRow('`fatigue_safety_factor_at`, `mass_strength.static_peak_at`, `mass_strength.fatigue_hot_spots[].at`',
            'object or null',
            "where the governing hot spot, the static check's peak, each hot spot is"),
@@ -156,7 +180,7 @@ KEYS = (
            'position, the crank angle of its von Mises peak and the nearest boundary, numbered from 1 (`bore_1`), and the same in words (`bore 1`)'),
     KeyRow('`fatigue_safety_factor_at.hot_spot`',
            'str',
-           'which hot spot governs (`structural`, `contact_zone`)'),
+           'which hot spot governs (`structural`)'),
     KeyRow('`mass_strength`',
            'object',
            'the details of the four keys above'),
@@ -181,6 +205,9 @@ KEYS = (
     KeyRow('`mass_strength.fatigue_criterion`',
            'str',
            'the criterion in words'),
+    KeyRow('`mass_strength.shear_fatigue_limit_MPa`, `mass_strength.findley_k`, `mass_strength.findley_f_MPa`',
+           'float',
+           "τ_W = f_W,τ·σ_W (f_W,τ = 0.577 for steel, FKM guideline) and Findley's constants k = q/√(1 − q²), f = τ_W·√(1 + k²) with q = 2τ_W/σ_W − 1"),
     KeyRow('`mass_strength.fatigue_hot_spots[]`',
            'array',
            'one entry per hot spot of `stress.hot_spots[]`'),
@@ -194,8 +221,17 @@ KEYS = (
            'float',
            'its largest and smallest value'),
     KeyRow('`mass_strength.fatigue_hot_spots[].p2_factor`, `mass_strength.fatigue_hot_spots[].safety_factor`',
-           'float',
-           'the P2/P1 factor applied; the Goodman safety factor (null if infinite)'),
+           'float, float or null',
+           "the P2/P1 factor applied; Findley's safety factor (null if infinite, and for the contact zone, which is assessed as `assessed_as` says)"),
+    KeyRow('`mass_strength.fatigue_hot_spots[].findley`',
+           'object or null',
+           'the critical plane of the structural hot spot: `parameter_MPa` (τ_a + k·σ_n,max), `shear_amplitude_MPa` (half the longest chord of the shear path), `normal_stress_max_MPa`, `plane_normal` (unit normal x, y, z; z the disc axis); null for the contact zone'),
+    KeyRow('`mass_strength.fatigue_hot_spots[].goodman_safety_factor`',
+           'float or null',
+           "the former criterion, for comparison: the signed von Mises stress's amplitude and mean on the Goodman line of σ_W and R_m (its sign flips near pure shear)"),
+    KeyRow('`mass_strength.fatigue_hot_spots[].assessed_as`',
+           'str or null',
+           "for the contact zone: what it is assessed as instead — a bore is the crank bearing's outer raceway (its rolling-contact fatigue is in L10r), the flank the pin–flank Hertz contact (`pin_flank`); null for the structural hot spot"),
 )
 """Its rows of the key table (docs/outputs.md)."""
 

@@ -89,9 +89,16 @@ def test_stress_history_holds_the_p2_consistent_stresses_the_fatigue_check_uses(
         n = 1.0 / (amplitude / sigma_w + max(mean, 0.0) / r_m)
         assert amplitude == pytest.approx(fatigue[name]["amplitude_MPa"], rel=1e-7)
         assert mean == pytest.approx(fatigue[name]["mean_MPa"], rel=1e-7, abs=1e-6)
-        assert n == pytest.approx(fatigue[name]["safety_factor"], rel=1e-7)
+        assert n == pytest.approx(fatigue[name]["goodman_safety_factor"], rel=1e-7)
         factors.append(n)
-    assert summary["fatigue_safety_factor"] == pytest.approx(min(factors), rel=1e-7)
+    # the verdict is Findley's at the structural hot spot; the contact zone is assessed as what it is
+    assert summary["fatigue_safety_factor"] == pytest.approx(fatigue["structural"]["safety_factor"], rel=1e-12)
+    assert summary["fatigue_safety_factor_at"]["hot_spot"] == "structural"
+    fin = fatigue["structural"]["findley"]
+    ms = summary["mass_strength"]
+    assert fatigue["structural"]["safety_factor"] == pytest.approx(
+        ms["findley_f_MPa"] / (fin["shear_amplitude_MPa"] + ms["findley_k"] * fin["normal_stress_max_MPa"]), rel=1e-12)
+    assert fatigue["contact_zone"]["safety_factor"] is None and fatigue["contact_zone"]["assessed_as"]
 
 
 # --------------------------------------------------------------------------------------------

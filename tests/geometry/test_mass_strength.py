@@ -156,10 +156,10 @@ def test_plate_under_alternating_uniaxial_stress(mean, amp):
     (f,) = strength.hot_spot_fatigue(_history(s, np.zeros_like(s)), STEEL)
     assert f.amplitude_MPa == pytest.approx(amp, rel=1e-12) and f.mean_MPa == pytest.approx(mean, abs=1e-9)
     hand = 960.0 / amp if mean < 0 else 1.0 / (amp / 960.0 + mean / 2400.0)
-    assert f.safety_factor == pytest.approx(hand, rel=1e-12)
+    assert f.goodman_safety_factor == pytest.approx(hand, rel=1e-12)
     # the same history in compression of the other principal direction (σ1 = 0, σ2 = σ): same factor
     (g,) = strength.hot_spot_fatigue(_history(np.zeros_like(s), s), STEEL)
-    assert g.safety_factor == pytest.approx(hand, rel=1e-12)
+    assert g.goodman_safety_factor == pytest.approx(hand, rel=1e-12)
 
 
 def test_hand_numbers():
@@ -185,10 +185,28 @@ def test_proportional_scaling_scales_amplitude_and_mean(s):
     (g,) = strength.hot_spot_fatigue(_history(s * s1, s * s2), STEEL)
     assert g.amplitude_MPa == pytest.approx(s * f.amplitude_MPa, rel=1e-12)
     assert g.mean_MPa == pytest.approx(s * f.mean_MPa, rel=1e-12)
-    assert g.safety_factor == pytest.approx(f.safety_factor / s, rel=1e-12)
+    assert g.goodman_safety_factor == pytest.approx(f.goodman_safety_factor / s, rel=1e-12)
     # the P2/P1 factor is a proportional scaling too
     (h,) = strength.hot_spot_fatigue(_history(s1, s2, factor=s), STEEL)
-    assert h.safety_factor == pytest.approx(g.safety_factor, rel=1e-12)
+    assert h.goodman_safety_factor == pytest.approx(g.goodman_safety_factor, rel=1e-12)
+
+
+def test_structural_hot_spot_gets_findley_and_the_contact_zone_none():
+    """A plate under σ_x = σ_W·sin θ at the structural hot spot: Findley's factor 1 (its bending
+    calibration), times 1/p2_factor; the contact zone at a bore gets no factor and is named the
+    bearing's outer raceway."""
+    theta = np.radians(np.arange(0.0, 360.0, 1.0))
+    s = 960.0 * np.sin(theta)
+    z = np.zeros_like(s)
+    peaks = (SimpleNamespace(x_mm=1.0, y_mm=2.0, theta_deg=0.0, feature="hole_0"),
+             SimpleNamespace(x_mm=3.0, y_mm=4.0, theta_deg=0.0, feature="bore_0"))
+    two = np.stack([s, s], axis=1)
+    zz = np.zeros_like(two)
+    history = SimpleNamespace(names=("structural", "contact_zone"), peaks=peaks, s1=two, s2=zz,
+                              p2_factor=(0.5, 1.0), sxx=two, syy=zz, sxy=zz)
+    f, c = strength.hot_spot_fatigue(history, STEEL)
+    assert f.safety_factor == pytest.approx(2.0, rel=1e-6)
+    assert c.safety_factor is None and "outer raceway" in c.assessed_as and "L10r" in c.assessed_as
 
 
 def test_material_strength_keys_are_checked(tmp_path):
@@ -212,6 +230,6 @@ def test_envelope_field_agrees_with_the_hot_spot_histories(tmp_path):
     field = fatigue_point_data(a)["fatigue_safety_factor_P1"]
     checks = design_checks(a)
     for f, vertex in zip(checks.fatigue, a.stress.history.vertices):
-        assert field[vertex] == pytest.approx(f.safety_factor * f.p2_factor, rel=1e-9)
+        assert field[vertex] == pytest.approx(f.goodman_safety_factor * f.p2_factor, rel=1e-9)
     assert checks.static_safety_factor == pytest.approx(1800.0 / a.stress.structural.von_mises_MPa, rel=1e-12)
     assert checks.mass.mass_kg == pytest.approx(disc_mass_properties(disc_geometry(a.case)).mass_kg, rel=1e-15)
