@@ -15,9 +15,9 @@ a radial axis and moves disc A's and disc B's eccentrics by equal and opposite a
 order no output rotation. So the component adds a series output compliance of exactly zero (its
 compliance share is zero) and states the pair's radial and moment rigidity for the external loads.
 
-Ball–raceway contact: Hertz point contact with Hamrock & Brewe's approximations of the ellipticity
-and the elliptic integrals ("Simplified solution for stresses and deformations", J. Lubr. Technol.
-105, 1983; Harris & Kotzalas, *Rolling Bearing Analysis*, ch. 6), δ = 𝓕·[9/(2𝓔R)·(Q/(πkE'))²]^(1/3);
+Ball–raceway contact: Hertz point contact, exact (the contact ellipse's eccentricity solved from
+the curvature ratio; Harris & Kotzalas, *Rolling Bearing Analysis*, ch. 6, in the notation of
+Hamrock & Brewe, "Simplified solution for stresses and deformations", J. Lubr. Technol. 105, 1983);
 each ball a spring along its contact line, of stiffness dQ/dδ = 3Q₀/(2δ₀) at its preload
 Q₀ = F_a0/(Z·sin α) (Harris & Kotzalas, ch. 7-8, the bearing's stiffness as the sum of its balls').
 """
@@ -28,6 +28,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk
 
 from rvfem.case.definition import Case, register_component_table
 from rvfem.case.schema import param
@@ -59,17 +61,26 @@ class MainBearingsTable:
 
 
 def ball_approach(Q: float, rx: float, ry: float, youngs_modulus: float, poissons_ratio: float) -> float:
-    """Approach (mm) of a Hertz point contact of principal relative radii ``rx`` ≤ ``ry`` (mm) under
-    the force Q (N), both bodies of E, ν (Hamrock & Brewe: k = 1.0339(R_y/R_x)^0.636,
-    𝓔 = 1.0003 + 0.5968 R_x/R_y, 𝓕 = 1.5277 + 0.6023 ln(R_y/R_x), 1/R = 1/R_x + 1/R_y,
-    E' = E/(1 − ν²))."""
+    """Approach (mm) of a Hertz point contact of principal relative radii ``rx`` ≤ ``ry`` (mm; 1/R_x
+    the sum of the two bodies' curvatures in x) under the force Q (N), both bodies of E, ν.
+
+    Exact Hertz: the ellipse's eccentricity m = 1 − 1/k² from
+    R_y/R_x = (𝓔(m)/(1 − m) − 𝓚(m))/(𝓚(m) − 𝓔(m)), then
+    δ = 𝓚·[9/(2𝓔R)·(Q/(πkE'))²]^(1/3), 1/R = 1/R_x + 1/R_y, E' = E/(1 − ν²), 𝓚 and 𝓔 the complete
+    elliptic integrals (Harris & Kotzalas, ch. 6; Hamrock & Brewe's notation, whose fits of k, 𝓚, 𝓔
+    this solves exactly instead)."""
     ratio = ry / rx
-    k = 1.0339 * ratio ** 0.636
-    ell_e = 1.0003 + 0.5968 / ratio
-    ell_f = 1.5277 + 0.6023 * math.log(ratio)
     R = 1.0 / (1.0 / rx + 1.0 / ry)
     e_prime = youngs_modulus / (1.0 - poissons_ratio ** 2)
-    return ell_f * (9.0 / (2.0 * ell_e * R) * (Q / (math.pi * k * e_prime)) ** 2) ** (1.0 / 3.0)
+    if ratio <= 1.0 + 1e-9:
+        m = 0.0
+    else:
+        def f(m: float) -> float:
+            return float((ellipe(m) / (1.0 - m) - ellipk(m)) / (ellipk(m) - ellipe(m)) - ratio)
+
+        m = float(brentq(f, 1e-12, 1.0 - 1e-15, xtol=1e-15))
+    k = 1.0 / math.sqrt(1.0 - m)
+    return float(ellipk(m) * (9.0 / (2.0 * ellipe(m) * R) * (Q / (math.pi * k * e_prime)) ** 2) ** (1.0 / 3.0))
 
 
 def ball_stiffness(t: MainBearingsTable) -> float:
@@ -94,7 +105,7 @@ def pair_stiffness(t: MainBearingsTable) -> np.ndarray:
     a = math.radians(t.contact_angle_deg)
     rm = 0.5 * t.pitch_diameter
     K = np.zeros((6, 6))
-    for row, z in ((1.0, 0.5 * t.row_spacing), (-1.0, -0.5 * t.row_spacing)):
+    for row, z in ((-1.0, 0.5 * t.row_spacing), (1.0, -0.5 * t.row_spacing)):   # O: the lines diverge
         for psi in 2.0 * math.pi * np.arange(t.balls) / t.balls:
             er = np.array([math.cos(psi), math.sin(psi), 0.0])
             n = math.cos(a) * er + row * math.sin(a) * np.array([0.0, 0.0, 1.0])     # contact normal
