@@ -41,11 +41,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.special import lambertw
 
 from rvfem.case.definition import Case, register_component_table
 from rvfem.case.schema import param
-from rvfem.solve.contact_laws import ForceLaw
+from rvfem.solve.contact_laws import ForceLaw, hertz_pin_approach
 from rvfem.solve.cycle_stage import ReducerStage
+from rvfem.solve.models import hertz_pin_parameters
 from rvfem.solve.stage_component import STIFFEN, StageComponent
 
 __all__ = [
@@ -177,12 +179,39 @@ SeatApproach = Any
 """``seat(Q) -> (δ, dδ/dQ)``: the approach of a pin's seat at the force Q, vectorised (mm, mm/N)."""
 
 
-def series_law(flank: ForceLaw, seat: SeatApproach, tolerance: float = 1e-12, iterations: int = 60) -> ForceLaw:
+def series_law(flank: ForceLaw, seat: SeatApproach, tolerance: float = 1e-12, iterations: int = 60,
+               flank_approach: SeatApproach | None = None) -> ForceLaw:
     """The law of a pin–flank contact ``flank`` (δ_f → Q) in series with the seat ``seat``
     (Q → δ_s): the force Q at which δ_f(Q) + δ_s(Q) = δ, and dQ/dδ = 1/(1/k_f + 1/k_s).
 
-    Solved for δ_f in [0, δ] (g(δ_f) = δ_f + δ_s(Q(δ_f)) − δ rises from −δ to ≥ 0) by Newton's
-    method kept inside the bracket (bisection where a step leaves it), to ``tolerance``·δ."""
+    With the flank's approach ``flank_approach`` (Q → (δ_f, dδ_f/dQ), the inverse of ``flank``):
+    Newton's method on Q from Q_f(δ), the flank's force at the whole approach (an upper bound; δ(Q)
+    rises and is concave, so the iterates settle from below after the first step), to
+    ``tolerance``·δ. Without it: solved for δ_f in [0, δ] (g(δ_f) = δ_f + δ_s(Q(δ_f)) − δ rises
+    from −δ to ≥ 0) by Newton's method kept inside the bracket (bisection where a step leaves it)."""
+
+    def explicit(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        assert flank_approach is not None
+        delta = np.asarray(delta, dtype=float)
+        q0, _ = flank(delta)
+        pos = q0 > 0
+        if not np.any(pos):
+            return np.zeros_like(q0), np.zeros_like(q0)
+        d = np.where(pos, np.broadcast_to(delta, q0.shape), 1.0)
+        Q = np.where(pos, q0, 1.0)              # the pins without force are carried along at 1 N
+        for _ in range(iterations):
+            df, ddf = flank_approach(Q)
+            ds, dds = seat(Q)
+            g = np.where(pos, df + ds - d, 0.0)
+            Q = np.maximum(Q - g / (ddf + dds), 1e-12 * Q)
+            if np.all(np.abs(g) <= tolerance * d):
+                break
+        _, ddf = flank_approach(Q)
+        _, dds = seat(Q)
+        return np.where(pos, Q, 0.0), np.where(pos, 1.0 / (ddf + dds), 0.0)
+
+    if flank_approach is not None:
+        return explicit
 
     def law(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         delta = np.asarray(delta, dtype=float)
@@ -246,7 +275,18 @@ class SeriesPins:
         flank = self.base.law(contacts, curvature)
         if flank is None:
             return None
-        return series_law(flank, self._seat)
+        approach = None
+        if self.base.name == "hertz" and curvature is not None:
+            params = hertz_pin_parameters(self.base.case, np.asarray(curvature, dtype=float))
+
+            def approach(Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                return hertz_pin_approach(Q, **params)    # the Hertz law's own inverse, explicit
+
+            closed = getattr(self.seat, "log_form", None)
+            if closed is not None:
+                return _closed_form_law(params, closed, self.scale, series_law(flank, self._seat,
+                                                                               flank_approach=approach))
+        return series_law(flank, self._seat, flank_approach=approach)
 
 
 def seat_approach(case: Case, table: PinHousingTable) -> SeatApproach:
@@ -264,7 +304,70 @@ def seat_approach(case: Case, table: PinHousingTable) -> SeatApproach:
         d, dd = groove_approach(Q, **params)
         return d + c_bend * np.asarray(Q, dtype=float), dd + c_bend
 
+    # δ_s = Q·(A − B ln Q) below the groove law's continuation point (groove_approach with ln a
+    # substituted), for the closed-form series law of the Hertz pins (_closed_form_law)
+    cp = (1.0 - p.poissons_ratio ** 2) / (math.pi * p.youngs_modulus)
+    ch = (1.0 - table.poissons_ratio ** 2) / (math.pi * table.youngs_modulus)
+    rg = p.radius + table.groove_clearance
+    R = p.radius * rg / (rg - p.radius)
+    k = table.poissons_ratio / (2.0 * (1.0 - table.poissons_ratio))
+    beta = cp + ch
+    alpha = (cp * (2.0 * math.log(4.0 * p.radius) - 1.0) + 2.0 * ch * (math.log(2.0 * depth) - k)
+             - beta * math.log(4.0 * R * (cp + ch)))          # 4R/(πE*), E* = 1/(πβ)
+    # the continuation point: dδ/dP = β(t − 1) = β at t = α/β − ln P = 2
+    q_lim = length * math.exp(alpha / beta - 2.0)
+    seat.log_form = ((alpha + beta * math.log(length)) / length + c_bend, beta / length, q_lim)  # type: ignore[attr-defined]
     return seat
+
+
+def _closed_form_law(params: dict[str, Any], seat_form: tuple[float, float, float], scale: float,
+                     fallback: ForceLaw) -> ForceLaw:
+    """The Hertz pin law in series with its seat, inverted in closed form.
+
+    Below both laws' continuation points the flank's approach is δ_f = P(α_f − β_f ln P), P = Q/L
+    (:func:`rvfem.solve.contact_laws.hertz_pin_law`), and the seat's δ_s = Q(A_s − B_s ln Q)
+    (``seat_form`` = (A_s, B_s, Q_lim), times ``scale``), so together δ = Q(A − B ln Q) with
+    A = (α_f + β_f ln L)/L + A_s, B = β_f/L + B_s; with Q = e^(A/B − t), t·e^(−t) = δ·e^(−A/B)/B,
+    whose root on the rising branch is t = −W₋₁(−δ·e^(−A/B)/B) (Lambert's W, as the flank law
+    alone), dQ/dδ = 1/(B(t − 1)). A force past either continuation point (far beyond a pin's load;
+    a trial approach of the solver) goes to ``fallback``, the iterative series law."""
+    L = float(params["length"])
+    rp, w = float(params["pin_radius"]), float(params["footprint_half_width"])
+    cp = (1.0 - params["pin_poisson"] ** 2) / (math.pi * params["pin_modulus"])
+    cd = (1.0 - params["disc_poisson"] ** 2) / (math.pi * params["disc_modulus"])
+    beta_f = cp + cd
+    inv_r = np.maximum(1.0 / rp + np.asarray(params["flank_curvature"], dtype=float), 1e-3 / rp)
+    alpha_f = (cp * (2.0 * np.log(4.0 * rp) - 1.0) + 2.0 * cd * np.log(w)
+               - beta_f * np.log(4.0 * beta_f / inv_r))          # 4/(κπE*), E* = 1/(πβ)
+    q_lim_f = L * np.exp(alpha_f / beta_f - 2.0)
+    a_s, b_s, q_lim_s = seat_form
+    A = (alpha_f + beta_f * math.log(L)) / L + scale * a_s
+    B = beta_f / L + scale * b_s
+    q_lim = np.minimum(q_lim_f, q_lim_s)
+    d_lim = q_lim * (A - B * np.log(q_lim))
+
+    def law(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        delta = np.asarray(delta, dtype=float)
+        shape = np.broadcast(delta, A).shape
+        d = np.broadcast_to(delta, shape)
+        if np.any(d > np.broadcast_to(d_lim, shape)):
+            return fallback(delta)
+        q = np.zeros(shape)
+        dq = np.zeros(shape)
+        pos = d > 0
+        if not np.any(pos):
+            return q, dq
+        a_, b_ = np.broadcast_to(A, shape)[pos], np.broadcast_to(B, shape)[pos]
+        t = -np.real(lambertw(-d[pos] / b_ * np.exp(-a_ / b_), k=-1))
+        lnq = a_ / b_ - t
+        # one Newton step on ln Q polishes the root: f = ln(Q(A − B ln Q)) − ln δ, f' = 1 − 1/t
+        t1 = a_ / b_ - lnq
+        lnq = lnq - (np.log(b_ * t1) + lnq - np.log(d[pos])) / (1.0 - 1.0 / t1)
+        q[pos] = np.exp(lnq)
+        dq[pos] = 1.0 / (b_ * (a_ / b_ - lnq - 1.0))
+        return q, dq
+
+    return law
 
 
 def _wall(case: Case, table: PinHousingTable) -> float:

@@ -260,3 +260,21 @@ def test_the_shares_of_the_three_parts_and_their_sum(shares):
     # interaction of the contacts' load sharing (a few per cent, as without the three parts)
     assert new["total"] == pytest.approx(1.0, abs=0.05)
     assert abs(new["total"] - old["total"]) < 0.03
+
+
+@pytest.mark.parametrize("scale", [1.0, 1.0 / STIFFEN])
+def test_the_hertz_pins_in_series_with_their_seats_invert_the_summed_approach(scale):
+    """The Hertz pin model with its seats (the closed-form inversion): at the approach
+    δ_f(Q) + scale·δ_s(Q) the law gives back Q, and dQ/dδ = 1/(dδ_f/dQ + scale·dδ_s/dQ)."""
+    from rvfem.solve.models import HertzPins, hertz_pin_parameters
+    from rvfem.solve.stage_pin_housing import SeriesPins
+    case = load_case("cases/rv40e_fanholes.toml")
+    seat = seat_approach(case, PinHousingTable())
+    curvature = np.linspace(-0.05, 0.1, 40)
+    law = SeriesPins(HertzPins(case), seat, scale).law(None, curvature)
+    Q = np.geomspace(1.0, 5000.0, 40)
+    df, ddf = hertz_pin_approach(Q, **hertz_pin_parameters(case, curvature))
+    ds, dds = seat(Q)
+    q, dq = law(df + scale * ds)
+    np.testing.assert_allclose(q, Q, rtol=1e-10)
+    np.testing.assert_allclose(dq, 1.0 / (ddf + scale * dds), rtol=1e-10)
