@@ -47,6 +47,7 @@ __all__ = [
     "HertzPins",
     "PalmgrenPins",
     "LinearPins",
+    "hertz_pin_parameters",
     "roller_angles",
     "bearing_contacts_many",
     "contact_columns",
@@ -397,13 +398,17 @@ class HertzPins:
         each pin's contact point, 1/mm (:func:`rvfem.geometry.profile_curvature`)."""
         if curvature is None:
             raise ValueError("the Hertz pin law needs the flank curvature at each contact point")
-        case = self.case
-        return contact.hertz_pin_law(
-            length=case.cycloid.thickness, pin_radius=case.pins.radius,
-            flank_curvature=np.asarray(curvature, dtype=float),
-            pin_modulus=case.pins.youngs_modulus, pin_poisson=case.pins.poissons_ratio,
-            disc_modulus=case.material.youngs_modulus, disc_poisson=case.material.poissons_ratio,
-            footprint_half_width=_footprint_half_width(case))
+        return contact.hertz_pin_law(**hertz_pin_parameters(self.case, np.asarray(curvature, dtype=float)))
+
+
+def hertz_pin_parameters(case: Case, curvature: np.ndarray) -> dict[str, Any]:
+    """The parameters of the Hertz pin law (:func:`rvfem.solve.contact.hertz_pin_law`) and of its
+    inverse (:func:`rvfem.solve.contact.hertz_pin_approach`) for ``case`` at the flank curvatures
+    ``curvature`` (1/mm), as :class:`HertzPins` uses them."""
+    return dict(length=case.cycloid.thickness, pin_radius=case.pins.radius, flank_curvature=curvature,
+                pin_modulus=case.pins.youngs_modulus, pin_poisson=case.pins.poissons_ratio,
+                disc_modulus=case.material.youngs_modulus, disc_poisson=case.material.poissons_ratio,
+                footprint_half_width=_footprint_half_width(case))
 
 
 @register_pin_model

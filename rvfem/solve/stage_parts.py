@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import dataclasses
 from types import SimpleNamespace
-from typing import Any, ClassVar
 
 import numpy as np
 
@@ -55,6 +54,10 @@ from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import models
 from rvfem.solve.cycle_stage import ReducerStage, build_stage, solve_pair
 from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, build_system
+from rvfem.solve.stage_carrier import Carrier
+from rvfem.solve.stage_component import STIFFEN, StageComponent
+from rvfem.solve.stage_main_bearings import MainBearings
+from rvfem.solve.stage_pin_housing import PinHousing
 
 __all__ = [
     "BUILTIN_COMPONENTS",
@@ -72,76 +75,6 @@ __all__ = [
     "stiffened_stage",
     "unregister_stage_component",
 ]
-
-STIFFEN = 1.0e3
-"""The factor a component is stiffened by to remove its compliance (:func:`stiffened_stage`)."""
-
-
-class StageComponent:
-    """One part of the reducer stage (module docstring). Subclass it, set the class attributes and
-    override :meth:`build` (if the part is not already in the disc model or the crankshafts) and
-    :meth:`stiffen`.
-
-    Attributes
-    ----------
-    name : str
-        The component's name in the compliance shares (``"disc body"``); unique.
-    table : str or None
-        The case table it owns (``"pins"``; a new one for a component registered from outside,
-        :func:`register_stage_component`); None for a component without one.
-    schema : type or None
-        The dataclass of that table (its keys, declared with :func:`rvfem.case.schema.param`).
-    table_by_default : bool
-        For a new table: a case without it has it with its defaults (True), or has no such
-        component (False, the default).
-    held : str
-        How the stage model holds the part, in words (a noun phrase of :func:`held_in_words`).
-    step : str or None
-        The attribution step that first models the part (``one_disc``, ``two_discs`` or
-        ``crankshafts``, or a step of its own named by ``step_label``); None for a part that changes
-        no bearing load (a compliance in series with the whole stage): it has no step.
-    step_label : str or None
-        What its own attribution step adds, in words (None: ``step`` is a built-in step).
-    body : bool
-        True for the bodies the other parts connect (named first in :func:`held_in_words`).
-    models : tuple of str
-        The keys of :data:`NOT_MODELLED` it brings into the model (they leave the left-out list).
-    """
-
-    name: ClassVar[str]
-    table: ClassVar[str | None] = None
-    schema: ClassVar[type[Any] | None] = None
-    table_by_default: ClassVar[bool] = False
-    held: ClassVar[str]
-    step: ClassVar[str | None] = None
-    step_label: ClassVar[str | None] = None
-    body: ClassVar[bool] = False
-    models: ClassVar[tuple[str, ...]] = ()
-
-    def parameters(self, case: Case) -> Any:
-        """The component's table of ``case`` (a field of the case, or a registered component table),
-        or None if the case does not have it."""
-        if self.table is None:
-            return None
-        if self.table in {f.name for f in dataclasses.fields(Case)}:
-            return getattr(case, self.table)
-        return case.component_table(self.table)
-
-    def present(self, case: Case) -> bool:
-        """True if ``case`` has the part (its table, where it owns one)."""
-        return self.table is None or self.parameters(case) is not None
-
-    def build(self, stage: ReducerStage) -> ReducerStage:
-        """The stage with this part added, from the stage's case (``stage.first.case``). The default
-        returns the stage as it is: the part is in the disc's model (:func:`build_system`), which the
-        stage is made of."""
-        return stage
-
-    def stiffen(self, stage: ReducerStage) -> ReducerStage:
-        """The stage with this part :data:`STIFFEN` times stiffer; ValueError where the stage has no
-        such compliance to remove."""
-        raise ValueError(f"the component {self.name!r} cannot be stiffened")
-
 
 # ------------------------------------------------------------------------------------------------
 # The built-in components
@@ -309,6 +242,9 @@ BUILTIN_COMPONENTS: tuple[StageComponent, ...] = (
     CrankBearingRollers(),
     Crankshafts(),
     SupportBearings(),
+    PinHousing(),
+    Carrier(),
+    MainBearings(),
 )
 """The stage's built-in components, in the order of the load path from the pins to the carrier: the
 one place they are listed."""
@@ -402,7 +338,11 @@ def stiffened_stage(stage: ReducerStage, component: str) -> ReducerStage:
     factorisation and compliance except for the disc body; every other field of the stage is
     carried through unchanged.
     """
-    return stage_component(component).stiffen(stage)
+    stiff = stage_component(component).stiffen(stage)
+    for c in stage_components():
+        if c.name != component:
+            stiff = c.carry(stage, stiff)
+    return stiff
 
 
 def build_components(stage: ReducerStage, steps: tuple[str, ...] | None = None) -> ReducerStage:

@@ -17,6 +17,8 @@ from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.mesh import mesh_case
 from rvfem.solve import cycle
 from rvfem.solve.accuracy import compliance_shares, loop_at_torques
+from rvfem.solve.stage_carrier import carrier_output_compliance
+from rvfem.solve.stage_pin_housing import ring_output_compliance
 from rvfem.solve.stage_parts import (
     BUILTIN_COMPONENTS,
     STIFFEN,
@@ -51,12 +53,21 @@ def _changed(before, after) -> set[str]:
 
 def test_the_components_build_the_stage_the_cases_tables_describe(linear_stage):
     """Both discs on one carrier (disc B as disc A) on the crankshaft influence of [crank_support],
-    with no series output compliance: the stage built directly from the case's keys."""
+    with the series output compliances of the housing ring, the carrier and the main bearings (zero)
+    of their tables' defaults: the stage built directly from the case's keys. (Linear pins: the pins'
+    seats are not added to a given pin stiffness, so disc A's model is the system itself.)"""
     system = linear_stage.first
     direct = cycle.build_stage(system, discs=2, influence=crankshaft_influence(system.case))
     assert linear_stage.second is linear_stage.first is direct.first
     np.testing.assert_array_equal(linear_stage.influence, direct.influence)
-    assert (linear_stage.second_phase, linear_stage.output_compliances) == (direct.second_phase, ()) == (0.0, ())
+    case = system.case
+    assert (linear_stage.second_phase, direct.second_phase, direct.output_compliances) == (0.0, 0.0, ())
+    assert linear_stage.output_compliances == (
+        ("pin_housing", ring_output_compliance(case, case.component_table("pin_housing"))),
+        ("carrier", carrier_output_compliance(case, case.component_table("carrier"))),
+        ("main_bearings", 0.0))
+    for name, c in linear_stage.output_compliances:
+        direct = direct.with_output_compliance(name, c)
     assert linear_stage.describe() == direct.describe()
 
 
@@ -66,9 +77,17 @@ def test_stiffening_a_part_carries_every_other_field_of_the_stage_through(linear
                         tag="carrier spring").with_output_compliance("a spring", 1e-9)
     stiff = stiffened_stage(stage, part.name)
     assert type(stiff) is TaggedStage and stiff.tag == "carrier spring"
-    assert stiff.output_compliances == (("a spring", 1e-9),)
-    # a disc's part changes the disc model (disc B is disc A), a crankshaft part the influence matrix
-    assert _changed(stage, stiff) == ({"influence"} if part.step == "crankshafts" else {"first", "second"})
+    own = dict(stage.output_compliances)
+    if part.name in own and own[part.name] > 0:          # a series part: its own compliance / STIFFEN
+        own[part.name] /= STIFFEN
+    assert stiff.output_compliances == tuple(own.items()) and ("a spring", 1e-9) in stiff.output_compliances
+    # a disc's part changes the disc model (disc B is disc A), a crankshaft part the influence matrix,
+    # a series part its output compliance (the pins' seats are not added to linear pins); the main
+    # bearings pass no torque and have nothing to stiffen
+    expected = ({"influence"} if part.step == "crankshafts" else
+                {"output_compliances"} if part.name in ("pin_housing", "carrier") else
+                set() if part.name == "main_bearings" else {"first", "second"})
+    assert _changed(stage, stiff) == expected
     assert stiff.second is stiff.first
 
 
@@ -110,11 +129,13 @@ def test_compliance_shares_equal_those_of_independently_built_stiffer_models(lin
 def test_the_parts_are_what_the_left_out_note_and_the_attribution_name():
     assert left_out().startswith("The stage model holds both discs, the pins (Hertz contact at the gaps of the "
                                  "modified profile), the crank-bearing rollers with their clearance, the "
-                                 "crankshafts as beams and their support bearings. It leaves out the main (output) "
-                                 "bearings, the carrier's end plates")
-    assert {p.step for p in BUILTIN_COMPONENTS} <= set(STEP_LABELS)
-    with pytest.raises(ValueError, match="unknown component 'carrier'; known: pin–flank contact"):
-        stiffened_stage(None, "carrier")
+                                 "crankshafts as beams, their support bearings, the pins' seats in their housing "
+                                 "grooves (Hertz, in series with each pin) and the housing ring, the carrier's "
+                                 "pillars between its end plates and the main bearings (which pass no torque). It "
+                                 "leaves out the input spur stage")
+    assert {p.step for p in BUILTIN_COMPONENTS} - {None} <= set(STEP_LABELS)
+    with pytest.raises(ValueError, match="unknown component 'a carrier'; known: pin–flank contact"):
+        stiffened_stage(None, "a carrier")
 
 
 class _Housing(StageComponent):
@@ -130,8 +151,7 @@ class _Housing(StageComponent):
 def test_a_registered_component_reaches_the_words_and_the_attribution_chain(registries, linear_stage):
     register_stage_component(_Housing())
     words = left_out()
-    assert "their support bearings and the pin housing. It leaves out the main (output) bearings, the " \
-           "carrier's end plates and pins (the carrier is rigid), the input spur stage" in words
+    assert "the main bearings (which pass no torque) and the pin housing. It leaves out the input spur stage" in words
     assert chain(linear_stage.first.case) == ["one_disc", "two_discs", "crankshafts", "housing"]
     with pytest.raises(ValueError, match="'pin housing' is registered already"):
         register_stage_component(type("Other", (_Housing,), {})())
