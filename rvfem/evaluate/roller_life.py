@@ -303,7 +303,8 @@ class DamageLocation:
         largest, mm (L_we for an evenly spread damage, short for a peak).
     middle_share : float
         Share of the bearing's damage (both raceways) in the middle half of the roller,
-        |x| ≤ L_we/4 (0.5 for an evenly spread damage).
+        |x| ≤ L_we/4, the damage taken as uniform within each lamina (0.5 for an evenly spread
+        damage).
     """
 
     raceway: str
@@ -339,7 +340,9 @@ def damage_location(x_mm, widths_mm, lamina_damage, length_mm: float,
     peak = float(density[r, k])
     mean = float(np.sum(d[r])) / length_mm
     spread = float(np.sum(dx[density[r] >= 0.5 * peak]))
-    middle = float(np.sum(d[:, np.abs(x) <= 0.25 * length_mm])) / total
+    quarter = 0.25 * length_mm                          # each lamina's part in |x| ≤ L/4 (uniform within it)
+    inside = np.clip(np.minimum(x + 0.5 * dx, quarter) - np.maximum(x - 0.5 * dx, -quarter), 0.0, None) / dx
+    middle = float(np.sum(d * inside)) / total
     return DamageLocation(raceway=names[r], x_mm=float(x[k]), peak_over_mean=peak / mean if mean > 0 else math.inf,
                           spread_mm=spread, middle_share=middle)
 
