@@ -14,9 +14,14 @@ numbers are the run's with ``--set crank_bearing.profile.kind=…``), then the s
 model leaves out of the straight and combined rollers — a sharp end, a mounting misalignment — to
 show what the ranking rests on.
 
-    python benchmarks/bench_roller_profiles_rig.py [CASE] [--torque 1250] [--step 5]
+    python benchmarks/bench_roller_profiles_rig.py [CASE] [--torque 1250] [--step 5] [--combined-grid]
 
-About a minute on the default case (one load cycle, then about a second per profile).
+``--combined-grid`` adds the combined roller's modification length a and drop b at the rated torque
+and at ``--torque`` (the grid of studies/rv40e_fanholes_combined_roller.toml, whose variants are
+full runs; here one load cycle per torque): flexible L10r and largest roller pressure per (a, b),
+and the best of each.
+
+About a minute on the default case (one load cycle per torque, then about a second per profile).
 """
 
 from __future__ import annotations
@@ -80,11 +85,38 @@ def row(label: str, f, r, length_mm: float, rig: str = "") -> str:
             f"{where(r, length_mm)} | {rig} |")
 
 
+GRID_LENGTHS_MM = (0.6, 1.23, 2.0, 3.0)
+GRID_DROPS_MM = (0.0008, 0.003, 0.006, 0.010, 0.015)
+"""The combined roller's a and b of ``--combined-grid`` (those of the shipped study)."""
+
+
+def combined_grid(a, lengths=GRID_LENGTHS_MM, drops=GRID_DROPS_MM) -> None:
+    """Print flexible L10r (h) and p_max (MPa) of bearing 1 for every (a, b) on the load cycle of ``a``."""
+    torque = a.case.loads.torque_Nm
+    cells = {}
+    for length in lengths:
+        for drop in drops:
+            f, _ = evaluate(a, with_profile(a.case, "combined", modification_length=length, modification_drop=drop))
+            cells[length, drop] = f
+    print(f"\ncombined roller at {torque:g} N·m: flexible L10r h / p_max MPa / damage peak |x| mm (bearing 1)")
+    print("| a mm \\ b µm | " + " | ".join(f"{1e3 * b:g}" for b in drops) + " |")
+    print("|---|" + "---|" * len(drops))
+    for length in lengths:
+        print(f"| {length:g} | " + " | ".join(
+            f"{cells[length, b].L10r_h:.0f} / {cells[length, b].roller_peak_pressure_MPa:.0f} / "
+            f"{abs(cells[length, b].damage.x_mm):.2f}" for b in drops) + " |")
+    best_life = max(cells, key=lambda k: cells[k].L10r_h)
+    best_p = min(cells, key=lambda k: cells[k].roller_peak_pressure_MPa)
+    print(f"longest L10r at a = {best_life[0]:g} mm, b = {1e3 * best_life[1]:g} µm; lowest p_max at "
+          f"a = {best_p[0]:g} mm, b = {1e3 * best_p[1]:g} µm")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("case", nargs="?", default="cases/rv40e_fanholes.toml")
     parser.add_argument("--torque", type=float, default=1250.0, help="output torque, N·m")
     parser.add_argument("--step", type=float, default=5.0, help="crank angle step, degrees")
+    parser.add_argument("--combined-grid", action="store_true", help="the combined roller's a × b grid too")
     args = parser.parse_args()
     a = analyse(args.case, overrides=(f"loads.torque_Nm={args.torque}",), angle_step_deg=args.step,
                 recover_stress=False, attribute=False)
@@ -109,6 +141,10 @@ def main() -> None:
         base = dict(next(k for n, k, _ in PROFILES if n == kind))
         f, r = evaluate(a, with_profile(a.case, kind, **{**base, **keys}))
         print(row(f"{kind}, {label}", f, r, length))
+    if args.combined_grid:
+        rated = analyse(args.case, angle_step_deg=args.step, recover_stress=False, attribute=False)
+        combined_grid(rated)
+        combined_grid(a)
 
 
 if __name__ == "__main__":
