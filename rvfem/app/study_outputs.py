@@ -47,7 +47,7 @@ def _depth_columns(s: Any) -> dict[str, Any]:
     bearings = _get(s, "crank_bearing_depth", "bearings") or []
     flex = [b["flexible"] for b in bearings if b.get("flexible")]
     rigid = [b["rigid"] for b in bearings if b.get("rigid")]
-    worst = min(flex, key=lambda f: f["L10r_h"], default={})
+    worst: dict[str, Any] = min(flex, key=lambda f: f["L10r_h"], default={})
     return {
         "L10r_h": worst.get("L10r_h"),
         "handbook_L10r_h": min((f["L10r_h"] for f in rigid), default=None),
