@@ -221,7 +221,7 @@ def test_the_report_of_a_run_renders_every_section(run_folder, summary, case):
     for f in summary["files"]:
         assert f in text
     raw = (run_folder / "report.html").read_text(encoding="utf-8")
-    assert raw.count('<img src="data:image/png;base64,') == len(summary["plots"]) == 5 and "<" not in text
+    assert raw.count('<img src="data:image/png;base64,') == len(summary["plots"]) == 6 and "<" not in text
     overrides = ", ".join(f"{k} = {report.toml_text(v)}" for k, v in summary["case"]["overrides"].items())
     assert f"overrides: {overrides}" in text
     assert "fan holes 3, r = 17…49 mm, ligament 4.5 mm, fillet 2 mm" in text
