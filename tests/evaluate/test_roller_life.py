@@ -384,3 +384,9 @@ def test_damage_csv_rows_sum_to_the_lamina_damage_of_l10r(case, tmp_path):
                 float(r["eccentric_damage_per_h"]), rel=1e-12, abs=1e-300)
         # straight rollers on rigid rings: the damage peaks at the ends of the effective length
         assert d.damage is not None and abs(abs(d.damage.x_mm) - 0.5 * case.crank_bearing.roller_length) < 0.1
+    # bearings that carry the same loads 120° apart (15° steps) share one curve of the plot
+    labels = [label for label, _ in roller_outputs.roller_damage_curves(depths)]
+    assert len(labels) == 1 and labels[0].startswith("bearings 1–2 (identical) rigid: L10r ")
+    png = roller_outputs.roller_damage_plot(tmp_path / "roller_damage.png", depths, "straight",
+                                            case.crank_bearing.roller_length)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 5000
