@@ -40,12 +40,32 @@ def _get(d: Any, *keys: str) -> Any:
     return d
 
 
+def _depth_columns(s: Any) -> dict[str, Any]:
+    """The crank bearing in depth of a variant (bearing model ``rollers``): the shortest flexible and
+    rigid L10r, the largest flexible roller pressure, and where the lamina damage of the bearing of
+    the shortest flexible L10r peaks (summary.json ``crank_bearing_depth``; None without it)."""
+    bearings = _get(s, "crank_bearing_depth", "bearings") or []
+    flex = [b["flexible"] for b in bearings if b.get("flexible")]
+    rigid = [b["rigid"] for b in bearings if b.get("rigid")]
+    worst: dict[str, Any] = min(flex, key=lambda f: f["L10r_h"], default={})
+    return {
+        "L10r_h": worst.get("L10r_h"),
+        "handbook_L10r_h": min((f["L10r_h"] for f in rigid), default=None),
+        "roller_peak_pressure_MPa": max((f["roller_peak_pressure_MPa"] for f in flex), default=None),
+        "damage_raceway": worst.get("damage_raceway"),
+        "damage_x_mm": worst.get("damage_x_mm"),
+        "damage_peak_over_mean": worst.get("damage_peak_over_mean"),
+        "damage_middle_share": worst.get("damage_middle_share"),
+    }
+
+
 def study_rows(study: Study, records: dict[str, dict]) -> list[dict]:
     """The rows of ``study.csv`` from the records of :func:`run_variant` (keyed by variant id).
 
     Per variant: the parameters, status, and from its ``summary.json`` the flexible max / min /
     F_m / L10h of every bearing, the handbook (rigid) values, deltas in % against the handbook
-    and against the base variant, life ratios, the largest load and the stress peaks.
+    and against the base variant, life ratios, the largest load and the stress peaks; the shortest
+    L10r and where its lamina damage peaks (:func:`_depth_columns`).
     """
     base_summary = (records.get("base") or {}).get("summary")
     n_bearings = max((len(r["summary"]["bearings"]) for r in records.values() if r.get("summary")), default=0)
@@ -98,6 +118,7 @@ def study_rows(study: Study, records: dict[str, dict]) -> list[dict]:
             "mass_vs_base_percent": _pct(_get(s, "disc_mass_kg"), _get(base_summary, "disc_mass_kg")),
             "static_safety_factor": _get(s, "static_safety_factor"),
             "fatigue_safety_factor": _get(s, "fatigue_safety_factor"),
+            **_depth_columns(s),
         })
         for i in range(n_bearings):
             pre = f"bearing{i + 1}_"

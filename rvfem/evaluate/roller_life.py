@@ -43,6 +43,9 @@ __all__ = [
     "cycle_slices",
     "lamina_ratings",
     "lamina_life_mrev",
+    "lamina_damage_mrev",
+    "DamageLocation",
+    "damage_location",
     "BearingDepth",
     "bearing_depth",
     "CrankBearingDepth",
@@ -254,6 +257,96 @@ def lamina_life_mrev(lamina_loads_inner: np.ndarray, lamina_loads_outer: np.ndar
         return np.where(damage > 0, damage ** (-8.0 / 9.0), np.inf)
 
 
+def lamina_damage_mrev(lamina_loads_inner: np.ndarray, lamina_loads_outer: np.ndarray, q_ci, q_ce, *,
+                       inner_rotates: bool = False) -> np.ndarray:
+    """Damage per million revolutions of every lamina on each raceway, (..., 2, n_s): the load
+    state's 1/L10r (:func:`lamina_life_mrev`) shared among the laminae of both raceways in
+    proportion to their terms (q_e,k/q_c,k)^(9/2).
+
+    The share is Lundberg and Palmgren's: ISO/TS 16281 combines the laminae as independent
+    Weibull survivals, ln(1/S) = Σ_k ln(1/S_k) with ln(1/S_k) ∝ (L/L_k)^e, e = 9/8 and
+    L_k = (q_c,k/q_e,k)^4 (line contact), which gives L10r = [Σ_k (q_c,k/q_e,k)^(−9/2)]^(−8/9);
+    lamina k's share of ln(1/S) at any life, the chance that the first spall starts there, is
+    (q_e,k/q_c,k)^(9/2) / Σ. So the laminae's damage sums to 1/L10r, and over a cycle (Palmgren–
+    Miner) to the cycle's damage.
+
+    Parameters and conventions as :func:`lamina_life_mrev`; index 0 of the axis −2 is the inner
+    raceway, 1 the outer.
+    """
+    wi, we = (4.0, 4.5) if inner_rotates else (4.5, 4.0)
+    z = lamina_loads_inner.shape[-2]
+    qei = (np.sum(lamina_loads_inner**wi, axis=-2) / z) ** (1.0 / wi)
+    qee = (np.sum(lamina_loads_outer**we, axis=-2) / z) ** (1.0 / we)
+    terms = np.stack([np.broadcast_to((qei / q_ci) ** 4.5, qei.shape),
+                      np.broadcast_to((qee / q_ce) ** 4.5, qee.shape)], axis=-2)
+    total = np.sum(terms, axis=(-2, -1), keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(total > 0, terms * total ** (-1.0 / 9.0), 0.0)   # terms/Σ · Σ^(8/9)
+
+
+@dataclass(frozen=True)
+class DamageLocation:
+    """Where the lamina damage of a bearing concentrates (:func:`damage_location`).
+
+    Attributes
+    ----------
+    raceway : str
+        ``"eccentric"`` or ``"bore"``: the raceway of the largest damage per length.
+    x_mm : float
+        Centre of the lamina of the largest damage per length, mm from the roller's centre (the
+        sign is the side; the profiles are symmetric).
+    peak_over_mean : float
+        That largest damage per length over the raceway's mean over the effective length L_we
+        (1 for a damage spread evenly).
+    spread_mm : float
+        Length of roller over which that raceway's damage per length is at least half its
+        largest, mm (L_we for an evenly spread damage, short for a peak).
+    middle_share : float
+        Share of the bearing's damage (both raceways) in the middle half of the roller,
+        |x| ≤ L_we/4, the damage taken as uniform within each lamina (0.5 for an evenly spread
+        damage).
+    """
+
+    raceway: str
+    x_mm: float
+    peak_over_mean: float
+    spread_mm: float
+    middle_share: float
+
+
+def damage_location(x_mm, widths_mm, lamina_damage, length_mm: float,
+                    names: tuple[str, str] = ("eccentric", "bore")) -> DamageLocation | None:
+    """Where the damage of :func:`lamina_damage_mrev` (summed over a cycle, (2, n_s)) concentrates:
+    the raceway and lamina of the largest damage per length, how far it spreads and the middle
+    half's share (:class:`DamageLocation`); None without damage.
+
+    Parameters
+    ----------
+    x_mm, widths_mm : array_like (n_s,)
+        Lamina centres and widths, mm.
+    lamina_damage : array_like (2, n_s)
+        Damage of every lamina of the inner and the outer raceway (any unit).
+    length_mm : float
+        Effective roller length L_we, mm.
+    """
+    x = np.asarray(x_mm, dtype=float)
+    dx = np.asarray(widths_mm, dtype=float)
+    d = np.asarray(lamina_damage, dtype=float)
+    total = float(np.sum(d))
+    if not total > 0:
+        return None
+    density = d / dx
+    r, k = np.unravel_index(int(np.argmax(density)), density.shape)
+    peak = float(density[r, k])
+    mean = float(np.sum(d[r])) / length_mm
+    spread = float(np.sum(dx[density[r] >= 0.5 * peak]))
+    quarter = 0.25 * length_mm                          # each lamina's part in |x| ≤ L/4 (uniform within it)
+    inside = np.clip(np.minimum(x + 0.5 * dx, quarter) - np.maximum(x - 0.5 * dx, -quarter), 0.0, None) / dx
+    middle = float(np.sum(d * inside)) / total
+    return DamageLocation(raceway=names[r], x_mm=float(x[k]), peak_over_mean=peak / mean if mean > 0 else math.inf,
+                          spread_mm=spread, middle_share=middle)
+
+
 @dataclass(frozen=True)
 class BearingDepth:
     """The crank bearing in depth for one bearing and one load model (rigid or flexible).
@@ -304,6 +397,14 @@ class BearingDepth:
         Its crank angle, degrees.
     max_roller : int
         Its 0-based roller.
+    slice_width_mm : ndarray (n_s,) or None
+        Widths Δx of the laminae centred at ``x_mm``, mm.
+    damage_per_h : ndarray (2, n_s) or None
+        Lamina damage per hour of operation on the eccentric (row 0) and the bore (row 1)
+        (:func:`lamina_damage_mrev`, Palmgren–Miner over the cycle): where spalling starts; its
+        sum is 1/``L10r_h``.
+    damage : DamageLocation or None
+        Where that damage concentrates (:func:`damage_location`).
     """
 
     bearing: int
@@ -330,6 +431,9 @@ class BearingDepth:
     max_roller_load_N: float = math.nan
     max_roller_theta_deg: float = math.nan
     max_roller: int = -1
+    slice_width_mm: np.ndarray | None = None
+    damage_per_h: np.ndarray | None = None
+    damage: DamageLocation | None = None
 
 
 def _cycle_damage(case, slice_loads, dx) -> float:
@@ -340,6 +444,14 @@ def _cycle_damage(case, slice_loads, dx) -> float:
     # frame but does not follow the crank); the bore stands relative to it
     per_angle = lamina_life_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
     return float(np.mean(1.0 / per_angle))
+
+
+def _cycle_lamina_damage(case, slice_loads, dx) -> np.ndarray:
+    """Palmgren–Miner damage per million revolutions of every lamina over a cycle, (2, n_s) (the
+    eccentric, the bore): mean_θ of :func:`lamina_damage_mrev`; sums to :func:`_cycle_damage`."""
+    q_ci, q_ce = lamina_ratings(case, dx)
+    per_angle = lamina_damage_mrev(slice_loads[0] * dx, slice_loads[1] * dx, q_ci, q_ce, inner_rotates=True)
+    return np.mean(per_angle, axis=0)
 
 
 def cycle_l10r_h(case, roller_loads: np.ndarray, tilts: np.ndarray, bearing_speed_rpm: float,
@@ -417,6 +529,7 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     to_hours = 1.0e6 / (60.0 * bearing_speed_rpm)
     l10h = to_hours * (rating_N / equivalent_load_N) ** ROLLER_LIFE_EXPONENT
     damage = _cycle_damage(case, slice_loads, dx)
+    lamina_damage = _cycle_lamina_damage(case, slice_loads, dx) / to_hours   # per hour
     k_max, j_max = np.unravel_index(int(np.argmax(roller_loads)), roller_loads.shape)
     return BearingDepth(
         bearing=bearing, model=model, roller_peak_pressure_MPa=worst.peak_pressure_MPa,
@@ -427,7 +540,8 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
         film_parameter=film.minimum_um / lubrication.composite_roughness_um(lub.roughness_Ra_um),
         kappa=kappa, a_iso=a_iso, L10h=l10h, L_nm_h=a_iso * l10h,
         L10r_h=math.inf if damage == 0 else to_hours / damage, max_roller_load_N=float(roller_loads[k_max, j_max]),
-        max_roller_theta_deg=crank_angle_deg(theta[k_max]), max_roller=int(j_max))
+        max_roller_theta_deg=crank_angle_deg(theta[k_max]), max_roller=int(j_max), slice_width_mm=dx,
+        damage_per_h=lamina_damage, damage=damage_location(x, dx, lamina_damage, b.roller_length))
 
 
 @dataclass(frozen=True)

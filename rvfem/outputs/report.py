@@ -491,6 +491,9 @@ def _plots(summary: dict, root: Path) -> list[dict]:
         _figure(root, pl.get("roller_pressure"), "Pressure along the roller of the highest contact pressure of "
                 "every bearing over the cycle (slice model; its load Q in the legend, which can be a little below the "
                 "most loaded roller's when the crankshaft's tilt moves the peak): flexible (solid) and rigid (dashed)."),
+        _figure(root, pl.get("roller_damage"), "Lamina damage per mm along the eccentric and the bore of every "
+                "bearing (ISO/TS 16281 laminae, Palmgren–Miner over the cycle; roller_damage.csv): where spalling is "
+                "likeliest to start. Flexible (solid) and rigid (dashed)."),
     ]
     return [f for f in figures if f]
 

@@ -1,5 +1,7 @@
 """Outputs of the crank bearing in depth: ``roller_pressure.csv`` (p(x) of the worst roller of every
-bearing, rigid and flexible) and ``plots/roller_pressure.png``.
+bearing, rigid and flexible) and ``plots/roller_pressure.png``; ``roller_damage.csv`` (the lamina
+damage along each raceway of every bearing, rigid and flexible: where spalling starts) and
+``plots/roller_damage.png``.
 
 The numbers come from :mod:`rvfem.evaluate.roller_life` (``Analysis.roller_depth``); docs/outputs.md
 describes the files.
@@ -19,10 +21,17 @@ from rvfem.outputs.figures import new_figure, save_figure
 from rvfem.outputs.plots import COLOURS
 from rvfem.outputs.registry import register_writer
 
-__all__ = ["write_roller_pressure_csv", "roller_pressure_calls", "roller_pressure_curves", "roller_pressure_plot"]
+__all__ = ["write_roller_pressure_csv", "roller_pressure_calls", "roller_pressure_curves", "roller_pressure_plot",
+           "write_roller_damage_csv", "roller_damage_rows", "roller_damage_curves", "roller_damage_plot",
+           "roller_damage_calls", "DAMAGE_COLUMNS"]
 
 _COLUMNS = ("bearing", "model", "raceway", "theta_deg", "roller", "roller_load_N", "tilt_mrad", "x_mm",
             "pressure_MPa")
+
+
+DAMAGE_COLUMNS = ("bearing", "model", "x_mm", "width_mm", "eccentric_damage_per_h", "bore_damage_per_h",
+                  "eccentric_damage_per_h_mm", "bore_damage_per_h_mm")
+"""Columns of ``roller_damage.csv`` (docs/outputs.md)."""
 
 
 def _depths(analysis):
@@ -104,3 +113,96 @@ def roller_pressure_calls(analysis, plots_folder: str | os.PathLike) -> list[tup
         return []
     return [(roller_pressure_plot, dict(path=Path(plots_folder) / "roller_pressure.png", depths=depths,
                                         profile=analysis.case.crank_bearing.profile.kind))]
+
+
+def roller_damage_rows(depths: Iterable[BearingDepth]) -> list[list]:
+    """The rows of ``roller_damage.csv``: per bearing and load model (rigid first) one row per
+    lamina: its centre and width (mm), its damage per hour on the eccentric and on the bore
+    (Palmgren–Miner over the cycle; the rows of a bearing and model sum to 1/L10r_h) and the same
+    per mm of roller (the damage's density along the roller, independent of the laminae's widths)."""
+    rows = []
+    for d in sorted(depths, key=lambda d: (d.bearing, d.model)):
+        if d.damage_per_h is None or d.slice_width_mm is None:
+            continue
+        ecc, bore = d.damage_per_h
+        for x, w, de, db in zip(d.x_mm, d.slice_width_mm, ecc, bore):
+            rows.append([d.bearing + 1, d.model, x, w, de, db, de / w, db / w])
+    return rows
+
+
+@register_writer("roller_damage_csv", order=16, stage="tables", files=("roller_damage.csv",))
+def write_roller_damage_csv(analysis, folder: str | os.PathLike) -> list[Path]:
+    """Write ``roller_damage.csv``: the lamina damage along each raceway of every bearing and load
+    model (:func:`roller_damage_rows`); nothing without FE rollers."""
+    rows = roller_damage_rows(_depths(analysis))
+    if not rows:
+        return []
+    path = Path(folder) / "roller_damage.csv"
+    write_csv(path, DAMAGE_COLUMNS, rows)
+    return [path]
+
+
+def _same_damage(a: BearingDepth, b: BearingDepth) -> bool:
+    """Whether two bearings' damage curves draw as one (to 1e-6 of the largest; N-fold symmetry)."""
+    if a.damage_per_h is None or b.damage_per_h is None or a.damage_per_h.shape != b.damage_per_h.shape:
+        return False
+    scale = 1e-6 * max(float(np.max(a.damage_per_h)), 1e-300)
+    return bool(np.allclose(a.damage_per_h, b.damage_per_h, rtol=0, atol=scale))
+
+
+def roller_damage_curves(depths: Iterable[BearingDepth]) -> list[tuple[str, BearingDepth]]:
+    """The curves of ``roller_damage.png``: (legend label, depth drawn) per model and run of
+    bearings with the same damage (one curve labelled ``bearings 1–3 (identical)``)."""
+    groups: list[list[BearingDepth]] = []
+    for d in sorted((d for d in depths if d.damage_per_h is not None), key=lambda d: (d.model, d.bearing)):
+        if groups and groups[-1][0].model == d.model and _same_damage(groups[-1][0], d):
+            groups[-1].append(d)
+        else:
+            groups.append([d])
+    out = []
+    for group in sorted(groups, key=lambda g: (g[0].bearing, g[0].model)):
+        d = group[0]
+        who = (f"bearings {group[0].bearing + 1}–{group[-1].bearing + 1} (identical)" if len(group) > 1
+               else f"bearing {d.bearing + 1}")
+        life = "∞" if not np.isfinite(d.L10r_h) else f"{d.L10r_h:.0f}"
+        out.append((f"{who} {d.model}: L10r {life} h", d))
+    return out
+
+
+def roller_damage_plot(path: str | os.PathLike, depths: Iterable[BearingDepth], profile: str,
+                       length_mm: float) -> Path:
+    """Draw the lamina damage per length along the roller on the eccentric (top) and the bore
+    (bottom) of every bearing and model (rigid dashed, flexible solid; piecewise constant over the
+    laminae), the ends of the effective length dotted."""
+    curves = roller_damage_curves(depths)
+    fig = new_figure((7.0, 6.2 + 0.22 * len(curves)))
+    axes = fig.subplots(2, 1, sharex=True)
+    for r, (ax, name) in enumerate(zip(axes, ("eccentric (inner raceway)", "bore (outer raceway)"))):
+        for label, d in curves:
+            assert d.damage_per_h is not None and d.slice_width_mm is not None
+            edges = np.concatenate([d.x_mm - 0.5 * d.slice_width_mm, d.x_mm[-1:] + 0.5 * d.slice_width_mm[-1:]])
+            ax.stairs(1e6 * d.damage_per_h[r] / d.slice_width_mm, edges, ls="--" if d.model == "rigid" else "-",
+                      color=COLOURS[d.bearing % len(COLOURS)], label=label if r == 0 else None)
+        for end in (-0.5 * length_mm, 0.5 * length_mm):
+            ax.axvline(end, color="0.6", ls=":", lw=0.8)
+        ax.set_ylabel("damage per mm\nper 10⁶ h of operation")
+        ax.set_title(name, fontsize=9)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("x along the roller (mm; dotted: ends of the effective length)")
+    fig.suptitle(f"Lamina damage along the roller: where spalling starts\n({profile} profile, ISO/TS 16281 "
+                 f"laminae, Palmgren–Miner over the cycle)", fontsize=10)
+    fig.legend(fontsize=7, loc="lower center", ncol=1, title="dashed: rigid loads, solid: flexible (FE) loads",
+               title_fontsize=7)
+    fig.tight_layout(rect=(0.0, 0.03 + 0.03 * len(curves), 1.0, 1.0))
+    return save_figure(fig, path)
+
+
+def roller_damage_calls(analysis, plots_folder: str | os.PathLike) -> list[tuple]:
+    """The drawing of ``plots/roller_damage.png`` as a call (:func:`roller_damage_plot`, keyword
+    arguments) for :func:`rvfem.outputs.summary.plot_calls`; none without FE rollers."""
+    depths = [d for d in _depths(analysis) if d.damage_per_h is not None]
+    if not depths:
+        return []
+    return [(roller_damage_plot, dict(path=Path(plots_folder) / "roller_damage.png", depths=depths,
+                                      profile=analysis.case.crank_bearing.profile.kind,
+                                      length_mm=analysis.case.crank_bearing.roller_length))]

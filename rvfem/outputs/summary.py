@@ -53,7 +53,7 @@ from rvfem.outputs import plots, render, tables, vtkio
 from rvfem.outputs.plots import mesh_plot, rim_closeup
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
-from rvfem.outputs.roller_outputs import roller_pressure_calls
+from rvfem.outputs.roller_outputs import roller_damage_calls, roller_pressure_calls
 from rvfem.results import registry as sections_registry
 from rvfem.results.bearing_checks import bearing_checks_dict
 from rvfem.results.files import stress_image_name
@@ -689,12 +689,13 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
     calls.append((plots.pins_in_contact_plot, dict(
         path=folder / "pins_in_contact.png", theta=th, count=cy.pins_in_contact, total=case.pins.count,
         classical=None if classical is None else np.count_nonzero(classical > 0, axis=0))))
-    return calls + roller_pressure_calls(analysis, folder)
+    return calls + roller_pressure_calls(analysis, folder) + roller_damage_calls(analysis, folder)
 
 
 @register_writer("plots", order=40, stage="plots", options=("pending",),
                  files=tuple(f"plots/{name}.png" for name in ("bearing_loads", "roller_loads", "pin_forces",
-                                                            "pins_in_contact", "roller_pressure")))
+                                                            "pins_in_contact", "roller_pressure",
+                                                            "roller_damage")))
 def write_plots(analysis, folder: str | os.PathLike, *, pending: PendingImages | None = None) -> list[Path]:
     """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
     the equal share where it is not defined), roller loads and pin forces at the angle of the

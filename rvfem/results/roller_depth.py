@@ -45,7 +45,16 @@ def _depth_dict(d: Any) -> dict[str, Any]:
         "L10h_h": d.L10h,
         "L_nm_h": d.L_nm_h,
         "L10r_h": d.L10r_h,
+        **_damage_dict(getattr(d, "damage", None)),
     }
+
+
+def _damage_dict(g: Any) -> dict[str, Any]:
+    """Where the lamina damage concentrates (a :class:`rvfem.evaluate.roller_life.DamageLocation`)."""
+    keys = ("damage_raceway", "damage_x_mm", "damage_peak_over_mean", "damage_spread_mm", "damage_middle_share")
+    if g is None:
+        return dict.fromkeys(keys)
+    return dict(zip(keys, (g.raceway, g.x_mm, g.peak_over_mean, g.spread_mm, g.middle_share)))
 
 
 def summary(a: Any, ctx: SummaryContext) -> dict[str, Any]:
@@ -119,6 +128,9 @@ KEYS = (
     KeyRow('&nbsp;&nbsp;`.L10h_h`, `.L_nm_h`, `.L10r_h`',
            'float',
            'basic rating life, modified rating life a1·a_ISO·L10h (a1 = 1), and the ISO/TS 16281 reference life from the lamina loads (Palmgren–Miner over the cycle; lamina ratings from C/λν as ISO/TS 16281 has them), hours'),
+    KeyRow('&nbsp;&nbsp;`.damage_raceway`, `.damage_x_mm`, `.damage_peak_over_mean`, `.damage_spread_mm`, `.damage_middle_share`',
+           'str, float, float, float, float (null without load)',
+           "where spalling starts: the lamina damage of L10r shared among the laminae as ISO/TS 16281's Weibull sum has it, over the cycle (`roller_damage.csv`); the raceway and lamina centre (mm from the roller's centre) of the largest damage per length, that largest over the raceway's mean over L_we (1: spread evenly), the length over which it is at least half its largest (mm), and the share of both raceways' damage in the middle half of the roller, \\|x\\| ≤ L_we/4 (0.5: spread evenly)"),
     KeyRow('`crank_bearing_depth.bearings[].L10h_ratio`, `crank_bearing_depth.bearings[].L_nm_ratio`, `crank_bearing_depth.bearings[].L10r_ratio`',
            'float or null',
            'flexible / rigid of each life'),

@@ -174,6 +174,13 @@ def drawing_text(t: dict[str, Any], files: Any) -> str:
 
 
 
+def _damage_words(d: dict[str, Any]) -> str:
+    """Where one model's lamina damage peaks, in words (``eccentric x = ±4.49 mm, 7.9× the mean,
+    half-peak over 0.31 mm``)."""
+    return (f"{d['damage_raceway']} x = ±{abs(d['damage_x_mm']):.2f} mm, {num(d['damage_peak_over_mean'], '.1f')}× "
+            f"the mean, half-peak over {num(d['damage_spread_mm'], '.2f')} mm")
+
+
 def bearing_depth_lines(b: dict[str, Any]) -> list[str]:
     """One bearing's lines of :func:`roller_depth_lines` without its name (``{name}`` in front)."""
     lines = []
@@ -185,6 +192,10 @@ def bearing_depth_lines(b: dict[str, Any]) -> list[str]:
                          f"{num(d['film_thickness_min_um'], '.3f')} µm, κ {num(d['kappa'], '.2f')}, a_ISO "
                          f"{num(d['a_iso'], '.2f')}; L10h {life(d['L10h_h'])} h, L_nm {life(d['L_nm_h'])} h, "
                          f"L10r {life(d['L10r_h'])} h")
+    where = [f"{model} {_damage_words(b[model])}" for model in ("rigid", "flexible")
+             if b[model] is not None and b[model].get("damage_raceway") is not None]
+    if where:
+        lines.append("damage peak (where spalling starts): " + "; ".join(where))
     if b["rigid"] is not None:
         lines.append(f"flexible/rigid: L10h {num(b['L10h_ratio'], '.2f')}, L_nm {num(b['L_nm_ratio'], '.2f')}, "
                      f"L10r {num(b['L10r_ratio'], '.2f')}")

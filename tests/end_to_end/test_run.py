@@ -247,7 +247,8 @@ def test_images_are_real_renders(cli_run, summary):
 
 
 def test_plots_exist(cli_run, summary):
-    assert set(summary["plots"]) == {"bearing_loads", "roller_loads", "pin_forces", "pins_in_contact", "roller_pressure"}
+    assert set(summary["plots"]) == {"bearing_loads", "roller_loads", "pin_forces", "pins_in_contact", "roller_pressure",
+                                     "roller_damage"}
     for rel in summary["plots"].values():
         _check_png(cli_run / rel)
 

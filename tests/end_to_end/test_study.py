@@ -371,6 +371,23 @@ def test_set_errors_name_the_key(tmp_path, monkeypatch, capsys):
     assert code == 2 and "expected KEY=VALUE" in err
 
 
+def test_shipped_combined_roller_study_is_a_grid_of_combined_rollers_around_the_rigs():
+    # every variant a combined roller (the study's overrides), the rig's a = 1.23 mm, b = 6 µm at the
+    # rated torque its base, and the grid's base point computed once
+    study = load_study(ROOT / "studies" / "rv40e_fanholes_combined_roller.toml")
+    assert study.kind == "grid" and [p.key for p in study.parameters] == [
+        "crank_bearing.profile.modification_length", "crank_bearing.profile.modification_drop", "loads.torque_Nm"]
+    sizes = [len(p.values) for p in study.parameters]
+    assert len(study.variants) == 1 + sizes[0] * sizes[1] * sizes[2]
+    assert len({v.digest for v in study.variants}) == len(study.variants) - 1     # the base is in the grid
+    base = load_case(study.base_case, overrides=study.base.overrides)
+    prof = base.crank_bearing.profile
+    assert (prof.kind, prof.modification_length, prof.modification_drop, base.loads.torque_Nm) == (
+        "combined", 1.23, 0.006, 412.0)
+    last = load_case(study.base_case, overrides=study.variants[-1].overrides)
+    assert last.crank_bearing.profile.kind == "combined" and last.loads.torque_Nm == 1250.0
+
+
 def test_sensitivity_study_variants_and_check(tmp_path, monkeypatch, capsys):
     shipped = load_study(ROOT / "studies" / "rv40e_fanholes_tornado.toml")
     assert shipped.kind == "sensitivity" and shipped.base.id == "base"

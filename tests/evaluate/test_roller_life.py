@@ -289,3 +289,104 @@ def test_l10r_steps_multiply_to_the_ratio_and_are_one_where_nothing_changes(case
     assert steps.ratio == pytest.approx(steps.L10r_h["flexible"] / steps.L10r_h["handbook"], rel=1e-12)
     # line contact: L10r ∝ load^−4 when every roller load scales (rigid rings without clearance)
     assert steps.factors["bearing_forces"] == pytest.approx(1.05**-4, rel=0.02)
+
+
+# --------------------------------------------------------------------------------------------
+# The lamina damage along the roller (where spalling starts)
+# --------------------------------------------------------------------------------------------
+
+
+def test_lamina_damage_sums_to_the_lamina_life_of_every_load_state(case):
+    # the laminae share 1/L10r of each state in proportion to (q_e/q_c)^(9/2): the shares add up to
+    # ISO/TS 16281's [Σ (q_c/q_e)^(−9/2)]^(8/9) whatever the loads and the laminae's widths
+    rng = np.random.default_rng(3)
+    _, dx = rs.slice_layout(case.crank_bearing.profile, case.crank_bearing.roller_length)
+    qci, qce = rl.lamina_ratings(case, dx)
+    inner = rng.uniform(0.0, 40.0, (5, 14, dx.size)) * dx
+    outer = rng.uniform(0.0, 40.0, (5, 14, dx.size)) * dx
+    for rotates in (True, False):
+        damage = rl.lamina_damage_mrev(inner, outer, qci, qce, inner_rotates=rotates)
+        assert damage.shape == (5, 2, dx.size)
+        life = rl.lamina_life_mrev(inner, outer, qci, qce, inner_rotates=rotates)
+        assert np.sum(damage, axis=(-2, -1)) == pytest.approx(1.0 / life, rel=1e-12)
+    # without load: no damage, and no division by zero
+    assert not np.any(rl.lamina_damage_mrev(0 * inner, 0 * outer, qci, qce))
+
+
+def test_uniform_line_load_gives_a_uniform_damage_per_length_on_unequal_laminae(case):
+    # q_c ∝ w^(7/9) and q_e ∝ w for a uniform load per length: (q_e/q_c)^(9/2) ∝ w, so the damage
+    # per mm is the same on the end-refined laminae as on the wide middle ones (the exact share
+    # 1/L_total of the whole for every mm)
+    prof = case.crank_bearing.profile
+    length = case.crank_bearing.roller_length
+    x, dx = rs.slice_layout(prof, length)
+    assert dx.max() / dx.min() > 50                    # really unequal laminae
+    qci, qce = rl.lamina_ratings(case, dx)
+    z = case.crank_bearing.rollers
+    q = rs.rigid_ring_roller_loads(np.array([8000.0, 0.0]), 2 * np.pi * np.arange(z) / z)
+    lam = q[:, None] / dx.sum() * dx[None, :]
+    damage = rl.lamina_damage_mrev(lam, lam, qci, qce, inner_rotates=True)
+    density = damage / dx
+    assert density / density.mean(axis=1, keepdims=True) == pytest.approx(np.ones_like(density), rel=1e-12)
+    where = rl.damage_location(x, dx, damage, dx.sum())
+    assert where.raceway == "eccentric"                # the smaller R' and the rotating ring rate lower
+    assert where.peak_over_mean == pytest.approx(1.0, rel=1e-9)
+    assert where.spread_mm == pytest.approx(dx.sum(), rel=1e-12)
+    assert where.middle_share == pytest.approx(0.5, rel=1e-12)
+
+
+def test_damage_along_a_uniformly_loaded_roller_is_uniform_away_from_its_corners(case):
+    # the logarithmic roller at its design load presses evenly along the roller (Johns and Gohar:
+    # the crown is the sag of a uniform strip load): one roller at Q_d on a raceway of rigid rings,
+    # its damage per mm over the inner 80 % within 1 % of its mean there (pressure within
+    # 0.2 %, damage ∝ p^9 on line loads ∝ p²), and the corners beyond L carry next to none
+    b = case.crank_bearing
+    prof = dataclasses.replace(b.profile, kind="logarithmic", design_load_N=2000.0, slices=60)
+    log_case = dataclasses.replace(case, crank_bearing=dataclasses.replace(b, profile=prof))
+    geoms = rl.raceways(log_case)
+    loads = np.zeros((1, b.rollers))
+    loads[0, 0] = 2000.0
+    slices = [rl.cycle_slices(loads, np.zeros_like(loads), b.roller_length, g, prof) for g in geoms]
+    x, dx = rs.slice_layout(prof, b.roller_length)
+    damage = rl._cycle_lamina_damage(log_case, slices, dx)
+    assert np.sum(damage) == pytest.approx(rl._cycle_damage(log_case, slices, dx), rel=1e-12)
+    density = damage / dx
+    inner = np.abs(x) <= 0.4 * b.roller_length
+    for row in density:
+        assert np.max(np.abs(row[inner] / row[inner].mean() - 1.0)) < 0.01
+    corners = np.abs(x) > 0.5 * b.roller_length
+    assert np.sum(damage[:, corners]) < 1e-3 * np.sum(damage)
+
+
+def test_damage_csv_rows_sum_to_the_lamina_damage_of_l10r(case, tmp_path):
+    from rvfem.evaluate import rigid
+    from rvfem.outputs import roller_outputs
+
+    theta = np.radians(np.arange(0.0, 360.0, 15.0))
+    hb = rigid.handbook_bearing_loads(case, theta)
+    handbook = np.stack([hb.fx.T, hb.fy.T], axis=2)
+    speed = iso281.case_bearing_speed_rpm(case)
+    depths = rl.rigid_bearing_depths(case, theta, handbook, {0: 2500.0, 1: 2500.0}, 20000.0, speed)
+    analysis = SimpleNamespace(roller_depth=SimpleNamespace(rigid=depths, flexible=()))
+    [path] = roller_outputs.write_roller_damage_csv(analysis, tmp_path)
+    import csv
+
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert tuple(rows[0]) == roller_outputs.DAMAGE_COLUMNS
+    for d in depths:
+        mine = [r for r in rows if int(r["bearing"]) == d.bearing + 1]
+        assert len(mine) == d.x_mm.size and {r["model"] for r in mine} == {"rigid"}
+        total = sum(float(r["eccentric_damage_per_h"]) + float(r["bore_damage_per_h"]) for r in mine)
+        assert total * d.L10r_h == pytest.approx(1.0, rel=1e-9)          # the CSV is printed to full precision
+        for r in mine:
+            assert float(r["eccentric_damage_per_h_mm"]) * float(r["width_mm"]) == pytest.approx(
+                float(r["eccentric_damage_per_h"]), rel=1e-12, abs=1e-300)
+        # straight rollers on rigid rings: the damage peaks at the ends of the effective length
+        assert d.damage is not None and abs(abs(d.damage.x_mm) - 0.5 * case.crank_bearing.roller_length) < 0.1
+    # bearings that carry the same loads 120° apart (15° steps) share one curve of the plot
+    labels = [label for label, _ in roller_outputs.roller_damage_curves(depths)]
+    assert len(labels) == 1 and labels[0].startswith("bearings 1–2 (identical) rigid: L10r ")
+    png = roller_outputs.roller_damage_plot(tmp_path / "roller_damage.png", depths, "straight",
+                                            case.crank_bearing.roller_length)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 5000

@@ -26,7 +26,7 @@ from rvfem.outputs import summary as outputs
 COARSE = ["--set", "mesh.size_flank=0.6", "--set", "mesh.size_bore=0.6", "--set", "mesh.size_interior=4.0",
           "--step", "30", "--no-images"]
 
-BUILT_IN = ["tables", "roller_pressure_csv", "case_json", "vtk", "plots", "images", "report",
+BUILT_IN = ["tables", "roller_pressure_csv", "roller_damage_csv", "case_json", "vtk", "plots", "images", "report",
             "summary"]
 """The built-in writers in the order a run calls them."""
 
@@ -135,7 +135,8 @@ def test_the_writers_are_registered_in_the_order_a_run_calls_them():
     # the registered functions are the public writers, with the options a run passes them
     public = {"tables": outputs.write_tables, "case_json": outputs.write_case_json, "vtk": outputs.write_vtk,
               "plots": outputs.write_plots, "images": outputs.write_images, "report": outputs.write_report,
-              "summary": outputs.write_summary, "roller_pressure_csv": roller_outputs.write_roller_pressure_csv}
+              "summary": outputs.write_summary, "roller_pressure_csv": roller_outputs.write_roller_pressure_csv,
+              "roller_damage_csv": roller_outputs.write_roller_damage_csv}
     for w in writers:
         assert w.write is public[w.name]
         assert set(w.options) <= set(registry.OPTIONS)
@@ -220,7 +221,7 @@ def test_the_report_of_a_run_renders_every_section(run_folder, summary, case):
     for f in summary["files"]:
         assert f in text
     raw = (run_folder / "report.html").read_text(encoding="utf-8")
-    assert raw.count('<img src="data:image/png;base64,') == len(summary["plots"]) == 5 and "<" not in text
+    assert raw.count('<img src="data:image/png;base64,') == len(summary["plots"]) == 6 and "<" not in text
     overrides = ", ".join(f"{k} = {report.toml_text(v)}" for k, v in summary["case"]["overrides"].items())
     assert f"overrides: {overrides}" in text
     assert "fan holes 3, r = 17…49 mm, ligament 4.5 mm, fillet 2 mm" in text
