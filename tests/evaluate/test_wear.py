@@ -98,20 +98,21 @@ def test_load_weighted_gap_of_a_uniform_gap_is_that_gap():
     assert archard.load_weighted_gap([1.0, 3.0, 0.0], [2e-3, 2e-3, 9.0]) == pytest.approx(2e-3)
 
 
-def _life(step_um: float) -> float:
+def _life(step_um: float, mesh_dir) -> float:
     case = coarse_case("rv40e_solid", analysis={"angle_step_deg": 30.0},
                        wear={"k_flank_pin": 4e-10, "update_step_um": step_um, "lost_motion_limit_arcsec": 40.0})
     geometry = disc_geometry(case)
-    system = build_system(case, mesh_case(case, CASES_DIR.parent / "meshes", geometry=geometry), geometry=geometry)
+    system = build_system(case, mesh_case(case, mesh_dir, geometry=geometry), geometry=geometry)
     records, _, _ = life_loop(case, case_stage(system), system, 1e4, 1)
     life = life_figures(records, 40.0)["transmission_accuracy_life_h"]
     assert life is not None
     return life
 
 
-def test_life_is_independent_of_the_update_step():
-    """Halving the update step changes the transmission-accuracy life by less than 5 %."""
-    a, b = _life(5.0), _life(2.5)
+def test_life_is_independent_of_the_update_step(tmp_path):
+    """Halving the update step changes the transmission-accuracy life by less than 5 % (3.96 h
+    against 3.85 h here)."""
+    a, b = _life(5.0, tmp_path), _life(2.5, tmp_path)
     assert abs(a - b) / b < 0.05
 
 
