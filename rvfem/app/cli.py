@@ -27,6 +27,7 @@ from typing import Callable, TextIO
 from rvfem import __version__
 from rvfem.app.analysis import analyse_rigid, default_cache_dir, resolve_case
 from rvfem.app.cli_hysteresis import HYSTERESIS
+from rvfem.app.cli_wear import WEAR
 from rvfem.app.cli_study import COMPARE, OPTIMISE, STUDY
 from rvfem.app.commands import (
     EXIT_BROKEN_PIPE,
@@ -468,7 +469,7 @@ def main(argv: list[str] | None = None) -> int:
         remove_notices()
 
 
-SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY, OPTIMISE, HYSTERESIS)
+SUBCOMMANDS = (*SUBCOMMANDS, COMPARE, STUDY, OPTIMISE, HYSTERESIS, WEAR)
 
 _ADDED: dict[str, Subcommand] = {}
 """Subcommands added with :func:`register_subcommand` (a test fixture saves and restores it)."""

@@ -40,6 +40,8 @@ __all__ = [
     "Analysis",
     "MeshSettings",
     "CrankSupport",
+    "PIN_ROLLING",
+    "Wear",
 ]
 
 
@@ -710,3 +712,42 @@ class CrankSupport:
     def carrier_stiffness_pair(self) -> tuple[float | None, float | None]:
         """Carrier stiffness at support 1 and support 2, N/mm (None where not given: rigid)."""
         return self._pair(self.carrier_stiffness_N_per_mm)
+
+
+PIN_ROLLING = ("none", "free")
+"""Values of ``wear.pin_rolling``."""
+
+
+@dataclass(frozen=True)
+class Wear:
+    """Archard wear over the hours of service (optional table ``[wear]``, all keys optional; read by
+    ``rvfem wear``). The duty is the case's ``[loads]``: its torque and speed, or its duty cycle
+    (negative torques load the other flanks)."""
+
+    k_flank_pin: float = param(
+        2.8e-11, unit="mm²/N", low=0.0, high=1.0e-3,
+        default_doc="2.8e-11 (2.8e-17 m²/N): Liu et al.'s k of the cycloid–pin pair (Janakiraman's regression, not "
+                    "printed), recovered from their mean flank wear of 2.70e-5 µm per output revolution at 412 N·m "
+                    "and 15 rpm (docs/theory.md, \"Transmission-accuracy life\")",
+        doc="Archard wear coefficient k = K/H of the cycloid flank and pin pair")
+    crank_bearing_rate_um_per_N_Mrev: float = param(
+        5.3e-7, unit="µm/(N·10⁶ rev)", low=0.0, high=1.0,
+        default_doc="5.3e-7: Liu et al.'s turning-arm bearing, 1.15e-4 µm/N over 6000 h at 600 rpm",
+        doc="growth of the crank bearings' radial clearance per N of mean radial load and per million "
+            "revolutions of the crank relative to the disc (the roller–raceway wear)")
+    support_bearing_rate_um_per_N_Mrev: float = param(
+        9.0e-7, unit="µm/(N·10⁶ rev)", low=0.0, high=1.0,
+        default_doc="9.0e-7: Liu et al.'s crankshaft support bearing, 1.90e-4 µm/N over 6000 h at 585 rpm",
+        doc="growth of the support bearings' radial clearance per N of mean radial load and per million "
+            "revolutions of the crank relative to the carrier (needs `[crank_support]`)")
+    update_step_um: float = param(
+        2.5, unit="µm", low=0.01, high=100.0,
+        default_doc="2.5 (Liu et al., after Zhang et al.: below it the contact pressures do not change)",
+        doc="the geometry is updated whenever the largest wear increment of any part reaches this")
+    lost_motion_limit_arcsec: float = param(
+        60.0, unit="arcsec", low=0.1, high=3600.0, default_doc="60 (Liu et al.)",
+        doc="the lost motion at which the transmission-accuracy life ends")
+    pin_rolling: str = param(
+        "none", choices=PIN_ROLLING, default_doc="`\"none\"` (Liu et al.)",
+        doc="`\"none\"`: the pins do not turn in their grooves (their wear stays on the contact arc); "
+            "`\"free\"`: they turn slowly, spreading their worn area over the whole circumference")

@@ -26,6 +26,7 @@ from rvfem.case.tables import (
     FanHoles,
     Loads,
     Lubricant,
+    Wear,
     Material,
     MeshSettings,
     Pins,
@@ -287,6 +288,7 @@ class Case:
     round_holes: RoundHoles | None = param(None)
     crank_support: CrankSupport | None = param(None)
     lubricant: Lubricant = param(Lubricant())
+    wear: Wear = param(Wear())
     description: str = param("", max_length=10000, doc="free text")
     source: str = param("<code>", compare=False, in_file=False)
     overrides: tuple[str, ...] = param((), compare=False, in_file=False)

@@ -1,0 +1,321 @@
+"""``rvfem wear``'s library part: the transmission-accuracy life of a case, Archard wear of the
+flanks, pins and bearings over the hours of service and the lost motion it leaves
+(docs/theory.md, "Transmission-accuracy life").
+
+The loop (Liu et al., *Degradation law analysis and life estimation of transmission accuracy of
+RV reducer based on tooth surface and bearing wear*, § 2.4 and its Figure 5): the load cycle of
+every duty row on the current (worn) stage gives the pin forces along each flank and the bearing
+loads; :mod:`rvfem.evaluate.wear` turns them into wear rates per hour of the flank (along the
+profile), of the pins (around them) and of the bearings' clearances; the wear runs on until the
+largest increment of any part reaches ``wear.update_step_um``; the worn geometry is then applied
+and the lost motion solved again, until the hours asked or the lost-motion limit.
+
+**The worn geometry (first version).** The flank and pin wear are applied as an *equivalent
+equidistant modification*: each flank's load-weighted mean wear gap
+(:func:`rvfem.evaluate.wear.load_weighted_gap`), the mean of the two flanks added to
+``cycloid.modification.equidistant``; the bearing wear is added to
+``crank_bearing.radial_clearance`` (the mean over the cranks) and
+``crank_support.radial_clearance``. The worn stage shares the disc's factorisation and column
+compliance (only the gaps and the bearing laws change); the shape of the wear along the flank is
+written out but not fed back element by element.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import logging
+import math
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rvfem.app.analysis import default_cache_dir
+from rvfem.case.definition import Case
+from rvfem.errors import CaseError
+from rvfem.evaluate import wear as archard
+from rvfem.evaluate.accuracy import quick_figures
+from rvfem.evaluate.hertz import composite_modulus
+from rvfem.geometry import disc_geometry
+from rvfem.mesh import mesh_case
+from rvfem.outputs import wear as files
+from rvfem.outputs.summary import result_folder
+from rvfem.solve import models
+from rvfem.solve.cycle import OperatingPoint, build_system, case_stage, load_cycle
+
+log = logging.getLogger(__name__)
+
+__all__ = ["GRID_POINTS", "WearState", "wear_life", "wear_option_problem"]
+
+GRID_POINTS = 361
+"""Pin phases ψ per flank (0 < ψ < π) the wear is accumulated on."""
+
+MAX_UPDATES = 2000
+"""Bound of the geometry updates of one run."""
+
+WORN_RANGE_MM = 0.05
+"""Wear depth beyond which the warning says the model leaves its range (the contact shape, taken
+as the unworn one, has changed by a visible part of the pin radius' curvature)."""
+
+
+@dataclass
+class WearState:
+    """The accumulated wear (mm): flank and pin depth per flank side (rows 0: ψ > 0, the flanks a
+    positive torque loads; 1: the mirror flanks) on the ψ grid, clearance added per crank bearing
+    and per crankshaft's support bearings."""
+
+    hours: float
+    flank: np.ndarray
+    pin: np.ndarray
+    crank: np.ndarray
+    support: np.ndarray
+    weights: np.ndarray = field(default_factory=lambda: np.ones((2, GRID_POINTS)))
+
+
+def wear_option_problem(hours: float, angle_count: int) -> tuple[str, str] | None:
+    """The first option of :func:`wear_life` that cannot be used, as ``(parameter, why)``, or None."""
+    if not (math.isfinite(hours) and hours > 0):
+        return "hours", f"must be a positive number of hours of service, got {hours:g}"
+    if angle_count < 1:
+        return "angle_count", f"needs at least 1 crank angle for the lost motion, got {angle_count}"
+    return None
+
+
+def _duty(case: Case) -> list[tuple[float, float, float]]:
+    """(time share normalised, speed rpm, torque N·m) of each duty row (the case's operating point
+    without a duty cycle); rows of zero torque wear nothing and are left out."""
+    rows = case.loads.duty_cycle
+    raw = ([(r.time_share, r.speed_rpm, r.torque_Nm) for r in rows] if rows
+           else [(1.0, case.loads.speed_rpm, case.loads.torque_Nm)])
+    total = sum(r[0] for r in raw)
+    return [(s / total, n, t) for s, n, t in raw if abs(t) > 0]
+
+
+def _worn_case(case: Case, state: WearState, kin) -> Case:
+    """The case with the wear applied (module docstring: the equivalent modification and clearances)."""
+    gap = np.zeros(2)
+    pin_at = kin.pin_angle * case.pins.radius
+    nodes = np.linspace(-0.5 * math.pi, 0.5 * math.pi, GRID_POINTS) * case.pins.radius
+    for s in range(2):
+        g = state.flank[s] + np.interp(pin_at, nodes, state.pin[s])
+        gap[s] = archard.load_weighted_gap(state.weights[s], g)
+    mod = case.cycloid.modification
+    cyc = dataclasses.replace(case.cycloid, modification=dataclasses.replace(
+        mod, equidistant=mod.equidistant + float(gap.mean())))
+    bearing = dataclasses.replace(case.crank_bearing,
+                                  radial_clearance=case.crank_bearing.radial_clearance + float(state.crank.mean()))
+    changes = {"cycloid": cyc, "crank_bearing": bearing}
+    if case.crank_support is not None:
+        changes["crank_support"] = dataclasses.replace(
+            case.crank_support, radial_clearance=case.crank_support.radial_clearance + float(state.support.mean()))
+    return case.replace(**changes)
+
+
+def _worn_stage(system, worn: Case):
+    """The stage of ``worn`` on the factorised disc of ``system`` (same mesh, model and column
+    compliance; the gaps from the worn profile, the bearing laws from the worn clearances)."""
+    bearing_class = models.bearing_model(system.bearing_model)
+    bearings = (bearing_class(worn, system.bearing_stiffness_scale, disc_stiffness_scale=system.stiffness_scale)
+                if getattr(bearing_class, "takes_disc_stiffness_scale", False)
+                else bearing_class(worn, system.bearing_stiffness_scale))
+    worn_system = dataclasses.replace(system, case=worn, geometry=disc_geometry(worn), bearings=bearings,
+                                      contact_sets={})
+    return case_stage(worn_system)
+
+
+def _figures(stage, case: Case, angle_count: int) -> tuple[float, float]:
+    """Lost motion (arcsec) and torsional rigidity (N·m/arcmin) of the stage at the rated torque,
+    the mean over ``angle_count`` crank angles of one tooth-mesh period."""
+    T = abs(case.loads.torque_Nm)
+    thetas = np.arange(angle_count) * 2.0 * math.pi / (angle_count * case.cycloid.teeth)
+    figs = [quick_figures(stage, T, case.analysis.friction, float(t)) for t in thetas]
+    return (60.0 * float(np.mean([f["lost_motion_arcmin"] for f in figs])),
+            float(np.mean([f["torsional_rigidity_Nm_per_arcmin"] for f in figs])))
+
+
+def _cycle_samples(cycle, case: Case):
+    """Pin phases (wrapped to (−π, π]) and forces (N) of every pin at every crank angle of a cycle."""
+    zp = case.pins.count
+    j = np.arange(zp)[None, :]
+    th = np.asarray(cycle.theta)[:, None]
+    psi = np.angle(np.exp(1j * (2 * np.pi * j / zp + th * (zp - case.cycloid.teeth) / zp - th)))
+    return psi.ravel(), np.asarray(cycle.pin_forces).ravel()
+
+
+def _support_loads(cycle, case: Case) -> np.ndarray | None:
+    """Mean radial load of each crankshaft's support bearings over the cycle, N (half the crank's
+    load from both discs), or None without ``[crank_support]``."""
+    if case.crank_support is None:
+        return None
+    if cycle.disc_bearing_forces is not None:
+        f = np.asarray(cycle.disc_bearing_forces).sum(axis=1)
+    else:
+        f = np.asarray(cycle.bearing_forces) * case.loads.discs
+    return 0.5 * np.linalg.norm(f, axis=-1).mean(axis=0)
+
+
+def _rates(system_stage, case: Case, kin, duty) -> dict:
+    """Wear rates per hour of every part on the current stage (mm/h), and the flank force weights."""
+    zp, zc, d = case.pins.count, case.cycloid.teeth, case.pins.count - case.cycloid.teeth
+    estar = composite_modulus(case.material.youngs_modulus, case.material.poissons_ratio)
+    w = case.wear
+    flank, pin = np.zeros((2, GRID_POINTS)), np.zeros((2, GRID_POINTS))
+    weights = np.zeros((2, GRID_POINTS))
+    n_cranks = case.cranks.count
+    crank, support = np.zeros(n_cranks), np.zeros(n_cranks)
+    for share, speed, torque in duty:
+        cycle = load_cycle(system_stage.first, op=OperatingPoint(torque, case.analysis.friction), stage=system_stage)
+        psi, force = _cycle_samples(cycle, case)
+        crank_revs_h = speed * 60.0 * zp / d                     # crank relative to the carrier
+        for s, sel in enumerate((psi >= 0, psi < 0)):
+            f = archard.side_force(np.abs(psi[sel]), force[sel], kin.psi)
+            dd, pp = archard.flank_pin_engagement(kin, f, k_mm2_per_N=w.k_flank_pin, length_mm=case.cycloid.thickness,
+                                                  modulus_MPa=estar, zp=zp, zc=zc, pin_radius=case.pins.radius,
+                                                  pin_rolling=w.pin_rolling)
+            flank[s] += share * dd * crank_revs_h * d            # one engagement per tooth per pin pitch passed
+            pin[s] += share * pp * speed * 60.0 * zc / d          # Zc/d engagements of a pin per output revolution
+            weights[s] += share * f
+        radial = np.linalg.norm(np.asarray(cycle.bearing_forces), axis=-1).mean(axis=0)
+        crank += share * np.array([archard.bearing_clearance_rate(r, crank_revs_h, w.crank_bearing_rate_um_per_N_Mrev)
+                                   for r in radial])
+        sup = _support_loads(cycle, case)
+        if sup is not None:
+            support += share * np.array([archard.bearing_clearance_rate(r, crank_revs_h,
+                                                                        w.support_bearing_rate_um_per_N_Mrev)
+                                         for r in sup])
+    return {"flank": flank, "pin": pin, "crank": crank, "support": support, "weights": weights}
+
+
+def _record(state: WearState, lm: float, rigidity: float, worn: Case, base: Case) -> dict:
+    """One row of wear.csv."""
+    return {"hours": state.hours, "lost_motion_arcsec": lm, "torsional_rigidity_Nm_per_arcmin": rigidity,
+            "flank_wear_max_um": 1e3 * float(state.flank.max()), "pin_wear_max_um": 1e3 * float(state.pin.max()),
+            "equivalent_equidistant_um": 1e3 * (worn.cycloid.modification.equidistant
+                                                 - base.cycloid.modification.equidistant),
+            "crank_bearing_clearance_um": 1e3 * worn.crank_bearing.radial_clearance,
+            "support_bearing_clearance_um": (1e3 * worn.crank_support.radial_clearance
+                                             if worn.crank_support is not None else None)}
+
+
+def _advance(state: WearState, rates: dict, step_mm: float, hours_left: float) -> float:
+    """Run the wear on by the hours at which the largest increment of any part reaches the step
+    (at most ``hours_left``); returns the hours run."""
+    fastest = max(float(np.max(rates[k])) for k in ("flank", "pin", "crank", "support"))
+    dt = hours_left if fastest <= 0 else min(hours_left, step_mm / fastest)
+    state.flank += rates["flank"] * dt
+    state.pin += rates["pin"] * dt
+    state.crank += rates["crank"] * dt
+    state.support += rates["support"] * dt
+    state.weights = rates["weights"]
+    state.hours += dt
+    return dt
+
+
+def life_loop(case: Case, stage, system, hours: float, angle_count: int) -> tuple[list[dict], WearState, object]:
+    """The loop over life (module docstring): the records of every update, the final state and the
+    kinematics of the flank grid."""
+    kin = archard.mesh_kinematics(case.pins.circle_radius, case.pins.radius, case.cycloid.eccentricity,
+                                  case.pins.count, case.cycloid.teeth,
+                                  np.linspace(0.0, math.pi, GRID_POINTS + 2)[1:-1])
+    duty = _duty(case)
+    if not duty:
+        raise CaseError("rvfem wear needs a torque: loads.torque_Nm (or every duty_cycle row's torque) is 0; "
+                        "give the torque of the service")
+    n = case.cranks.count
+    state = WearState(0.0, np.zeros((2, GRID_POINTS)), np.zeros((2, GRID_POINTS)), np.zeros(n), np.zeros(n))
+    lm, rig = _figures(stage, case, angle_count)
+    records = [_record(state, lm, rig, case, case)]
+    step = 1e-3 * case.wear.update_step_um
+    current = stage
+    for _ in range(MAX_UPDATES):
+        if state.hours >= hours * (1 - 1e-12) or records[-1]["lost_motion_arcsec"] >= case.wear.lost_motion_limit_arcsec:
+            break
+        rates = _rates(current, case, kin, duty)
+        _advance(state, rates, step, hours - state.hours)
+        worn = _worn_case(case, state, kin)
+        current = _worn_stage(system, worn)
+        lm, rig = _figures(current, case, angle_count)
+        records.append(_record(state, lm, rig, worn, case))
+        log.info("wear: %.1f h, lost motion %.2f arcsec", state.hours, lm)
+    return records, state, kin
+
+
+def life_figures(records: list[dict], limit: float) -> dict:
+    """``transmission_accuracy_life_h`` (the hours at which the lost motion reaches ``limit``,
+    linear between updates; None when not reached), the hours run and
+    ``lost_motion_growth_arcsec_per_h`` (the least-squares slope over the second half of the hours
+    run, or the secant of the last two records)."""
+    h = np.array([r["hours"] for r in records])
+    lm = np.array([r["lost_motion_arcsec"] for r in records])
+    life = None
+    above = np.flatnonzero(lm >= limit)
+    if above.size:
+        i = int(above[0])
+        life = 0.0 if i == 0 else float(np.interp(limit, lm[i - 1:i + 1], h[i - 1:i + 1]))
+    late = h >= 0.5 * h[-1]
+    if late.sum() >= 3:
+        slope = float(np.polyfit(h[late], lm[late], 1)[0])
+    elif len(h) >= 2 and h[-1] > h[-2]:
+        slope = float((lm[-1] - lm[-2]) / (h[-1] - h[-2]))
+    else:
+        slope = None
+    return {"transmission_accuracy_life_h": life, "hours_run": float(h[-1]),
+            "lost_motion_growth_arcsec_per_h": slope}
+
+
+def _warnings(state: WearState, case: Case) -> list[str]:
+    """Where the wear leaves the model's range."""
+    out = []
+    deepest = max(float(state.flank.max()), float(state.pin.max()))
+    if deepest > WORN_RANGE_MM:
+        out.append(f"the deepest wear, {1e3 * deepest:.0f} µm, is beyond {1e3 * WORN_RANGE_MM:.0f} µm: the contact "
+                   "shape is taken as the unworn one and the wear as an equivalent equidistant modification; "
+                   "the results past it are indicative")
+    if case.crank_support is None:
+        out.append("no [crank_support]: the support bearings' wear is not modelled")
+    return out
+
+
+def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_count: int = 3,
+              cache_dir: str | os.PathLike | None = None, overwrite: bool = False) -> dict:
+    """Run the wear of ``case`` over ``hours`` of service (or to the lost-motion limit) and write
+    wear.csv, worn_flank.csv, worn_pin.csv, plots/lost_motion.png, plots/wear_profile.png and
+    summary.json to ``out_dir`` (an atomic result folder, :func:`rvfem.outputs.summary.result_folder`).
+    Returns the summary.
+
+    The lost motion is read at ±3 % of ``loads.torque_Nm`` (its magnitude) with
+    :func:`rvfem.evaluate.accuracy.quick_figures`, the mean over ``angle_count`` crank angles of one
+    tooth-mesh period.
+
+    Raises
+    ------
+    CaseError
+        An option cannot be used (:func:`wear_option_problem`), or the duty has no torque.
+    OutputError
+        ``out_dir`` cannot take the results.
+    """
+    t0 = time.perf_counter()
+    problem = wear_option_problem(hours, angle_count)
+    if problem is not None:
+        raise CaseError(" ".join(problem))
+    if not case.loads.torque_Nm:
+        raise CaseError("rvfem wear reads the lost motion at ±3 % of loads.torque_Nm, which is 0; give the rated torque")
+    with result_folder(out_dir, overwrite=overwrite, what="wear") as out:
+        geometry = disc_geometry(case)
+        mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
+        system = build_system(case, mesh, geometry=geometry)
+        records, state, kin = life_loop(case, case_stage(system), system, hours, angle_count)
+        summary = {"case": case.name, "hours_asked": float(hours),
+                   **life_figures(records, case.wear.lost_motion_limit_arcsec),
+                   "lost_motion_limit_arcsec": case.wear.lost_motion_limit_arcsec,
+                   "initial_lost_motion_arcsec": records[0]["lost_motion_arcsec"],
+                   "final_lost_motion_arcsec": records[-1]["lost_motion_arcsec"], "updates": len(records) - 1,
+                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in _duty(case)],
+                   "warnings": _warnings(state, case)}
+        files.write_wear_files(out, records, state, kin, case)
+        summary["timings"] = {"total_s": time.perf_counter() - t0}
+        (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")
+    return summary
+

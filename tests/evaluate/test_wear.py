@@ -1,0 +1,143 @@
+"""Archard wear (rvfem.evaluate.wear) and the life loop of ``rvfem wear`` (rvfem.app.wear), against
+closed forms and Liu et al.'s published kinematics (*Degradation law analysis and life estimation of
+transmission accuracy of RV reducer based on tooth surface and bearing wear*, § 3.1 and § 4.1)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import CASES_DIR, coarse_case
+
+from rvfem.app import cli
+from rvfem.app.wear import life_figures, life_loop
+from rvfem.errors import CaseError
+from rvfem.evaluate import wear as archard
+from rvfem.geometry import disc_geometry
+from rvfem.mesh import mesh_case
+from rvfem.solve.cycle import build_system, case_stage
+
+RV40E = dict(Rp=64.0, r_rp=3.0, e=1.3, zp=40, zc=39)   # Liu et al. Table 1
+PSI = np.linspace(0.0, math.pi, 3603)[1:-1]
+
+
+def _kin(psi=PSI, **kw):
+    g = {**RV40E, **kw}
+    return archard.mesh_kinematics(g["Rp"], g["r_rp"], g["e"], g["zp"], g["zc"], psi)
+
+
+def test_pin_on_flat_depth_is_archard_and_linear_in_time():
+    """A pin pressed on a flat that slides under it at constant load: the pin's point under the
+    contact centre wears k·p_h·s (p_h = 2F/(πbL), the Hertz peak) and the worn area is k·F·s/L,
+    both linear in the sliding distance s = v·t."""
+    k, F, L, b, v, dt = 3e-11, 500.0, 9.0, 0.05, 20.0, 1e-3
+    nodes = np.linspace(-0.2, 0.2, 4001)
+    for steps in (100, 200):
+        depth = archard.footprint_wear(nodes, np.zeros(steps), np.full(steps, k * F * v * dt / L), np.full(steps, b))
+        s = v * dt * steps
+        p_h = 2 * F / (math.pi * b * L)
+        assert depth[2000] == pytest.approx(archard.archard_depth(k, p_h, s), rel=2e-3)
+        assert np.trapezoid(depth, nodes) * L == pytest.approx(k * F * s, rel=1e-12)
+        if steps == 100:
+            first = depth[2000]
+    assert depth[2000] == pytest.approx(2 * first, rel=1e-12)
+
+
+def test_sliding_speed_is_liu_closed_form_and_coefficients_match_their_figure_9():
+    """|v_s| = (Zp − Zc)/Zp·(Rp·τ − r_rp) per unit crank angle (Liu et al.'s V_pc^r with
+    ω_p = Zc/Zp); their RV-40E: the flank's largest sliding coefficient 2.7258, the pin's contact
+    arc α = 0–54.3692° and its sliding coefficient infinite near ψ = 36° (contact standing still on
+    the pin)."""
+    kin = _kin()
+    K1 = 1.3 * 40 / 64
+    tau = np.sqrt(1 + K1**2 - 2 * K1 * np.cos(PSI))
+    assert np.allclose(kin.sliding, (64 * tau - 3) / 40, rtol=1e-12, atol=1e-12)
+    assert kin.eps_disc.max() == pytest.approx(2.7258, abs=1e-4)
+    # the contact arc on the pin ends where sin γ = K1 (the largest lever, docs/theory.md § 9b): 54.341°,
+    # Liu et al. print 54.3692° (their modified profile)
+    assert math.degrees(np.abs(kin.pin_angle).max()) == pytest.approx(math.degrees(math.asin(K1)), abs=1e-3)
+    assert math.degrees(np.abs(kin.pin_angle).max()) == pytest.approx(54.3692, abs=0.05)
+    assert math.degrees(PSI[np.argmin(kin.rolling_pin)]) == pytest.approx(36.0, abs=1.0)
+    # another tooth difference: the pitch point at e·Zp/(Zp − Zc), |v_s| = (Zp − Zc)/Zp·|P − C|
+    two = _kin(zp=40, zc=38)
+    C = np.array([1.3 * 40 / 2, 0.0])
+    assert np.allclose(two.sliding, 2 / 40 * np.linalg.norm(two.point - C, axis=-1), rtol=1e-12)
+
+
+def test_sliding_vanishes_at_the_pitch_point():
+    """With r_rp = Rp·(1 − K1) the pin at ψ = 0 touches the disc at the pitch point: the two bodies
+    move alike there (the rolling/sliding decomposition: sliding 0, equal rolling speeds over
+    both surfaces), so both sliding coefficients vanish; away from it they do not."""
+    K1 = 1.3 * 40 / 64
+    kin = _kin(np.array([0.0, 0.3]), r_rp=64 * (1 - K1))
+    assert kin.sliding[0] == pytest.approx(0.0, abs=1e-12)
+    assert kin.rolling_disc[0] == pytest.approx(kin.rolling_pin[0], rel=1e-9)
+    assert kin.eps_disc[0] == pytest.approx(0.0, abs=1e-12) and kin.eps_pin[0] == pytest.approx(0.0, abs=1e-12)
+    assert kin.eps_disc[1] > 0.01
+
+
+def test_engagement_conserves_the_worn_area():
+    """Worn area of the flank (and of a fixed pin) in one engagement = k·Σ F·ds / L, ds the sliding
+    distance of each step; a freely turning pin spreads the same area over its circumference."""
+    kin = _kin(np.linspace(0.0, math.pi, 723)[1:-1])
+    K1 = 1.3 * 40 / 64
+    F = 406.0 * np.sin(kin.psi) / np.sqrt(1 + K1**2 - 2 * K1 * np.cos(kin.psi))
+    k, L = 2.8e-11, 9.0
+    expect = k * np.sum(F * kin.sliding * 40 / 39 * np.abs(np.gradient(kin.psi))) / L
+    for mode in ("none", "free"):
+        disc, pin = archard.flank_pin_engagement(kin, F, k_mm2_per_N=k, length_mm=L, modulus_MPa=1.16e5, zp=40,
+                                                 zc=39, pin_radius=3.0, pin_rolling=mode)
+        assert np.trapezoid(disc, kin.disc_arc) == pytest.approx(expect, rel=1e-3)
+        nodes = np.linspace(-0.5 * math.pi, 0.5 * math.pi, len(pin)) * 3.0
+        area = np.trapezoid(pin, nodes) if mode == "none" else pin[0] * 2 * math.pi * 3.0
+        assert area == pytest.approx(expect, rel=1e-3)
+
+
+def test_load_weighted_gap_of_a_uniform_gap_is_that_gap():
+    assert archard.load_weighted_gap([1.0, 3.0, 0.0], [2e-3, 2e-3, 9.0]) == pytest.approx(2e-3)
+
+
+def _life(step_um: float, mesh_dir) -> float:
+    case = coarse_case("rv40e_solid", analysis={"angle_step_deg": 30.0},
+                       wear={"k_flank_pin": 4e-10, "update_step_um": step_um, "lost_motion_limit_arcsec": 40.0})
+    geometry = disc_geometry(case)
+    system = build_system(case, mesh_case(case, mesh_dir, geometry=geometry), geometry=geometry)
+    records, _, _ = life_loop(case, case_stage(system), system, 1e4, 1)
+    life = life_figures(records, 40.0)["transmission_accuracy_life_h"]
+    assert life is not None
+    return life
+
+
+def test_life_is_independent_of_the_update_step(tmp_path):
+    """Halving the update step changes the transmission-accuracy life by less than 5 % (3.96 h
+    against 3.85 h here)."""
+    a, b = _life(5.0, tmp_path), _life(2.5, tmp_path)
+    assert abs(a - b) / b < 0.05
+
+
+@pytest.mark.parametrize("key, value, words", [("wear.pin_rolling", '"rolling"', "must be one of"),
+                                               ("wear.k_flank_pin", "-1e-11", "wear.k_flank_pin"),
+                                               ("wear.update_step_um", "0", "wear.update_step_um")])
+def test_bad_wear_keys_are_refused_in_one_line(key, value, words, tmp_path, capsys):
+    assert cli.main(["wear", str(CASES_DIR / "rv40e.toml"), "--hours", "10", "-o", str(tmp_path / "o"),
+                     "--set", f"{key}={value}"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and key in err and "Traceback" not in err
+    assert words in err or "must be" in err
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("hours", ["0", "-5", "nan"])
+def test_bad_hours_are_refused(hours, tmp_path, capsys):
+    assert cli.main(["wear", str(CASES_DIR / "rv40e.toml"), "--hours", hours, "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--hours" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_duty_without_torque_is_refused():
+    from rvfem.app.wear import wear_life
+    case = coarse_case("rv40e_solid")
+    with pytest.raises(CaseError, match="torque"):
+        wear_life(case.replace(loads=case.loads.__class__(torque_Nm=0.0, speed_rpm=15.0)), "/nonexistent/x", hours=1)
