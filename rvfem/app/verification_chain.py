@@ -416,7 +416,7 @@ def accuracy_section(discs: _Discs) -> Section:
                    "crank_bearing.stiffness_law='linear'", "crank_bearing.linear_stiffness_N_per_mm=3e5")
     stage = cycle.case_stage(build_system(linear, mesh_case(linear, discs.cache)))
     loop = accuracy.hysteresis_loop(stage, 0.3, T, steps=8)
-    phi = cycle.solve_pair(stage, 0.3, op=cycle.OperatingPoint(T)).results[0].carrier_rotation
+    phi = cycle.solve_pair(stage, 0.3, op=cycle.OperatingPoint(T)).output_rotation   # with the series parts
     plus = loop.torque_Nm > 0
     e_lin = float(np.abs(loop.torque_Nm[plus] / loop.rotation_rad[plus] / (T / phi) - 1.0).max())
     dr, g2 = 0.01, 0.01
