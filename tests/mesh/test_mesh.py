@@ -273,11 +273,13 @@ def test_gmsh_session_leaves_sigpipe_ignored():
 
 @pytest.mark.slow
 def test_default_fanholes_case_size_and_quality(tmp_path):
-    """The project's default case at its own sizes: 10-20k nodes (the load cycle budget), good
-    quality, and the fine size really is applied along the flanks and the bores."""
+    """The project's default case at its own sizes: 10-21k nodes (the load cycle budget; the hole
+    fillets' own size, mesh.size_fillet, added 1065 vertices to 19 074 to bring the structural peak
+    within 3 % of converged), good quality, and the fine size really is applied along the flanks and
+    the bores."""
     case = load_case(CASES / "rv40e_fanholes.toml")
     m = mesh_case(case, tmp_path)
-    assert 10_000 <= m.n_nodes <= 20_000
+    assert 10_000 <= m.n_nodes <= 21_000
     assert m.min_quality > MIN_QUALITY
     for name, h in (("profile", case.mesh.size_flank), ("bore_0", case.mesh.size_bore)):
         e = m.boundaries[name]
