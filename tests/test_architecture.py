@@ -201,3 +201,13 @@ def test_the_analysis_scheduler_takes_at_most_eight_parameters_per_function():
         count = (len(a.posonlyargs) + len(a.args) + len(a.kwonlyargs) + (a.vararg is not None)
                  + (a.kwarg is not None) - (1 if a.args and a.args[0].arg in ("self", "cls") else 0))
         assert count <= 8, f"rvfem/app/analysis.py: {f.name} takes {count} parameters"
+
+
+MAX_MODULE_LINES = 800
+"""Longest module of the package, lines: a module longer than this holds more than one concern."""
+
+
+def test_no_module_is_longer_than_eight_hundred_lines():
+    long = {str(p.relative_to(ROOT)): n for p in sorted(PACKAGE.rglob("*.py"))
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > MAX_MODULE_LINES}
+    assert not long, f"modules over {MAX_MODULE_LINES} lines (split them along their concerns): {long}"

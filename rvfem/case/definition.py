@@ -78,10 +78,8 @@ from rvfem.case.tables import (
     RollerProfile,
     RoundHoles,
 )
+from rvfem.case.mesh_checks import _MESH_BAND_FACTOR, _MESH_HOLE_SIZE_FACTOR, _MESH_SIZE_GROWTH
 from rvfem.case.whole_case import (
-    _MESH_BAND_FACTOR,
-    _MESH_HOLE_SIZE_FACTOR,
-    _MESH_SIZE_GROWTH,
     BORE_FOOTPRINT_FRACTION,
     BUILTIN_HOLE_TABLES,
     FLANK_FOOTPRINT_FRACTION,

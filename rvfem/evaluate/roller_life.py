@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rvfem.evaluate import lubrication, roller_slices
+from rvfem.solve.models import roller_angles
 from rvfem.evaluate.bearing_checks import crank_bearing_static_rating
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
 from rvfem.evaluate.iso281 import ROLLER_LIFE_EXPONENT
@@ -647,7 +648,7 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
         ``progress(done, total)`` after each bearing.
     """
     loads = roller_slices.case_rigid_roller_loads(case, theta, rigid_forces)
-    angles = roller_slices.roller_angles(case, np.asarray(theta, dtype=float))
+    angles = roller_angles(case, np.asarray(theta, dtype=float))
     tilts = roller_tilts(np.zeros(np.shape(rigid_forces)), angles, rigid_forces,
                          1e-3 * case.crank_bearing.profile.misalignment_mrad)
     cache = {} if cache is None else cache
@@ -719,7 +720,7 @@ def l10r_steps(case, theta: np.ndarray, cycle, handbook_forces: np.ndarray, fric
     """
     theta = np.asarray(theta, dtype=float)
     misalignment = 1e-3 * case.crank_bearing.profile.misalignment_mrad
-    angles = roller_slices.roller_angles(case, theta)
+    angles = roller_angles(case, theta)
     slopes = eccentric_slopes(case, cycle)
     tilted = roller_tilts(slopes, cycle.roller_angles, cycle.bearing_forces, misalignment)
     untilted = roller_tilts(np.zeros_like(slopes), cycle.roller_angles, cycle.bearing_forces, misalignment)

@@ -15,6 +15,7 @@ from rvfem.evaluate import iso281, lubrication as lb, roller_life as rl, roller_
 from rvfem.evaluate.hertz import composite_modulus, reduced_radius
 from rvfem.errors import CaseError
 from rvfem.fem.crankshaft import beam_influence
+from rvfem.solve.models import roller_angles
 
 from conftest import CASES_DIR
 
@@ -262,7 +263,7 @@ def _steps_cycle(case, theta, forces, scale_rollers=1.0):
         top = loads == loads.max(axis=-1, keepdims=True)
         loads = np.where(top, scale_rollers * loads, loads)
     return types.SimpleNamespace(bearing_forces=forces, roller_loads=loads, disc_bearing_forces=None,
-                                 roller_angles=rs.roller_angles(case, theta))
+                                 roller_angles=roller_angles(case, theta))
 
 
 def test_l10r_steps_multiply_to_the_ratio_and_are_one_where_nothing_changes(case):
