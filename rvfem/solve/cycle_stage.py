@@ -186,7 +186,8 @@ class ReducerStage:
                  else "crankshafts as beams on elastic support bearings")
         if self.eccentric_play_mm > 0:
             crank += f" with {1e3 * self.eccentric_play_mm:.3g} µm radial play in the support bearings"
-        springs = "".join(f"; {name} in series with the output ({1.0 / c if c > 0 else math.inf:.4g} N·mm/rad)"
+        springs = "".join(f"; {name} in series with the output ({1.0 / c:.4g} N·mm/rad)" if c > 0
+                          else f"; {name} without compliance under the output torque"
                           for name, c in self.output_compliances)
         return f"{disc}; {crank}{springs}"
 
