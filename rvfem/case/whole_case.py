@@ -437,22 +437,29 @@ def _check_crank_bearing(case: Case) -> None:
                      "the rollers do not fit between the eccentric and the bore")
 
 
-def _check_other_holes(case: Case) -> None:
-    """Check the tables of :attr:`Case.other_holes` like the fields (each against its declaration)
-    and put them in the order of :func:`hole_table_names`."""
-    given = case.other_holes
+def _named_tables(case: Case, key: str, names: tuple[str, ...], owners: str) -> list[tuple[str, Any]]:
+    """The (table name, table) pairs of ``case.<key>`` (a mapping or pairs), each name one of
+    ``names`` (the tables of the registered ``owners``) and given once."""
+    given = getattr(case, key)
     pairs = list(given.items()) if isinstance(given, Mapping) else list(given)
-    names = _other_hole_names()
     seen: set[str] = set()
     for pair in pairs:
         if not (isinstance(pair, tuple) and len(pair) == 2 and pair[0] in names):
             known = ", ".join(names) or "none"
-            raise _error(case, "other_holes", f"must hold (table name, table) pairs of the registered hole shapes "
-                                              f"({known}), got {pair!r}")
-        name, table = pair
-        if name in seen:
-            raise _error(case, name, "is given twice")
-        seen.add(name)
+            raise _error(case, key, f"must hold (table name, table) pairs of the registered {owners} ({known}), "
+                                    f"got {pair!r}")
+        if pair[0] in seen:
+            raise _error(case, pair[0], "is given twice")
+        seen.add(pair[0])
+    return pairs
+
+
+def _check_other_holes(case: Case) -> None:
+    """Check the tables of :attr:`Case.other_holes` like the fields (each against its declaration)
+    and put them in the order of :func:`hole_table_names`."""
+    names = _other_hole_names()
+    pairs = _named_tables(case, "other_holes", names, "hole shapes")
+    for name, table in pairs:
         if table is None:
             continue
         cls = _HOLE_SHAPES[name].table
@@ -467,19 +474,7 @@ def _check_component_tables(case: Case) -> None:
     """Check the tables of :attr:`Case.component_tables` against their declarations, add those
     there by default that are missing (with their defaults), run each table's own ``check`` and
     put them in the order of :func:`component_tables`."""
-    given = case.component_tables
-    pairs = list(given.items()) if isinstance(given, Mapping) else list(given)
-    names = _component_table_names()
-    tables: dict[str, Any] = {}
-    for pair in pairs:
-        if not (isinstance(pair, tuple) and len(pair) == 2 and pair[0] in names):
-            known = ", ".join(names) or "none"
-            raise _error(case, "component_tables", f"must hold (table name, table) pairs of the registered stage "
-                                                   f"components ({known}), got {pair!r}")
-        name, table = pair
-        if name in tables:
-            raise _error(case, name, "is given twice")
-        tables[name] = table
+    tables = dict(_named_tables(case, "component_tables", _component_table_names(), "stage components"))
     ordered = []
     for entry in component_tables():
         table = tables.get(entry.name)
