@@ -46,6 +46,7 @@ from rvfem.app.case_resolution import MIN_ANGLES, cycle_angles, resolve_case
 from rvfem.app.p2_model import P2Model, models_in_package, recover_structural_peak, start_p2_child
 from rvfem.app.stages import STAGES, ProgressCallback, Stages, StageSteps, timed
 from rvfem.case.definition import Case
+from rvfem.case.mesh_checks import contact_grid_spacing
 from rvfem.errors import CaseError
 from rvfem.evaluate import attribution, bearing_checks, compare, hertz, iso281, postprocess, rigid, roller_life, roller_slices, validity
 from rvfem.geometry import disc_geometry
@@ -105,8 +106,9 @@ __all__ = [
 
 CONTACT_BAND_ELEMENTS = 6.0
 """Width of the band along the tooth profile and the bores excluded from the "away from contacts"
-stress peak, in element sizes there (``mesh.size_flank``, ``mesh.size_bore``): four times the
-footprint half-width over which the pin and roller forces are spread."""
+stress peak, in element sizes there (``mesh.size_flank``, ``mesh.size_bore``, or the contact grid's
+spacing where it is coarser): four times the footprint half-width over which the pin and roller
+forces are spread."""
 
 
 
@@ -495,8 +497,10 @@ def _stress_envelope(case: Case, system: DiscSystem, mesh: DiscMesh, cycle: Cycl
     contact bands (:data:`CONTACT_BAND_ELEMENTS` element sizes), and the kept fields with theirs."""
     peak = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries)
     assert peak is not None               # nothing excluded: the disc's largest vertex stress
-    band = {"profile": CONTACT_BAND_ELEMENTS * case.mesh.size_flank}
-    band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * case.mesh.size_bore for i in range(case.cranks.count)})
+    size = {"profile": max(case.mesh.size_flank, contact_grid_spacing(case)["profile"]),
+            "bore": max(case.mesh.size_bore, contact_grid_spacing(case)["bore"])}
+    band = {"profile": CONTACT_BAND_ELEMENTS * size["profile"]}
+    band.update({f"bore_{i}": CONTACT_BAND_ELEMENTS * size["bore"] for i in range(case.cranks.count)})
     away = postprocess.peak_von_mises(cycle, mesh.points, mesh.boundaries, exclude=band)
     snapshots = postprocess.field_snapshots(
         system, cycle, extra_angles=[math.radians(pk.theta_deg) for pk in (peak, away) if pk is not None])

@@ -13,7 +13,8 @@ Case = Any
 """A case (:class:`rvfem.case.whole_case.Case`, the layer above this module, which calls these checks)."""
 
 __all__ = ["BORE_FOOTPRINT_FRACTION", "FLANK_FOOTPRINT_FRACTION", "FOOTPRINT_ELEMENTS", "MAX_MESH_NODES",
-           "check_mesh", "check_mesh_sizes", "estimated_mesh_nodes", "max_element_sizes"]
+           "check_mesh", "check_mesh_sizes", "contact_grid_spacing", "estimated_mesh_nodes", "footprint_half_widths",
+           "max_element_sizes"]
 
 
 MAX_MESH_NODES = 2_000_000
@@ -95,6 +96,28 @@ the case bounds the mesh sizes with it. The Hertz half-widths of these contacts 
 one element at the default sizes, so the footprint spreads each force over a few elements; the
 bearing loads do not depend on it (global equilibrium), only the stress right under a contact."""
 
+
+def contact_grid_spacing(case: Case) -> dict[str, float]:
+    """Spacing of the contact grid (the footprint columns) along the profile and the bores, mm:
+    ``mesh.contact_grid_flank`` / ``mesh.contact_grid_bore``, else the element size there
+    (``mesh.size_flank`` / ``mesh.size_bore``: a column at every boundary vertex).
+
+    Returns
+    -------
+    dict
+        ``{"profile": spacing, "bore": spacing}``, mm.
+    """
+    ms = case.mesh
+    return {"profile": ms.contact_grid_flank if ms.contact_grid_flank is not None else ms.size_flank,
+            "bore": ms.contact_grid_bore if ms.contact_grid_bore is not None else ms.size_bore}
+
+
+def footprint_half_widths(case: Case) -> dict[str, float]:
+    """Half-width of the pin (``"profile"``) and roller (``"bore"``) load footprints, mm:
+    :data:`FOOTPRINT_ELEMENTS` spacings of the contact grid (:func:`contact_grid_spacing`)."""
+    return {name: FOOTPRINT_ELEMENTS * h for name, h in contact_grid_spacing(case).items()}
+
+
 BORE_FOOTPRINT_FRACTION = 0.25
 """Largest part of a bore's circumference a roller footprint (2·FOOTPRINT_ELEMENTS·size_bore wide)
 may cover."""
@@ -136,18 +159,25 @@ def _floor3(x: float) -> float:
 
 
 def check_mesh_sizes(case: Case) -> None:
+    """Refuse a contact grid (the element size, or ``mesh.contact_grid_*`` when given) whose load
+    footprints would not act locally (:func:`max_element_sizes`), naming the key that sets it."""
     limits = max_element_sizes(case)
     ms = case.mesh
-    if limits["mesh.size_flank"] > 0 and ms.size_flank > limits["mesh.size_flank"]:
-        raise table_error(case.source, "mesh.size_flank",
-                     f"({ms.size_flank:g} mm) is too coarse for the teeth: a pin load is spread over "
-                     f"±{FOOTPRINT_ELEMENTS:g} element sizes, which must stay within one flank (half a lobe, "
+    spacing = contact_grid_spacing(case)
+    flank_key = "mesh.contact_grid_flank" if ms.contact_grid_flank is not None else "mesh.size_flank"
+    bore_key = "mesh.contact_grid_bore" if ms.contact_grid_bore is not None else "mesh.size_bore"
+    unit = "grid spacings" if ms.contact_grid_flank is not None else "element sizes"
+    if limits["mesh.size_flank"] > 0 and spacing["profile"] > limits["mesh.size_flank"]:
+        raise table_error(case.source, flank_key,
+                     f"({spacing['profile']:g} mm) is too coarse for the teeth: a pin load is spread over "
+                     f"±{FOOTPRINT_ELEMENTS:g} {unit}, which must stay within one flank (half a lobe, "
                      f"π·r_root/Zc = {2.0 * FOOTPRINT_ELEMENTS * limits['mesh.size_flank']:.3g} mm); "
                      f"use at most {_floor3(limits['mesh.size_flank']):g} mm")
-    if ms.size_bore > limits["mesh.size_bore"]:
-        raise table_error(case.source, "mesh.size_bore",
-                     f"({ms.size_bore:g} mm) is too coarse for the bores: a roller load is spread over "
-                     f"±{FOOTPRINT_ELEMENTS:g} element sizes, which must stay within a quarter of the bore "
+    unit = "grid spacings" if ms.contact_grid_bore is not None else "element sizes"
+    if spacing["bore"] > limits["mesh.size_bore"]:
+        raise table_error(case.source, bore_key,
+                     f"({spacing['bore']:g} mm) is too coarse for the bores: a roller load is spread over "
+                     f"±{FOOTPRINT_ELEMENTS:g} {unit}, which must stay within a quarter of the bore "
                      f"circumference ({2.0 * FOOTPRINT_ELEMENTS * limits['mesh.size_bore']:.3g} mm for "
                      f"crank_bearing.bore_radius = {case.crank_bearing.bore_radius:g} mm); use at most "
                      f"{_floor3(limits['mesh.size_bore']):g} mm")

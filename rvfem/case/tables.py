@@ -612,6 +612,15 @@ class MeshSettings:
                                       doc="element size on the corner fillets of the lightening holes, where the "
                                           "structural stress peak is (a local refinement: the rest of the hole "
                                           "keeps `size_hole`)")
+    contact_grid_flank: float | None = param(None, unit="mm", low=0.01, high=100.0,
+                                             default_doc="`size_flank` (a column at every boundary vertex)",
+                                             doc="spacing of the contact grid along the profile: the pin-load footprint "
+                                                 "columns and their half-width (1.5 spacings); set it to keep the contact "
+                                                 "model, and its cost, fixed while the mesh is refined (docs/theory.md § 6)")
+    contact_grid_bore: float | None = param(None, unit="mm", low=0.01, high=100.0,
+                                            default_doc="`size_bore` (a column at every boundary vertex)",
+                                            doc="spacing of the contact grid along the bores (the roller-load footprint "
+                                                "columns), as `contact_grid_flank`")
     symmetric: bool = param(True, doc="mesh one 360°/N sector and copy it by rotation when the disc is N-fold "
                                       "symmetric (exactly symmetric mesh; the load cycle then solves one sector "
                                       "of crank angles)")

@@ -39,6 +39,13 @@ class FootprintGrid:
         Bore centre for bore grids (one column per vertex, pushing radially away from it), None
         for the profile (two columns per vertex, unit forces in x and y, so that a contact force
         of any direction is represented exactly).
+    spacing : float or None
+        When given, the columns sit at equal arc-length steps of about ``spacing`` (mm) instead of
+        at the vertices, whatever the mesh: a contact grid that stays the same when the mesh is
+        refined (``stride`` is then not used). Their count is a multiple of ``multiple``.
+    multiple : int
+        With ``spacing``: the column count is rounded to a multiple of it (the mesh's rotation
+        symmetry N, so that the equal steps of an N-fold symmetric loop turn into each other).
     """
 
     name: str
@@ -46,6 +53,8 @@ class FootprintGrid:
     chain: fem.BoundaryChain
     centre: np.ndarray | None = None
     stride: int = 1
+    spacing: float | None = None
+    multiple: int = 1
 
     @property
     def components(self) -> int:
@@ -55,17 +64,24 @@ class FootprintGrid:
     @functools.cached_property
     def arcs(self) -> np.ndarray:
         """Arc lengths of the column positions, mm, with the loop length appended."""
-        return _readonly(np.append(self.chain.s[:-1][::self.stride], self.chain.s[-1]))
+        if self.spacing is None:
+            return _readonly(np.append(self.chain.s[:-1][::self.stride], self.chain.s[-1]))
+        length = float(self.chain.s[-1])
+        m = max(1, int(self.multiple))
+        n = m * max(1, round(length / (m * float(self.spacing))))
+        return _readonly(np.linspace(0.0, length, n + 1))
 
     @functools.cached_property
     def count(self) -> int:
         """Number of column positions."""
         return len(self.arcs) - 1
 
-    @property
+    @functools.cached_property
     def polyline(self) -> np.ndarray:
-        """Column positions (vertices) in loop order, (count, 2), mm."""
-        return self.chain.points[:-1][::self.stride]
+        """Column positions (vertices, or the points at :attr:`arcs`) in loop order, (count, 2), mm."""
+        if self.spacing is None:
+            return self.chain.points[:-1][::self.stride]
+        return _readonly(self.chain.point_at(self.arcs[:-1]))
 
     def arc_of(self, points: np.ndarray) -> np.ndarray:
         """Arc length of the boundary point closest to each of ``points``, mm."""
@@ -124,7 +140,8 @@ class Interface:
 
 def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.ndarray,
                     bore_centres: dict[str, np.ndarray], half_width: dict[str, float],
-                    stride: dict[str, int] | None = None) -> Interface:
+                    stride: dict[str, int] | None = None, *, spacing: dict[str, float] | None = None,
+                    multiple: int = 1) -> Interface:
     """Build the footprint columns and the load operator B on the named boundaries.
 
     Column k of a boundary sits at its k-th vertex; its unit force is spread over the arc
@@ -149,6 +166,11 @@ def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
     stride : dict name → int, optional
         Columns at every stride-th vertex (default 1). With a half-width above the column spacing
         the footprints still overlap, and fewer columns mean fewer back-substitutions.
+    spacing : dict name → float, optional
+        Boundaries whose columns sit at equal arc-length steps of about this spacing (mm) instead
+        of at the vertices (:class:`FootprintGrid`): a contact grid independent of the mesh.
+    multiple : int
+        The column count of a ``spacing`` grid is a multiple of it (the mesh's rotation symmetry).
     """
 
     blocks, points, directions, grids, widths = [], [], [], {}, {}
@@ -160,7 +182,7 @@ def build_interface(model, boundaries: dict[str, np.ndarray], rigid_modes: np.nd
         chain = chains[0]
         centre = bore_centres.get(name)
         grid = FootprintGrid(name, offset, chain, None if centre is None else np.asarray(centre, float),
-                             (stride or {}).get(name, 1))
+                             (stride or {}).get(name, 1), (spacing or {}).get(name), multiple)
         grids[name] = grid
         widths[name] = a = float(half_width[name])
         weights = fem.footprint_weights(model, chain, grid.arcs[:-1], a)

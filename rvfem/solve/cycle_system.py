@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rvfem import fem
-from rvfem.case.definition import FOOTPRINT_ELEMENTS, Case
+from rvfem.case.definition import Case
+from rvfem.case.mesh_checks import footprint_half_widths
 from rvfem.errors import CaseError, MeshError
 from rvfem.geometry import DiscGeometry, crank_centres, disc_geometry
 from rvfem.mesh import DiscMesh, rotation_permutation
@@ -207,17 +208,27 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
 
 def _footprint_interface(case: Case, mesh, model, rigid: np.ndarray, column_stride: int) -> Interface:
     """The contact interface of the profile and the bores: load footprints of ±FOOTPRINT_ELEMENTS
-    element sizes (:func:`rvfem.solve.contact.build_interface`), columns at every ``column_stride``-th
-    boundary vertex."""
+    spacings of the contact grid (:func:`rvfem.case.mesh_checks.footprint_half_widths`;
+    :func:`rvfem.solve.contact.build_interface`). Columns sit at every ``column_stride``-th boundary
+    vertex, or, where ``mesh.contact_grid_flank`` / ``mesh.contact_grid_bore`` is given, at that
+    spacing along the boundary whatever the mesh (their count a multiple of the mesh's rotation
+    symmetry, so that the grid turns into itself)."""
     centres = crank_centres(case)
     names = ["profile"] + [f"bore_{i}" for i in range(case.cranks.count)]
     boundaries = {n: mesh.boundaries[n] for n in names}
-    half = {"profile": FOOTPRINT_ELEMENTS * case.mesh.size_flank}
-    for i in range(case.cranks.count):
-        half[f"bore_{i}"] = FOOTPRINT_ELEMENTS * case.mesh.size_bore
+    widths = footprint_half_widths(case)
+    given = {"profile": case.mesh.contact_grid_flank, "bore": case.mesh.contact_grid_bore}
+    half, spacing = {}, {}
+    for name in names:
+        kind = "profile" if name == "profile" else "bore"
+        half[name] = widths[kind]
+        step = given[kind]
+        if step is not None:
+            spacing[name] = float(step)
     return contact.build_interface(model, boundaries, rigid,
                                    {f"bore_{i}": centres[i] for i in range(len(centres))}, half,
-                                   {name: column_stride for name in boundaries})
+                                   {name: column_stride for name in boundaries}, spacing=spacing,
+                                   multiple=max(1, int(getattr(mesh, "symmetry", 1))))
 
 
 def _interface_symmetry(iface: Interface, model, symmetry: int) -> tuple:

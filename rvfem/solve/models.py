@@ -24,7 +24,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from rvfem._arrays import readonly as _readonly
-from rvfem.case.definition import FOOTPRINT_ELEMENTS, Case
+from rvfem.case.definition import Case
+from rvfem.case.mesh_checks import footprint_half_widths
 from rvfem.case.registry import (
     builtin_model_names,
     register_bearing_model,
@@ -243,7 +244,7 @@ class RollerBearing:
             self._law = contact.roller_bore_law(
                 length=b.roller_length, reduced_radius_bore=r * b.bore_radius / (b.bore_radius - r),
                 disc_modulus=case.material.youngs_modulus, disc_poisson=case.material.poissons_ratio,
-                footprint_half_width=FOOTPRINT_ELEMENTS * case.mesh.size_bore,
+                footprint_half_width=footprint_half_widths(case)["bore"],
                 disc_stiffness_scale=disc_stiffness_scale)
         else:
             assert b.linear_stiffness_N_per_mm is not None      # the case requires it with the linear law
@@ -364,9 +365,10 @@ class RigidPins:
 
 
 def _footprint_half_width(case: Case) -> float:
-    """Half-width of the FE pin-load footprint, mm (``FOOTPRINT_ELEMENTS`` element sizes)."""
+    """Half-width of the FE pin-load footprint, mm (``FOOTPRINT_ELEMENTS`` spacings of the contact
+    grid, :func:`rvfem.case.mesh_checks.footprint_half_widths`)."""
 
-    return FOOTPRINT_ELEMENTS * case.mesh.size_flank
+    return footprint_half_widths(case)["profile"]
 
 
 @register_pin_model
