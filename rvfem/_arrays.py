@@ -1,11 +1,13 @@
 """Small array utilities shared by the modules: read-only arrays, the first of equal maxima, the
-ordering of mesh edges and giving freed memory back."""
+ordering of mesh edges, giving freed memory back and single-threaded BLAS for small systems."""
 
 from __future__ import annotations
 
 import ctypes
+import functools
 
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from rvfem.errors import MeshError
 
@@ -133,3 +135,21 @@ def _component(neighbours: dict[int, list[int]], start: int) -> set[int]:
                 seen.add(w)
                 todo.append(w)
     return seen
+
+
+@functools.lru_cache(maxsize=1)
+def _blas_libraries() -> ThreadpoolController:
+    """The process's BLAS libraries, found once: reading the process's memory map takes about
+    2 ms, as long as a small contact solve."""
+    return ThreadpoolController()
+
+
+def single_threaded_blas():
+    """A context in which BLAS runs on one thread.
+
+    For the many small dense systems of the contact solves (about 100 unknowns) and the roller
+    slices: threaded BLAS only contends for the cores there (two BLAS threads on two cores ran a
+    load cycle's per-angle solves 7× slower and a hysteresis loop's 2-4× slower than one;
+    benchmarks/README.md, "Load cycle"). Nested uses are cheap.
+    """
+    return _blas_libraries().limit(limits=1, user_api="blas")

@@ -34,9 +34,8 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
-from rvfem._arrays import max_load_index
+from rvfem._arrays import max_load_index, single_threaded_blas
 from rvfem.case.definition import Case
 from rvfem.fem import nodal_stress_operator
 from rvfem.geometry import crank_centres, load_cycle_angles
@@ -308,7 +307,7 @@ def load_cycle(system: DiscSystem, thetas: np.ndarray | None = None, *, op: Oper
     t0 = time.perf_counter()
     # the per-angle systems are small (~100 unknowns): threaded BLAS only adds overhead there
     # (benchmarks/README.md, "Load cycle"), so the cycle runs BLAS single-threaded
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded_blas():
         results, extras = solve_stage_cycle(stage, thetas, op, progress)
         t_prefetch = extras.pop("prefetch_seconds")
         t_cycle = time.perf_counter() - t0

@@ -61,6 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem._arrays import single_threaded_blas
 from rvfem.errors import CaseError
 from rvfem.solve import contact
 from rvfem.solve.contact import ContactSet
@@ -347,7 +348,15 @@ def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = Non
                op: OperatingPoint | None = None, g_cache: dict | None = None) -> PairResult:
     """Solve the stage at crank angle θ (rad) and the operating point ``op`` (default the case's):
     disc A at θ with disc B at θ + 180°. ``g_cache`` keeps the contact compliance between solves
-    of the same crank angle (:func:`rvfem.solve.contact.solve_bodies`)."""
+    of the same crank angle (:func:`rvfem.solve.contact.solve_bodies`). BLAS runs single-threaded
+    in it (:func:`rvfem._arrays.single_threaded_blas`: its dense systems are small), also when it is
+    called outside a load cycle (hysteresis loops, TE, operating points)."""
+    with single_threaded_blas():
+        return _solve_pair(stage, theta, start, op, g_cache)
+
+
+def _solve_pair(stage: ReducerStage, theta: float, start: PairResult | None, op: OperatingPoint | None,
+                g_cache: dict | None) -> PairResult:
     op = OperatingPoint.of(stage.first.case) if op is None else op
     systems, thetas, phases, sets = _bodies(stage, theta, op)
     case = stage.first.case
