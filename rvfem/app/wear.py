@@ -10,14 +10,13 @@ profile), of the pins (around them) and of the bearings' clearances; the wear ru
 largest increment of any part reaches ``wear.update_step_um``; the worn geometry is then applied
 and the lost motion solved again, until the hours asked or the lost-motion limit.
 
-**The worn geometry (first version).** The flank and pin wear are applied as an *equivalent
-equidistant modification*: each flank's load-weighted mean wear gap
-(:func:`rvfem.evaluate.wear.load_weighted_gap`), the mean of the two flanks added to
-``cycloid.modification.equidistant``; the bearing wear is added to
-``crank_bearing.radial_clearance`` (the mean over the cranks) and
-``crank_support.radial_clearance``. The worn stage shares the disc's factorisation and column
-compliance (only the gaps and the bearing laws change); the shape of the wear along the flank is
-written out but not fed back element by element.
+**The worn geometry.** Every tooth wears alike, so the wear of the flanks is a function of the
+pin phase ψ (:func:`rvfem.geometry.pin_phases`); with the pin's wear at the same contact it is the
+disc model's :class:`rvfem.geometry.FlankDeviation`, added to the FE gap of each pin at each crank
+angle (element by element, Liu et al.'s tooth-surface update). The bearing wear is added to
+``crank_bearing.radial_clearance`` (the mean over the cranks) and ``crank_support.radial_clearance``.
+The worn stage shares the disc's factorisation and column compliance: only the gaps and the bearing
+laws change (:func:`worn_stage`).
 """
 
 from __future__ import annotations
@@ -28,7 +27,7 @@ import logging
 import math
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -38,12 +37,14 @@ from rvfem.errors import CaseError
 from rvfem.evaluate import wear as archard
 from rvfem.evaluate.accuracy import quick_figures
 from rvfem.evaluate.hertz import composite_modulus
-from rvfem.geometry import disc_geometry
+from rvfem.geometry import FlankDeviation, disc_geometry, pin_phases
 from rvfem.mesh import mesh_case
 from rvfem.outputs import wear as files
 from rvfem.outputs.summary import result_folder
 from rvfem.solve import models
+from rvfem.solve.accuracy import loop_at_torques
 from rvfem.solve.cycle import OperatingPoint, build_system, case_stage, load_cycle
+from rvfem.units import ARCSEC_PER_RAD
 
 log = logging.getLogger(__name__)
 
@@ -71,7 +72,6 @@ class WearState:
     pin: np.ndarray
     crank: np.ndarray
     support: np.ndarray
-    weights: np.ndarray = field(default_factory=lambda: np.ones((2, GRID_POINTS)))
 
 
 def wear_option_problem(hours: float, angle_count: int) -> tuple[str, str] | None:
@@ -93,55 +93,83 @@ def _duty(case: Case) -> list[tuple[float, float, float]]:
     return [(s / total, n, t) for s, n, t in raw if abs(t) > 0]
 
 
-def _worn_case(case: Case, state: WearState, kin) -> Case:
-    """The case with the wear applied (module docstring: the equivalent modification and clearances)."""
-    gap = np.zeros(2)
+def flank_deviation(case: Case, state: WearState, kin) -> FlankDeviation:
+    """The worn flanks as the disc model's gap deviation (module docstring): at each pin phase of
+    the grid, the flank's depth plus the pin's depth at the point of the pin that contact touches
+    (mm), for the flanks of either torque."""
     pin_at = kin.pin_angle * case.pins.radius
-    nodes = np.linspace(-0.5 * math.pi, 0.5 * math.pi, GRID_POINTS) * case.pins.radius
-    for s in range(2):
-        g = state.flank[s] + np.interp(pin_at, nodes, state.pin[s])
-        gap[s] = archard.load_weighted_gap(state.weights[s], g)
-    mod = case.cycloid.modification
-    cyc = dataclasses.replace(case.cycloid, modification=dataclasses.replace(
-        mod, equidistant=mod.equidistant + float(gap.mean())))
+    nodes = pin_nodes(case)
+    g = [state.flank[s] + np.interp(pin_at, nodes, state.pin[s]) for s in range(2)]
+    # the flanks of either torque meet at the root (ψ = 0) and the tip (ψ = π): one value there, so
+    # that the gap of a pin is continuous in ψ (a pin at ψ = ±0 by round-off gets the same gap)
+    root, tip = 0.5 * (g[0][0] + g[1][0]), 0.5 * (g[0][-1] + g[1][-1])
+    psi = np.concatenate([[0.0], kin.psi, [math.pi]])
+    return FlankDeviation.of(psi, np.concatenate([[root], g[0], [tip]]), np.concatenate([[root], g[1], [tip]]))
+
+
+def pin_nodes(case: Case) -> np.ndarray:
+    """Where the pin's wear is kept: arc length around the pin from its pole facing the pin-circle
+    centre, −π/2·r_rp … π/2·r_rp, mm (GRID_POINTS)."""
+    return np.linspace(-0.5 * math.pi, 0.5 * math.pi, GRID_POINTS) * case.pins.radius
+
+
+def _worn_case(case: Case, state: WearState) -> Case:
+    """The case with the bearings' worn clearances (the flanks' wear is the disc model's deviation)."""
     bearing = dataclasses.replace(case.crank_bearing,
                                   radial_clearance=case.crank_bearing.radial_clearance + float(state.crank.mean()))
-    changes = {"cycloid": cyc, "crank_bearing": bearing}
+    changes = {"crank_bearing": bearing}
     if case.crank_support is not None:
         changes["crank_support"] = dataclasses.replace(
             case.crank_support, radial_clearance=case.crank_support.radial_clearance + float(state.support.mean()))
     return case.replace(**changes)
 
 
-def _worn_stage(system, worn: Case):
+def worn_stage(system, worn: Case, deviation: FlankDeviation | None):
     """The stage of ``worn`` on the factorised disc of ``system`` (same mesh, model and column
-    compliance; the gaps from the worn profile, the bearing laws from the worn clearances)."""
+    compliance): the gaps of its profile plus ``deviation``
+    (:attr:`rvfem.solve.cycle.DiscSystem.flank_deviation`), the bearing laws of its clearances."""
     bearing_class = models.bearing_model(system.bearing_model)
     bearings = (bearing_class(worn, system.bearing_stiffness_scale, disc_stiffness_scale=system.stiffness_scale)
                 if getattr(bearing_class, "takes_disc_stiffness_scale", False)
                 else bearing_class(worn, system.bearing_stiffness_scale))
-    worn_system = dataclasses.replace(system, case=worn, geometry=disc_geometry(worn), bearings=bearings,
-                                      contact_sets={})
+    geometry = system.geometry if worn is system.case else disc_geometry(worn)
+    worn_system = dataclasses.replace(system, case=worn, geometry=geometry, bearings=bearings,
+                                      contact_sets={}, flank_deviation=deviation)
     return case_stage(worn_system)
 
 
-def _figures(stage, case: Case, angle_count: int) -> tuple[float, float]:
+def _figures(stage, case: Case, angle_count: int) -> tuple[float, float, float]:
     """Lost motion (arcsec) and torsional rigidity (N·m/arcmin) of the stage at the rated torque,
-    the mean over ``angle_count`` crank angles of one tooth-mesh period."""
+    the mean over ``angle_count`` crank angles of one tooth-mesh period, and the peak-to-peak
+    transmission error (arcsec) at the rated torque over one mesh period (:func:`te_peak_to_peak`)."""
     T = abs(case.loads.torque_Nm)
     thetas = np.arange(angle_count) * 2.0 * math.pi / (angle_count * case.cycloid.teeth)
     figs = [quick_figures(stage, T, case.analysis.friction, float(t)) for t in thetas]
     return (60.0 * float(np.mean([f["lost_motion_arcmin"] for f in figs])),
-            float(np.mean([f["torsional_rigidity_Nm_per_arcmin"] for f in figs])))
+            float(np.mean([f["torsional_rigidity_Nm_per_arcmin"] for f in figs])),
+            te_peak_to_peak(stage, case))
+
+
+TE_ANGLES = 6
+"""Crank angles of one tooth-mesh period at which the loaded transmission error is solved."""
+
+
+def te_peak_to_peak(stage, case: Case, count: int = TE_ANGLES) -> float:
+    """Peak-to-peak transmission error at the rated torque over one tooth-mesh period (2π/Zc of
+    crank angle), arcsec: the output rotation of the running stage (pins sliding as the crank
+    turns) at +|``loads.torque_Nm``| at ``count`` equally spaced crank angles, one solve each
+    (:func:`rvfem.solve.accuracy.loop_at_torques`; Liu et al. § 4: TE = θ_out − θ_in/i, here the
+    deviation from the ideal ratio within a mesh period, the part the flank wear can change)."""
+    T = abs(case.loads.torque_Nm)
+    thetas = np.arange(count) * 2.0 * math.pi / (count * case.cycloid.teeth)
+    rot = [float(loop_at_torques(stage, float(t), [T], case.analysis.friction, [0])[0][0]) for t in thetas]
+    return float(np.ptp(rot)) * ARCSEC_PER_RAD
 
 
 def _cycle_samples(cycle, case: Case):
     """Pin phases (wrapped to (−π, π]) and forces (N) of every pin at every crank angle of a cycle."""
-    zp = case.pins.count
-    j = np.arange(zp)[None, :]
-    th = np.asarray(cycle.theta)[:, None]
-    psi = np.angle(np.exp(1j * (2 * np.pi * j / zp + th * (zp - case.cycloid.teeth) / zp - th)))
-    return psi.ravel(), np.asarray(cycle.pin_forces).ravel()
+    psi = np.concatenate([pin_phases(case, float(t)) for t in cycle.theta])
+    return psi, np.asarray(cycle.pin_forces).ravel()
 
 
 def _support_loads(cycle, case: Case) -> np.ndarray | None:
@@ -157,12 +185,11 @@ def _support_loads(cycle, case: Case) -> np.ndarray | None:
 
 
 def _rates(system_stage, case: Case, kin, duty) -> dict:
-    """Wear rates per hour of every part on the current stage (mm/h), and the flank force weights."""
+    """Wear rates per hour of every part on the current stage (mm/h)."""
     zp, zc, d = case.pins.count, case.cycloid.teeth, case.pins.count - case.cycloid.teeth
     estar = composite_modulus(case.material.youngs_modulus, case.material.poissons_ratio)
     w = case.wear
     flank, pin = np.zeros((2, GRID_POINTS)), np.zeros((2, GRID_POINTS))
-    weights = np.zeros((2, GRID_POINTS))
     n_cranks = case.cranks.count
     crank, support = np.zeros(n_cranks), np.zeros(n_cranks)
     for share, speed, torque in duty:
@@ -176,7 +203,6 @@ def _rates(system_stage, case: Case, kin, duty) -> dict:
                                                   pin_rolling=w.pin_rolling)
             flank[s] += share * dd * crank_revs_h * d            # one engagement per tooth per pin pitch passed
             pin[s] += share * pp * speed * 60.0 * zc / d          # Zc/d engagements of a pin per output revolution
-            weights[s] += share * f
         radial = np.linalg.norm(np.asarray(cycle.bearing_forces), axis=-1).mean(axis=0)
         crank += share * np.array([archard.bearing_clearance_rate(r, crank_revs_h, w.crank_bearing_rate_um_per_N_Mrev)
                                    for r in radial])
@@ -185,15 +211,18 @@ def _rates(system_stage, case: Case, kin, duty) -> dict:
             support += share * np.array([archard.bearing_clearance_rate(r, crank_revs_h,
                                                                         w.support_bearing_rate_um_per_N_Mrev)
                                          for r in sup])
-    return {"flank": flank, "pin": pin, "crank": crank, "support": support, "weights": weights}
+    return {"flank": flank, "pin": pin, "crank": crank, "support": support}
 
 
-def _record(state: WearState, lm: float, rigidity: float, worn: Case, base: Case) -> dict:
+def _record(state: WearState, figures: tuple[float, float, float], worn: Case, deviation: FlankDeviation | None
+            ) -> dict:
     """One row of wear.csv."""
-    return {"hours": state.hours, "lost_motion_arcsec": lm, "torsional_rigidity_Nm_per_arcmin": rigidity,
+    lm, rigidity, te = figures
+    gap = 0.0 if deviation is None else max(max(deviation.positive), max(deviation.negative))
+    return {"hours": state.hours, "lost_motion_arcsec": lm, "te_peak_to_peak_arcsec": te,
+            "torsional_rigidity_Nm_per_arcmin": rigidity,
             "flank_wear_max_um": 1e3 * float(state.flank.max()), "pin_wear_max_um": 1e3 * float(state.pin.max()),
-            "equivalent_equidistant_um": 1e3 * (worn.cycloid.modification.equidistant
-                                                 - base.cycloid.modification.equidistant),
+            "wear_gap_max_um": 1e3 * gap,
             "crank_bearing_clearance_um": 1e3 * worn.crank_bearing.radial_clearance,
             "support_bearing_clearance_um": (1e3 * worn.crank_support.radial_clearance
                                              if worn.crank_support is not None else None)}
@@ -208,7 +237,6 @@ def _advance(state: WearState, rates: dict, step_mm: float, hours_left: float) -
     state.pin += rates["pin"] * dt
     state.crank += rates["crank"] * dt
     state.support += rates["support"] * dt
-    state.weights = rates["weights"]
     state.hours += dt
     return dt
 
@@ -225,8 +253,7 @@ def life_loop(case: Case, stage, system, hours: float, angle_count: int) -> tupl
                         "give the torque of the service")
     n = case.cranks.count
     state = WearState(0.0, np.zeros((2, GRID_POINTS)), np.zeros((2, GRID_POINTS)), np.zeros(n), np.zeros(n))
-    lm, rig = _figures(stage, case, angle_count)
-    records = [_record(state, lm, rig, case, case)]
+    records = [_record(state, _figures(stage, case, angle_count), case, None)]
     step = 1e-3 * case.wear.update_step_um
     current = stage
     for _ in range(MAX_UPDATES):
@@ -234,11 +261,11 @@ def life_loop(case: Case, stage, system, hours: float, angle_count: int) -> tupl
             break
         rates = _rates(current, case, kin, duty)
         _advance(state, rates, step, hours - state.hours)
-        worn = _worn_case(case, state, kin)
-        current = _worn_stage(system, worn)
-        lm, rig = _figures(current, case, angle_count)
-        records.append(_record(state, lm, rig, worn, case))
-        log.info("wear: %.1f h, lost motion %.2f arcsec", state.hours, lm)
+        worn = _worn_case(case, state)
+        deviation = flank_deviation(case, state, kin)
+        current = worn_stage(system, worn, deviation)
+        records.append(_record(state, _figures(current, case, angle_count), worn, deviation))
+        log.info("wear: %.1f h, lost motion %.2f arcsec", state.hours, records[-1]["lost_motion_arcsec"])
     return records, state, kin
 
 

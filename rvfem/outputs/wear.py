@@ -14,9 +14,10 @@ __all__ = ["WEAR_COLUMNS", "write_wear_files"]
 
 WEAR_COLUMNS = (
     ("hours", "hours"), ("lost_motion_arcsec", "lost_motion_arcsec"),
+    ("te_peak_to_peak_arcsec", "te_peak_to_peak_arcsec"),
     ("torsional_rigidity_Nm_per_arcmin", "torsional_rigidity_Nm_per_arcmin"),
     ("flank_wear_max_um", "flank_wear_max_um"), ("pin_wear_max_um", "pin_wear_max_um"),
-    ("equivalent_equidistant_um", "equivalent_equidistant_um"),
+    ("wear_gap_max_um", "wear_gap_max_um"),
     ("crank_bearing_clearance_um", "crank_bearing_clearance_um"),
     ("support_bearing_clearance_um", "support_bearing_clearance_um"),
 )
