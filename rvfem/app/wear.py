@@ -48,7 +48,8 @@ from rvfem.units import ARCSEC_PER_RAD
 
 log = logging.getLogger(__name__)
 
-__all__ = ["GRID_POINTS", "WearState", "wear_life", "wear_option_problem"]
+__all__ = ["GRID_POINTS", "WearState", "flank_deviation", "life_figures", "life_loop", "te_peak_to_peak", "wear_life",
+           "wear_option_problem", "wear_warnings", "worn_stage"]
 
 GRID_POINTS = 361
 """Pin phases ψ per flank (0 < ψ < π) the wear is accumulated on."""
@@ -292,29 +293,45 @@ def life_figures(records: list[dict], limit: float) -> dict:
             "lost_motion_growth_arcsec_per_h": slope}
 
 
-def _warnings(state: WearState, case: Case) -> list[str]:
-    """Where the wear leaves the model's range."""
+def wear_warnings(state: WearState, case: Case, records: list[dict], hours: float) -> list[str]:
+    """Where the wear leaves the model's range, or the run did not resolve what it was asked."""
     out = []
     deepest = max(float(state.flank.max()), float(state.pin.max()))
     if deepest > WORN_RANGE_MM:
-        out.append(f"the deepest wear, {1e3 * deepest:.0f} µm, is beyond {1e3 * WORN_RANGE_MM:.0f} µm: the contact "
-                   "shape is taken as the unworn one and the wear as an equivalent equidistant modification; "
-                   "the results past it are indicative")
+        out.append(f"the deepest wear, {1e3 * deepest:.0f} µm, is beyond {1e3 * WORN_RANGE_MM:.0f} µm: the worn depth "
+                   "enters the gaps, but the Hertz law and the load footprints keep the unworn flank's curvature and "
+                   "position; the results past it are indicative")
+    limit = case.wear.lost_motion_limit_arcsec
+    lm = [r["lost_motion_arcsec"] for r in records]
+    if lm[0] >= limit:
+        out.append(f"the lost motion before any wear, {lm[0]:.2f} arcsec, is already at the limit of {limit:g} arcsec "
+                   "(wear.lost_motion_limit_arcsec): the life is 0 h")
+    elif lm[-1] >= limit and len(records) <= 3:
+        out.append(f"the limit is reached within {len(records) - 1} geometry update(s): the life is interpolated "
+                   "over few points; a smaller wear.update_step_um resolves it")
+    if len(records) - 1 >= MAX_UPDATES and state.hours < hours * (1 - 1e-12) and lm[-1] < limit:
+        out.append(f"stopped after {MAX_UPDATES} geometry updates at {state.hours:.0f} h of the {hours:g} h asked; "
+                   "a larger wear.update_step_um runs further")
     if case.crank_support is None:
         out.append("no [crank_support]: the support bearings' wear is not modelled")
     return out
 
 
+RUNNING_IN = ("not modelled: a constant wear coefficient from the first hour (no cited running-in law for the "
+              "cycloid–pin pair; docs/theory.md, \"Transmission-accuracy life\")")
+"""What the run says about running-in (report.md)."""
+
+
 def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_count: int = 3,
               cache_dir: str | os.PathLike | None = None, overwrite: bool = False) -> dict:
     """Run the wear of ``case`` over ``hours`` of service (or to the lost-motion limit) and write
-    wear.csv, worn_flank.csv, worn_pin.csv, plots/lost_motion.png, plots/wear_profile.png and
-    summary.json to ``out_dir`` (an atomic result folder, :func:`rvfem.outputs.summary.result_folder`).
+    wear.csv, worn_flank.csv, worn_pin.csv, plots/lost_motion.png, plots/wear_profile.png, report.md
+    and summary.json to ``out_dir`` (an atomic result folder, :func:`rvfem.outputs.summary.result_folder`).
     Returns the summary.
 
     The lost motion is read at ±3 % of ``loads.torque_Nm`` (its magnitude) with
     :func:`rvfem.evaluate.accuracy.quick_figures`, the mean over ``angle_count`` crank angles of one
-    tooth-mesh period.
+    tooth-mesh period; the TE over a mesh period at the rated torque with :func:`te_peak_to_peak`.
 
     Raises
     ------
@@ -340,9 +357,16 @@ def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_cou
                    "initial_lost_motion_arcsec": records[0]["lost_motion_arcsec"],
                    "final_lost_motion_arcsec": records[-1]["lost_motion_arcsec"], "updates": len(records) - 1,
                    "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in _duty(case)],
-                   "warnings": _warnings(state, case)}
-        files.write_wear_files(out, records, state, kin, case)
+                   "te_peak_to_peak_initial_arcsec": records[0]["te_peak_to_peak_arcsec"],
+                   "te_peak_to_peak_final_arcsec": records[-1]["te_peak_to_peak_arcsec"],
+                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in _duty(case)],
+                   "running_in": RUNNING_IN, "warnings": wear_warnings(state, case, records, hours)}
+        pin_at = kin.pin_angle * case.pins.radius
+        pin_gap = np.array([np.interp(pin_at, pin_nodes(case), state.pin[s]) for s in range(2)])
+        profile = archard.worn_profile(geometry, kin.psi, state.flank[0], state.flank[1])
+        files.write_wear_files(out, records, state, kin, case, profile, pin_gap)
         summary["timings"] = {"total_s": time.perf_counter() - t0}
+        files.write_wear_report(out, summary, records)
         (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")
     return summary
 
