@@ -48,8 +48,8 @@ from rvfem.units import ARCSEC_PER_RAD
 
 log = logging.getLogger(__name__)
 
-__all__ = ["GRID_POINTS", "WearState", "flank_deviation", "life_figures", "life_loop", "te_peak_to_peak", "wear_life",
-           "wear_option_problem", "wear_warnings", "worn_stage"]
+__all__ = ["GRID_POINTS", "WearState", "duty_rows", "flank_deviation", "flank_grid", "life_figures", "life_loop",
+           "te_peak_to_peak", "wear_life", "wear_option_problem", "wear_rates", "wear_warnings", "worn_stage"]
 
 GRID_POINTS = 361
 """Pin phases ψ per flank (0 < ψ < π) the wear is accumulated on."""
@@ -84,7 +84,7 @@ def wear_option_problem(hours: float, angle_count: int) -> tuple[str, str] | Non
     return None
 
 
-def _duty(case: Case) -> list[tuple[float, float, float]]:
+def duty_rows(case: Case) -> list[tuple[float, float, float]]:
     """(time share normalised, speed rpm, torque N·m) of each duty row (the case's operating point
     without a duty cycle); rows of zero torque wear nothing and are left out."""
     rows = case.loads.duty_cycle
@@ -118,7 +118,7 @@ def _worn_case(case: Case, state: WearState) -> Case:
     """The case with the bearings' worn clearances (the flanks' wear is the disc model's deviation)."""
     bearing = dataclasses.replace(case.crank_bearing,
                                   radial_clearance=case.crank_bearing.radial_clearance + float(state.crank.mean()))
-    changes = {"crank_bearing": bearing}
+    changes: dict[str, object] = {"crank_bearing": bearing}
     if case.crank_support is not None:
         changes["crank_support"] = dataclasses.replace(
             case.crank_support, radial_clearance=case.crank_support.radial_clearance + float(state.support.mean()))
@@ -185,8 +185,10 @@ def _support_loads(cycle, case: Case) -> np.ndarray | None:
     return 0.5 * np.linalg.norm(f, axis=-1).mean(axis=0)
 
 
-def _rates(system_stage, case: Case, kin, duty) -> dict:
-    """Wear rates per hour of every part on the current stage (mm/h)."""
+def wear_rates(system_stage, case: Case, kin, duty) -> dict:
+    """Wear rates per hour of every part on ``system_stage`` (mm/h) under the ``duty`` rows
+    (:func:`duty_rows`): ``flank`` and ``pin`` (2, GRID_POINTS) on the grid ``kin``
+    (:func:`flank_grid`; rows +ψ, −ψ), ``crank`` and ``support`` per crankshaft."""
     zp, zc, d = case.pins.count, case.cycloid.teeth, case.pins.count - case.cycloid.teeth
     estar = composite_modulus(case.material.youngs_modulus, case.material.poissons_ratio)
     w = case.wear
@@ -242,13 +244,20 @@ def _advance(state: WearState, rates: dict, step_mm: float, hours_left: float) -
     return dt
 
 
-def life_loop(case: Case, stage, system, hours: float, angle_count: int) -> tuple[list[dict], WearState, object]:
+def flank_grid(case: Case) -> archard.MeshKinematics:
+    """The kinematics (:func:`rvfem.evaluate.wear.mesh_kinematics`) of the pin phases the wear is
+    kept on: GRID_POINTS in (0, π), ends left out."""
+    return archard.mesh_kinematics(case.pins.circle_radius, case.pins.radius, case.cycloid.eccentricity,
+                                   case.pins.count, case.cycloid.teeth,
+                                   np.linspace(0.0, math.pi, GRID_POINTS + 2)[1:-1])
+
+
+def life_loop(case: Case, stage, system, hours: float, angle_count: int
+              ) -> tuple[list[dict], WearState, archard.MeshKinematics]:
     """The loop over life (module docstring): the records of every update, the final state and the
     kinematics of the flank grid."""
-    kin = archard.mesh_kinematics(case.pins.circle_radius, case.pins.radius, case.cycloid.eccentricity,
-                                  case.pins.count, case.cycloid.teeth,
-                                  np.linspace(0.0, math.pi, GRID_POINTS + 2)[1:-1])
-    duty = _duty(case)
+    kin = flank_grid(case)
+    duty = duty_rows(case)
     if not duty:
         raise CaseError("rvfem wear needs a torque: loads.torque_Nm (or every duty_cycle row's torque) is 0; "
                         "give the torque of the service")
@@ -260,7 +269,7 @@ def life_loop(case: Case, stage, system, hours: float, angle_count: int) -> tupl
     for _ in range(MAX_UPDATES):
         if state.hours >= hours * (1 - 1e-12) or records[-1]["lost_motion_arcsec"] >= case.wear.lost_motion_limit_arcsec:
             break
-        rates = _rates(current, case, kin, duty)
+        rates = wear_rates(current, case, kin, duty)
         _advance(state, rates, step, hours - state.hours)
         worn = _worn_case(case, state)
         deviation = flank_deviation(case, state, kin)
@@ -356,10 +365,10 @@ def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_cou
                    "lost_motion_limit_arcsec": case.wear.lost_motion_limit_arcsec,
                    "initial_lost_motion_arcsec": records[0]["lost_motion_arcsec"],
                    "final_lost_motion_arcsec": records[-1]["lost_motion_arcsec"], "updates": len(records) - 1,
-                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in _duty(case)],
+                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in duty_rows(case)],
                    "te_peak_to_peak_initial_arcsec": records[0]["te_peak_to_peak_arcsec"],
                    "te_peak_to_peak_final_arcsec": records[-1]["te_peak_to_peak_arcsec"],
-                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in _duty(case)],
+                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in duty_rows(case)],
                    "running_in": RUNNING_IN, "warnings": wear_warnings(state, case, records, hours)}
         pin_at = kin.pin_angle * case.pins.radius
         pin_gap = np.array([np.interp(pin_at, pin_nodes(case), state.pin[s]) for s in range(2)])
