@@ -14,6 +14,7 @@ Run: ``python benchmarks/bench_wear.py [CASE] [--hours 100] [--set KEY=VALUE ...
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import tempfile
 import time
@@ -55,8 +56,8 @@ def main(argv=None) -> int:
     print("|---|---|---|---|---|")
     for step in (case.wear.update_step_um, 2 * case.wear.update_step_um):
         for hours in (args.hours, 2 * args.hours):
-            lifted = case.replace(wear=case.wear.__class__(**{**case.wear.__dict__, "update_step_um": step,
-                                                              "lost_motion_limit_arcsec": 3600.0}))
+            lifted = case.replace(wear=dataclasses.replace(case.wear, update_step_um=step,
+                                                           lost_motion_limit_arcsec=3600.0))
             t0 = time.perf_counter()
             records, _, _ = life_loop(lifted, case_stage(system), system, hours, 3)
             dt = time.perf_counter() - t0
