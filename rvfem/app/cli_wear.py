@@ -47,11 +47,13 @@ def _run(args: argparse.Namespace) -> int:
           f"{case.wear.update_step_um:g} µm, pins {case.wear.pin_rolling}, {s['updates']} geometry updates")
     print(f"  lost motion {s['initial_lost_motion_arcsec']:.2f} → {s['final_lost_motion_arcsec']:.2f} arcsec over "
           f"{s['hours_run']:.0f} h" + (f"; late growth {slope:.4f} arcsec/h" if slope is not None else ""))
+    print(f"  TE peak to peak over a mesh period {s['te_peak_to_peak_initial_arcsec']:.2f} → "
+          f"{s['te_peak_to_peak_final_arcsec']:.2f} arcsec")
     print(f"  life to {s['lost_motion_limit_arcsec']:g} arcsec: "
           + (f"{life:.0f} h" if life is not None else f"not reached in {s['hours_run']:.0f} h"))
     for w in s["warnings"]:
         print(f"  warning: {w}")
-    print(f"  wall time {s['timings']['total_s']:.1f} s; results: {out}/ (summary.json, wear.csv, worn_flank.csv)")
+    print(f"  wall time {s['timings']['total_s']:.1f} s; results: {out}/ (report.md, summary.json, wear.csv, worn_flank.csv)")
     return EXIT_OK
 
 

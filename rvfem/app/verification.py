@@ -13,7 +13,8 @@ by a solve (``< 1e-06``), each bound lowered to the check's tolerance where that
 
 The checks are computed in :mod:`rvfem.app.verification_closed_form` (sections 1-3: the FE core,
 contact and the seed numbers against closed forms and published values) and
-:mod:`rvfem.app.verification_chain` (sections 4-12: the FE chain on the coarse RV-40E pair), on the
+:mod:`rvfem.app.verification_chain` (sections 4-12: the FE chain on the coarse RV-40E pair) and
+:mod:`rvfem.app.verification_wear` (section 14: wear and the transmission-accuracy life), on the
 rows of :mod:`rvfem.app.verification_check`; this module gathers them and writes the document, and
 gives every name of those modules the tests use. The whole document takes under a minute of CPU
 time (coarse meshes, 10° steps; about two minutes of wall time on a busy two-core machine).
@@ -67,6 +68,7 @@ from rvfem.app.verification_closed_form import (
     structured_plate_with_hole,
     traction_load,
 )
+from rvfem.app.verification_wear import wear_section
 
 log = logging.getLogger(__name__)
 
@@ -80,7 +82,7 @@ __all__ = [
     "contact_section", "fe_core_section", "hertz_cylinder", "kirsch_concentration", "kirsch_stress",
     "lame_dirichlet_errors", "lame_pressure_displacement_error", "lame_solution", "quads_to_triangles",
     "bearing_checks_section", "seed_section", "squeezed_cylinder_mesh", "structured_annulus", "structured_plate_with_hole",
-    "traction_load",
+    "traction_load", "wear_section",
 ]
 
 
@@ -98,6 +100,7 @@ def all_sections(cache_dir: str | Path | None = None) -> list[Section]:
         sections.append(roller_depth_section())
         sections.append(mass_strength_section(discs))
         sections.append(bearing_checks_section())
+        sections.append(wear_section(discs.cache))
     return sections
 
 

@@ -40,15 +40,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rvfem.geometry import pin_profile_contacts_many
+
 __all__ = [
     "MeshKinematics",
     "archard_depth",
     "bearing_clearance_rate",
+    "WornProfile",
     "footprint_wear",
     "flank_pin_engagement",
-    "load_weighted_gap",
     "mesh_kinematics",
     "side_force",
+    "worn_profile",
 ]
 
 
@@ -248,20 +251,53 @@ def flank_pin_engagement(kin: MeshKinematics, force: np.ndarray, *, k_mm2_per_N:
     return disc, pin
 
 
-def load_weighted_gap(force: np.ndarray, gap: np.ndarray) -> float:
-    """The uniform gap (mm) equivalent to a worn flank: Σ F·g / Σ F over the flank's samples.
-
-    For pins as equal linear springs that all stay closed, the stage rotation at a torque moves by
-    Σ g_j·l_j / Σ l_j² per unit gap, and the rigid pin forces are proportional to the levers l_j,
-    so a gap g_j at each pin acts as the uniform (equidistant) gap Σ F_j g_j / Σ F_j."""
-    force = np.clip(np.asarray(force, dtype=float), 0.0, None)
-    total = force.sum()
-    return float(np.sum(force * np.asarray(gap, dtype=float)) / total) if total > 0 else 0.0
-
-
 def bearing_clearance_rate(mean_radial_load_N: float, revolutions_per_hour: float,
                            rate_um_per_N_per_Mrev: float) -> float:
     """Radial-clearance growth of a rolling bearing, mm per hour: rate·F̄·revolutions (Liu et al.
     § 4.2: the clearance grows in proportion to the mean radial load and, by Archard's law, to the
     sliding distance, i.e. to the revolutions)."""
     return 1e-3 * rate_um_per_N_per_Mrev * mean_radial_load_N * revolutions_per_hour * 1e-6
+
+
+@dataclass(frozen=True)
+class WornProfile:
+    """One tooth space of the disc's profile, unworn and worn, along the pin phases ψ (arrays (n,)).
+
+    Attributes
+    ----------
+    psi : ndarray
+        Pin phase of the contact, rad, increasing over (−π, π): ψ < 0 the flank a negative torque
+        loads, ψ > 0 the one a positive torque loads.
+    segment, param : ndarray
+        Profile segment and base-curve parameter of the contact point (:class:`rvfem.geometry.Profile`).
+    point, worn : ndarray (n, 2)
+        Contact point on the nominal profile and the same point on the worn one (moved by the depth
+        along the inward normal), disc frame, mm.
+    depth : ndarray
+        Flank wear depth, mm.
+    """
+
+    psi: np.ndarray
+    segment: np.ndarray
+    param: np.ndarray
+    point: np.ndarray
+    worn: np.ndarray
+    depth: np.ndarray
+
+
+def worn_profile(geometry, psi: np.ndarray, depth_positive: np.ndarray, depth_negative: np.ndarray) -> WornProfile:
+    """The profile points the pins touch at phases ±``psi`` (rad, increasing in (0, π)) and their
+    positions after the flank wear ``depth_positive`` / ``depth_negative`` (mm, at +ψ / −ψ).
+
+    Pin 0 has the phase ψ at the crank angle θ = −ψ·Zp/Zc (:func:`rvfem.geometry.pin_phases`), so
+    its closest points over θ trace one tooth space of the disc
+    (:func:`rvfem.geometry.pin_profile_contacts_many`)."""
+    case = geometry.case
+    psi = np.asarray(psi, dtype=float)
+    phases = np.concatenate([-psi[::-1], psi])
+    depth = np.concatenate([np.asarray(depth_negative, dtype=float)[::-1], np.asarray(depth_positive, dtype=float)])
+    pcs = pin_profile_contacts_many(geometry, -phases * case.pins.count / case.cycloid.teeth)
+    point = np.array([pc.point[0] for pc in pcs])
+    normal = np.array([pc.normal[0] for pc in pcs])
+    return WornProfile(phases, np.array([pc.segment[0] for pc in pcs]), np.array([pc.param[0] for pc in pcs]),
+                       point, point - depth[:, None] * normal, depth)

@@ -48,11 +48,13 @@ from rvfem.geometry.holes import (
     unregister_hole_shape,
 )
 from rvfem.geometry.kinematics import (
+    FlankDeviation,
     PinContacts,
     closest_points,
     crank_centres,
     load_cycle_angles,
     pin_centres,
+    pin_phases,
     pin_profile_contacts,
     pin_profile_contacts_many,
 )
@@ -92,6 +94,8 @@ __all__ = [
     "profile_eval",
     "profile_curvature",
     "pin_centres",
+    "pin_phases",
+    "FlankDeviation",
     "crank_centres",
     "pin_profile_contacts",
     "pin_profile_contacts_many",

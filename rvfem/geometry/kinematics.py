@@ -36,7 +36,9 @@ from rvfem.geometry.profile import Profile, _c2xy, _u, build_profile, profile_ev
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "FlankDeviation",
     "load_cycle_angles",
+    "pin_phases",
     "pin_centres",
     "crank_centres",
     "PinContacts",
@@ -68,6 +70,63 @@ def pin_centres(case: Case, theta: float) -> np.ndarray:
     c = case.pins.circle_radius * _u(2 * np.pi * j / zp + theta * (zp - zc) / zp) \
         - case.cycloid.eccentricity * _u(theta)
     return _c2xy(c)
+
+
+def pin_phases(case: Case, theta: float) -> np.ndarray:
+    """The phase ψ_j of every pin at crank angle θ: its angle about the pin-circle centre from the
+    eccentric's direction, 2πj/Zp + θ·(Zp − Zc)/Zp − θ wrapped to (−π, π], rad (Zp,).
+
+    Every tooth meets the pins alike: a pin at phase ψ touches the same point of a tooth's flank
+    (ψ > 0 one flank of the tooth, ψ < 0 the other) whatever the pin and the tooth, so a property of
+    every tooth's flank (its wear) is a function of ψ (:class:`FlankDeviation`).
+    """
+    zp, zc = case.pins.count, case.cycloid.teeth
+    j = np.arange(zp)
+    return np.angle(np.exp(1j * (2 * np.pi * j / zp + float(theta) * (zp - zc) / zp - float(theta))))
+
+
+@dataclass(frozen=True)
+class FlankDeviation:
+    """A deviation of the pin–flank gaps from those of the nominal profile, the same for every
+    tooth, as a function of the pin phase ψ (:func:`pin_phases`): the depth worn off the flank
+    (and off the pin at the same contact), mm, added to the gap of each pin at each crank angle.
+
+    Linear between the samples, the end values beyond them. Frozen and compared by value (tuples),
+    so that a disc model's contact sets are keyed by it (:func:`rvfem.solve.cycle_contacts.contact_model_key`).
+
+    Attributes
+    ----------
+    psi : tuple of float
+        Pin phases |ψ|, rad, increasing, within [0, π].
+    positive, negative : tuple of float
+        Added gap, mm, of a pin at phase +|ψ| (the flanks a positive torque loads) and at −|ψ|.
+    """
+
+    psi: tuple[float, ...]
+    positive: tuple[float, ...]
+    negative: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        n = len(self.psi)
+        if n < 2 or len(self.positive) != n or len(self.negative) != n:
+            raise ValueError("a flank deviation needs at least two pin phases and one gap per phase on each flank")
+        psi = np.asarray(self.psi, dtype=float)
+        if not (np.all(np.diff(psi) > 0) and psi[0] >= 0.0 and psi[-1] <= math.pi):
+            raise ValueError("the pin phases of a flank deviation must increase within [0, π]")
+        if not (np.all(np.isfinite(self.positive)) and np.all(np.isfinite(self.negative))):
+            raise ValueError("a flank deviation's gaps must be finite numbers (mm)")
+
+    @classmethod
+    def of(cls, psi, positive, negative) -> "FlankDeviation":
+        """From arrays (rad, mm, mm)."""
+        return cls(tuple(float(x) for x in psi), tuple(float(x) for x in positive),
+                   tuple(float(x) for x in negative))
+
+    def gap(self, psi) -> np.ndarray:
+        """The added gap (mm) of pins at phases ``psi`` (rad, in (−π, π])."""
+        psi = np.asarray(psi, dtype=float)
+        a = np.abs(psi)
+        return np.where(psi >= 0.0, np.interp(a, self.psi, self.positive), np.interp(a, self.psi, self.negative))
 
 
 def crank_centres(case: Case) -> np.ndarray:

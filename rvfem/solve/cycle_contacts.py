@@ -14,6 +14,7 @@ import scipy.sparse as sp
 from rvfem.geometry import (
     crank_centres,
     pin_centres,
+    pin_phases,
     pin_profile_contacts,
     pin_profile_contacts_many,
     profile_curvature,
@@ -27,10 +28,12 @@ def pin_contacts(system: DiscSystem, theta: float, friction: float, pc=None):
     """The pin contacts of crank angle θ (rad) as a :class:`rvfem.solve.models.ContactGroup`.
 
     Each pin pushes along the inward normal of the profile at its closest point; the gap is the
-    exact one of the (modified, pitch-error) profile. With friction (μ = ``friction``, the
-    operating point's) the load on the disc is λ·(d + μ·s·t) along the known sliding direction,
-    while the gap is still measured along the normal d. The pin model's law gets the angle's
-    contacts and the flank curvature at each pin's closest point (the Hertz law depends on it).
+    exact one of the (modified, pitch-error) profile, plus the system's flank deviation at the
+    pin's phase when it has one (:attr:`rvfem.solve.cycle.DiscSystem.flank_deviation`). With
+    friction (μ = ``friction``, the operating point's) the load on the disc is λ·(d + μ·s·t) along
+    the known sliding direction, while the gap is still measured along the normal d. The pin
+    model's law gets the angle's contacts and the flank curvature at each pin's closest point (the
+    Hertz law depends on it).
     ``pc`` passes the angle's :class:`rvfem.geometry.PinContacts` if they are already computed.
     """
 
@@ -84,10 +87,13 @@ def pin_contacts_many(system: DiscSystem, pcs, friction: float, slip: int = 0) -
         W_load = W_loads[a]
         law = system.pins.law(pc, curvature[rows])
         rigid = law is None
+        gap = np.asarray(pc.gap)
+        if system.flank_deviation is not None:     # worn flanks: the same for every tooth, by pin phase
+            gap = gap + system.flank_deviation.gap(pin_phases(case, pc.theta))
         out.append(ContactGroup(
             W=Ws[a], signorini=np.full(zp, rigid),
-            gap0=np.asarray(pc.gap) if rigid else np.zeros(zp),
-            offset=np.zeros(zp) if rigid else -np.asarray(pc.gap),
+            gap0=gap if rigid else np.zeros(zp),
+            offset=np.zeros(zp) if rigid else -gap,
             laws=[] if law is None else [(np.arange(zp), law)], names=names,
             bearing=np.full(zp, -1), W_load=W_load))
     return out
@@ -127,11 +133,11 @@ def contact_sets(system: DiscSystem, thetas, op: OperatingPoint) -> list[tuple[C
 
 def contact_model_key(system: DiscSystem) -> tuple:
     """What a system's contacts depend on besides the crank angle and the friction, by value: the
-    case (frozen, hashable) and the bearing and pin models with their stiffness options. Systems
-    that share an interface and a compliance (:func:`dataclasses.replace` of one disc model with
-    another case) share the cache without mixing their contacts."""
+    case (frozen, hashable), the bearing and pin models with their stiffness options and the flank
+    deviation. Systems that share an interface and a compliance (:func:`dataclasses.replace` of
+    one disc model with another case) share the cache without mixing their contacts."""
     return (system.case, system.bearing_model, system.pin_model, system.bearing_stiffness_scale,
-            system.pin_stiffness_N_per_mm)
+            system.pin_stiffness_N_per_mm, system.flank_deviation)
 
 
 def reducer_axis(case, theta: float) -> np.ndarray:

@@ -20,7 +20,7 @@ from rvfem import fem
 from rvfem.case.definition import Case
 from rvfem.case.mesh_checks import footprint_half_widths
 from rvfem.errors import CaseError, MeshError
-from rvfem.geometry import DiscGeometry, crank_centres, disc_geometry
+from rvfem.geometry import DiscGeometry, FlankDeviation, crank_centres, disc_geometry
 from rvfem.mesh import DiscMesh, rotation_permutation
 from rvfem.solve import contact, models
 from rvfem.solve.contact import Compliance, Interface
@@ -108,6 +108,12 @@ class DiscSystem:
         :func:`rvfem.solve.cycle_contacts.contact_model_key`): the cycles of the attribution and the
         operating points of a sweep revisit the same angles; also the contact maps of
         :func:`rvfem.solve.cycle_symmetry.turn_result`, by angle and turn.
+    flank_deviation : rvfem.geometry.FlankDeviation or None
+        A deviation of every tooth's flank gaps from the nominal profile's as a function of the pin
+        phase (worn flanks and pins, :mod:`rvfem.app.wear`), added to each pin's gap at each crank
+        angle; None (default): the profile's own gaps. Only the gaps change: a system with one is
+        ``dataclasses.replace(system, flank_deviation=..., contact_sets={})`` on the same
+        factorisation and column compliance.
     """
 
     case: Case
@@ -129,6 +135,7 @@ class DiscSystem:
     symmetry: int = 1
     node_rotation: np.ndarray | None = field(default=None, repr=False)
     contact_sets: dict = field(default_factory=dict, repr=False, compare=False)
+    flank_deviation: FlankDeviation | None = None
 
 
 def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: str | None = None,

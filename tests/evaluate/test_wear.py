@@ -4,6 +4,7 @@ transmission accuracy of RV reducer based on tooth surface and bearing wear*, §
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -11,12 +12,13 @@ import pytest
 from conftest import CASES_DIR, coarse_case
 
 from rvfem.app import cli
-from rvfem.app.wear import life_figures, life_loop
+from rvfem.app.wear import duty_rows, flank_grid, life_figures, life_loop, wear_rates, worn_stage
 from rvfem.errors import CaseError
 from rvfem.evaluate import wear as archard
-from rvfem.geometry import disc_geometry
+from rvfem.evaluate.accuracy import quick_figures
+from rvfem.geometry import FlankDeviation, disc_geometry, pin_centres, pin_phases
 from rvfem.mesh import mesh_case
-from rvfem.solve.cycle import build_system, case_stage
+from rvfem.solve.cycle import OperatingPoint, build_system, case_stage, contact_set, load_cycle
 
 RV40E = dict(Rp=64.0, r_rp=3.0, e=1.3, zp=40, zc=39)   # Liu et al. Table 1
 PSI = np.linspace(0.0, math.pi, 3603)[1:-1]
@@ -94,26 +96,76 @@ def test_engagement_conserves_the_worn_area():
         assert area == pytest.approx(expect, rel=1e-3)
 
 
-def test_load_weighted_gap_of_a_uniform_gap_is_that_gap():
-    assert archard.load_weighted_gap([1.0, 3.0, 0.0], [2e-3, 2e-3, 9.0]) == pytest.approx(2e-3)
-
-
-def _life(step_um: float, mesh_dir) -> float:
-    case = coarse_case("rv40e_solid", analysis={"angle_step_deg": 30.0},
-                       wear={"k_flank_pin": 4e-10, "update_step_um": step_um, "lost_motion_limit_arcsec": 40.0})
+@pytest.fixture(scope="module")
+def coarse(tmp_path_factory):
+    """The coarse solid RV-40E at 10° crank-angle steps and its factorised disc."""
+    case = coarse_case("rv40e_solid", analysis={"angle_step_deg": 10.0})
     geometry = disc_geometry(case)
-    system = build_system(case, mesh_case(case, mesh_dir, geometry=geometry), geometry=geometry)
-    records, _, _ = life_loop(case, case_stage(system), system, 1e4, 1)
-    life = life_figures(records, 40.0)["transmission_accuracy_life_h"]
-    assert life is not None
-    return life
+    system = build_system(case, mesh_case(case, tmp_path_factory.mktemp("mesh"), geometry=geometry),
+                          geometry=geometry)
+    return case, system
 
 
-def test_life_is_independent_of_the_update_step(tmp_path):
-    """Halving the update step changes the transmission-accuracy life by less than 5 % (3.96 h
-    against 3.85 h here)."""
-    a, b = _life(5.0, tmp_path), _life(2.5, tmp_path)
-    assert abs(a - b) / b < 0.05
+def test_pin_phases_are_the_angle_of_each_pin_from_the_eccentric():
+    """ψ_j: the pin centre's angle about the pin-circle centre (at −e·u(θ) in the disc frame) minus
+    the eccentric's angle θ (rvfem.geometry.pin_centres)."""
+    case = coarse_case("rv40e_solid")
+    for theta in (0.0, 0.37, 2.9):
+        c = pin_centres(case, theta) + 1.3 * np.array([math.cos(theta), math.sin(theta)])
+        expect = np.angle(np.exp(1j * (np.arctan2(c[:, 1], c[:, 0]) - theta)))
+        assert np.allclose(pin_phases(case, theta), expect, atol=1e-12)
+
+
+def test_a_uniform_wear_gap_is_an_equidistant_modification(coarse):
+    """Every flank worn by the same depth g is the profile of the generating pin radius r_rp + g (an
+    offset curve at g: every pin's gap grows by g at every crank angle), so the flank deviation
+    and the equidistant modification give the same pin gaps to round-off and the same lost motion
+    and rigidity; a zero deviation changes nothing."""
+    case, system = coarse
+    g = 4e-3
+    mod = case.cycloid.modification
+    offset_case = case.replace(cycloid=dataclasses.replace(
+        case.cycloid, modification=dataclasses.replace(mod, equidistant=mod.equidistant + g)))
+    worn = worn_stage(system, case, FlankDeviation.of([0.0, math.pi], [g, g], [g, g]))
+    offset = worn_stage(system, offset_case, None)
+    zp = case.pins.count
+    op = OperatingPoint(412.0, 0.05)
+    for theta in (0.0, 0.1, 1.0, 2.5):
+        a, b = contact_set(worn.first, theta, op)[0], contact_set(offset.first, theta, op)[0]
+        assert np.allclose(a.offset[:zp], b.offset[:zp], rtol=0.0, atol=1e-10)
+    fa, fb = quick_figures(worn, 412.0, 0.05, 0.0), quick_figures(offset, 412.0, 0.05, 0.0)
+    assert fa["lost_motion_arcmin"] == pytest.approx(fb["lost_motion_arcmin"], rel=1e-3)
+    assert fa["torsional_rigidity_Nm_per_arcmin"] == pytest.approx(fb["torsional_rigidity_Nm_per_arcmin"], rel=1e-3)
+    nominal = quick_figures(case_stage(system), 412.0, 0.05, 0.0)
+    zero = quick_figures(worn_stage(system, case, FlankDeviation.of([0.0, math.pi], [0.0, 0.0], [0.0, 0.0])),
+                         412.0, 0.05, 0.0)
+    assert zero == nominal
+
+
+def test_wear_rates_conserve_archard_over_the_load_cycle(coarse):
+    """Archard's law in its global form over a load cycle of the FE stage: the worn area of all the
+    teeth's flanks per crank revolution is k/L·∫ Σ_j F_j·|v_s(ψ_j)| dθ, and the same area is worn off
+    the pins (|v_s| the closed form (Zp − Zc)/Zp·(Rp·τ − r_rp)); the rates spread it over one tooth
+    (÷ Zc) and one pin (÷ Zp) at the crank revolutions of an hour."""
+    case, system = coarse
+    stage = case_stage(system)
+    kin = flank_grid(case)
+    rates = wear_rates(stage, case, kin, duty_rows(case))
+    cycle = load_cycle(system, op=OperatingPoint(412.0, 0.05), stage=stage)
+    psi = np.array([pin_phases(case, t) for t in cycle.theta])
+    F = np.asarray(cycle.pin_forces)
+    K1 = 1.3 * 40 / 64
+    v = (64 * np.sqrt(1 + K1**2 - 2 * K1 * np.cos(psi)) - 3) / 40
+    dtheta = 2 * math.pi / len(cycle.theta)
+    revs_h = 15.0 * 60.0 * 40
+    k, L = case.wear.k_flank_pin, case.cycloid.thickness
+    nodes = np.linspace(-0.5 * math.pi, 0.5 * math.pi, rates["pin"].shape[1]) * 3.0
+    loaded = k / L * np.sum((F * v)[psi >= 0]) * dtheta * revs_h
+    assert loaded > 0
+    for side, sel in enumerate((psi >= 0, psi < 0)):     # the flanks of the torque, then the nearly idle ones
+        area = k / L * np.sum((F * v)[sel]) * dtheta * revs_h
+        assert np.trapezoid(rates["flank"][side], kin.disc_arc) * 39 == pytest.approx(area, abs=0.01 * loaded)
+        assert np.trapezoid(rates["pin"][side], nodes) * 40 == pytest.approx(area, abs=0.01 * loaded)
 
 
 @pytest.mark.parametrize("key, value, words", [("wear.pin_rolling", '"rolling"', "must be one of"),
