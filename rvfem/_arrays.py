@@ -1,5 +1,6 @@
 """Small array utilities shared by the modules: read-only arrays, the first of equal maxima, the
-ordering of mesh edges, giving freed memory back and single-threaded BLAS for small systems."""
+ordering of mesh edges, points in a polygon, giving freed memory back and single-threaded BLAS for
+small systems."""
 
 from __future__ import annotations
 
@@ -153,3 +154,24 @@ def single_threaded_blas():
     benchmarks/README.md, "Load cycle"). Nested uses are cheap.
     """
     return _blas_libraries().limit(limits=1, user_api="blas")
+
+
+def points_in_polygon(points: np.ndarray, vertices: np.ndarray, chunk: int = 1 << 22) -> np.ndarray:
+    """Which of ``points`` (m, 2) lie inside the closed polygon ``vertices`` (n, 2), by the
+    even-odd rule: a horizontal ray from the point crosses the polygon's edges an odd number of
+    times (a point on an edge may count either way).
+
+    The edges are vectorised against the points, at most ``chunk`` point-edge pairs at a time.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    v = np.asarray(vertices, dtype=float)
+    a, b = v, np.roll(v, -1, axis=0)
+    inside = np.zeros(len(p), dtype=bool)
+    rows = max(1, chunk // max(1, len(v)))
+    for i in range(0, len(p), rows):
+        x, y = p[i:i + rows, :1], p[i:i + rows, 1:]
+        straddles = (a[:, 1] > y) != (b[:, 1] > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+        inside[i:i + rows] = np.count_nonzero(straddles & (x < cross), axis=1) % 2 == 1
+    return inside

@@ -33,8 +33,8 @@ from dataclasses import dataclass
 from typing import Protocol, Union
 
 import numpy as np
-from matplotlib.path import Path as _MplPath
 
+from rvfem._arrays import points_in_polygon
 from rvfem.case.definition import Case
 from rvfem.errors import GeometryError
 from rvfem.geometry.kinematics import crank_centres
@@ -559,10 +559,9 @@ def _disc_geometry(case: Case) -> DiscGeometry:
         f.validate()
 
     # every feature inside the profile
-    outline = _MplPath(profile.points)
     for f in features:
         pts = f.sample(max(0.5, f.sampling_length / 1000.0))   # enough to tell "entirely outside"
-        outside = ~outline.contains_points(pts)
+        outside = ~points_in_polygon(pts, profile.points)
         if np.all(outside):
             raise GeometryError(
                 f"{feature_text(f.name)} lies entirely outside the cycloid profile (root radius "

@@ -26,9 +26,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from matplotlib.path import Path as _MplPath
 
 from rvfem import NOTICE
+from rvfem._arrays import points_in_polygon
 from rvfem._arrays import readonly as _readonly
 from rvfem.case.definition import Case
 from rvfem.geometry.profile import Profile, _c2xy, _u, build_profile, profile_eval
@@ -282,7 +282,7 @@ def pin_profile_contacts_many(geom_or_case, thetas) -> list[PinContacts]:
     if profile.tooth_difference > 1:
         corner = np.abs(np.abs(s_all) - profile.half_range) < 1e-12
         if np.any(corner):
-            inside = _MplPath(profile.points).contains_points(_c2xy(c_all[corner]))
+            inside = points_in_polygon(_c2xy(c_all[corner]), profile.points)
             sgn = np.where(inside, -1.0, 1.0)
             u = diff[corner] / np.where(dist[corner] > 0, dist[corner], 1.0)
             n[corner] = sgn * u
