@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
 
 from rvfem.evaluate import lubrication, roller_slices
 from rvfem.solve.models import roller_angles
@@ -183,18 +184,21 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
     _, b = roller_slices.hertz_peak_from_line_load(q_bin / length_mm, r_red, e_star)   # Hertz half-width of Q/L
     group = np.floor(np.log(b) / math.log(bin_ratio)).astype(int)
     cache = {} if cache is None else cache
+    shapes = np.stack([x, drop])                     # g = ψ·x − z: the coefficients (ψ, −1)
     for key in np.unique(group):
         idx = loaded[group == key]
         b_g = bin_ratio ** (key + 0.5)
         ckey = (int(key), bin_ratio, e_star, length_mm, x.size)
-        if ckey not in cache:   # C and C⁻¹ (the solver's block inverse uses it)
-            influence = roller_slices.rectangle_influence(x, dx, b_g, e_star)
-            cache[ckey] = influence, roller_slices.influence_inverse(influence)
-        influence, inverse = cache[ckey]
-        p, _ = roller_slices.solve_slices(influence, 2.0 * b_g * dx,
-                                          flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx],
-                                          inverse=inverse)
-        out[idx] = (p * 2.0 * b_g) @ roller_slices.section_window(x, dx, b_g).T
+        solver = cache.get(ckey)
+        if solver is None:
+            solver = roller_slices.SliceSolver(roller_slices.rectangle_influence(x, dx, b_g, e_star),
+                                               2.0 * b_g * dx, shapes)
+        elif not np.array_equal(solver.modes[:, 1:].T, shapes):      # another profile: C and C⁻¹ kept
+            solver = roller_slices.SliceSolver(solver.influence, 2.0 * b_g * dx, shapes, inverse=solver.inverse)
+        cache[ckey] = solver
+        coef = np.stack([flat_t[idx], np.full(idx.size, -1.0)], axis=1)
+        p, _ = solver.solve(coef, flat_q[idx])
+        out[idx] = sparse.csr_matrix(roller_slices.section_window(x, dx, b_g)).dot((p * 2.0 * b_g).T).T
     return out.reshape(shape + (x.size,))
 
 
@@ -471,10 +475,10 @@ def _peak(case, theta, loads, tilts, slice_loads, geoms):
     """(raceway index, angle, roller, p(x) array) of the largest slice pressure of one bearing."""
     best = None
     for r, (geom, q) in enumerate(zip(geoms, slice_loads)):
-        ph, _ = roller_slices.hertz_peak_from_line_load(q, geom.reduced_radius_mm, geom.composite_modulus_MPa)
-        k, j, s = np.unravel_index(int(np.argmax(ph)), ph.shape)
-        if best is None or ph[k, j, s] > best[0]:
-            best = (float(ph[k, j, s]), r, int(k), int(j), ph[k, j])
+        k, j, s = np.unravel_index(int(np.argmax(q)), q.shape)       # p_h grows with q
+        ph, _ = roller_slices.hertz_peak_from_line_load(q[k, j], geom.reduced_radius_mm, geom.composite_modulus_MPa)
+        if best is None or ph[s] > best[0]:
+            best = (float(ph[s]), r, int(k), int(j), ph)
     return best
 
 

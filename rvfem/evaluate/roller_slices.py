@@ -421,7 +421,9 @@ def solve_slices(influence: np.ndarray, area_mm2: np.ndarray, interference_mm: n
     """Pressures of many slice contacts sharing one influence matrix (active-set method).
 
     For every contact k: p ≥ 0 and C·p = δ_k + g_k on the slices in contact, C·p ≥ δ_k + g_k on
-    the others, Σ p·A = Q_k.
+    the others, Σ p·A = Q_k. Solved by a :class:`SliceSolver` whose shapes are the interferences
+    themselves (a few contacts at a time); a cycle's contacts, whose interferences are
+    combinations of two shapes, use :class:`SliceSolver` directly.
 
     Parameters
     ----------
@@ -445,23 +447,21 @@ def solve_slices(influence: np.ndarray, area_mm2: np.ndarray, interference_mm: n
     approach : ndarray (m,)
         δ, mm.
     """
-    c = np.asarray(influence, dtype=float)
     g = np.atleast_2d(np.asarray(interference_mm, dtype=float))
     q = np.asarray(load_N, dtype=float).reshape(-1)
-    a = np.asarray(area_mm2, dtype=float)
-    with _single_threaded_blas():
-        h = np.linalg.inv(c) if inverse is None else np.asarray(inverse, dtype=float)
-        # all slices in contact: p = H·(δ·1 + g), H = C⁻¹, δ from the load balance
-        h1 = h.sum(axis=1)
-        hg = g @ h.T
-        delta = (q - hg @ a) / (h1 @ a)
-        p = delta[:, None] * h1[None, :] + hg
-        todo = np.flatnonzero((p < 0.0).any(axis=1))
-        if todo.size:
-            p_t, d_t = _active_set(c, h, a, g[todo], hg[todo], q[todo], p[todo] > 0.0, max_iterations)
-            p[todo] = p_t
-            delta[todo] = d_t
+    m, n = g.shape
+    p = np.zeros((m, n))
+    delta = np.zeros(m)
+    for lo in range(0, m, _SHAPES_PER_SOLVER):
+        rows = slice(lo, min(m, lo + _SHAPES_PER_SOLVER))
+        solver = SliceSolver(influence, area_mm2, g[rows], inverse=inverse)
+        p[rows], delta[rows] = solver.solve(np.eye(g[rows].shape[0]), q[rows], max_iterations)
+        inverse = solver.inverse
     return p, delta
+
+
+_SHAPES_PER_SOLVER = 4
+"""Contacts of :func:`solve_slices` solved together, each interference one shape of the solver."""
 
 
 def influence_inverse(influence: np.ndarray) -> np.ndarray:
@@ -485,147 +485,297 @@ def _single_threaded_blas():
     return _BLAS.limit(limits=1, user_api="blas")
 
 
-DENSE_SLICES = 60
-"""Up to this many slices an active set is solved by one dense system per contact
-(:func:`_solve_dense`); with more, through C⁻¹ (:func:`_solve_masked`)."""
-
 _BATCH_ELEMENTS = 1 << 21
-"""Largest temporary array of one batch of :func:`_solve_group` (elements; 16 MB)."""
+"""Largest temporary array of one batch of the solver (elements; 16 MB)."""
+
+WAVE_STRIDES = (64, 8, 1)
+"""The waves of a :meth:`SliceSolver.solve`: every 64th contact in the order of load starts with
+every slice in contact, then every 8th and then every contact not solved yet from the final active
+set of its nearest solved neighbour in that order."""
 
 
-def _solve_masked(c, h, a, g, hg, q, act):
-    """Pressures and approaches of contacts with the given active sets S (I the slices out of
-    contact): p_S = K_S·(δ·1 + g_S), p_I = 0, with K_S = C_SS⁻¹ and δ from A_S·p_S = Q.
+class SliceSolver:
+    """Slice contacts sharing one influence matrix whose interferences are combinations of a few
+    shapes: g_k = Σ_r c_kr·f_r (a cycle's contacts on one raceway: g = ψ·x − z, the shapes x and
+    z, the coefficients ψ and −1).
 
-    K_S is applied through the smaller of two systems: C_SS itself (|S| unknowns), or the block
-    inverse of C with H = C⁻¹, C_SS⁻¹ = H_SS − H_SI·H_II⁻¹·H_IS (|I| unknowns; a heavily loaded
-    roller has only a few slices out of contact), using H·1 and H·g (``hg``) of every slice in
-    contact. Contacts with the same number of unknowns k = min(|S|, |I|) are solved as one batch
-    (:func:`_solve_group`): O(n·k + k³) per contact where one dense solve costs O(n³)."""
-    m, n = g.shape
-    if n <= DENSE_SLICES:
-        return _solve_dense(c, a, g, q, act)
-    p = np.zeros((m, n))
-    delta = np.zeros(m)
-    size = act.sum(axis=1)
-    direct = size <= n - size
-    key = np.where(direct, size, -1 - (n - size))        # ≥ 0: |S| unknowns; < 0: |I| unknowns
-    h1 = h.sum(axis=1)
-    for k in np.unique(key):
-        rows = np.flatnonzero(key == k)
-        unknowns = int(k if k >= 0 else -1 - k)
-        batch = max(1, _BATCH_ELEMENTS // max(unknowns * unknowns, unknowns * n, n))
-        for lo in range(0, rows.size, batch):
-            _solve_group(c, h, h1, a, g, hg, q, act, rows[lo:lo + batch], unknowns, bool(k >= 0), p, delta)
-    return p, delta
+    The contact conditions of :func:`solve_slices` are linear in (δ, c) once the active set S
+    (the slices in contact) is known: with M = [1, f_1, …, f_r] (n × (r + 1)) and
+    U_S = C_SS⁻¹·M_S (zero off S),
+
+        p = U·v,   v = (δ, c_1, …, c_r),   δ = (Q − Σ_r c_r·A·U_r)/(A·U_0),
+
+    and the gap w − s = C·p − (δ + g) = (C·U − M)·v, zero on S. So every distinct active set is
+    solved once, for r + 1 right-hand sides, whichever contacts have it, and each contact costs
+    O(n·r) per active-set iteration: no influence product and no solve per contact. The active
+    sets of a roller's contacts repeat over a cycle (its loads and tilts do), so the distinct
+    sets are far fewer than the contacts (about a quarter with 400 slices on the default case).
+
+    U_S comes from the smaller of two systems: C_SS itself (|S| unknowns) or the block inverse
+    C_SS⁻¹ = H_SS − H_SI·H_II⁻¹·H_IS with H = C⁻¹ (|I| unknowns, I the slices out of contact: a
+    loaded roller has only a few beyond the corners' first µm); sets with the same number of
+    unknowns are solved as one batch.
+
+    Parameters
+    ----------
+    influence : ndarray (n, n)
+        C, mm/MPa (:func:`rectangle_influence`).
+    area_mm2 : ndarray (n,)
+        A_j, mm².
+    shapes : ndarray (r, n)
+        f_r, mm.
+    inverse : ndarray (n, n), optional
+        C⁻¹ (computed when first needed otherwise).
+    """
+
+    def __init__(self, influence: np.ndarray, area_mm2: np.ndarray, shapes: np.ndarray,
+                 inverse: np.ndarray | None = None):
+        self.influence = np.asarray(influence, dtype=float)
+        self.area = np.asarray(area_mm2, dtype=float)
+        n = self.influence.shape[0]
+        shapes = np.atleast_2d(np.asarray(shapes, dtype=float))
+        self.modes = np.ascontiguousarray(np.concatenate([np.ones((1, n)), shapes], axis=0).T)   # M, (n, r + 1)
+        self._inverse = None if inverse is None else np.asarray(inverse, dtype=float)
+        self._hm: np.ndarray | None = None
+        self._sets: dict[bytes, int] = {}
+        r1 = self.modes.shape[1]
+        self._count = 0                               # sets solved; their rows of:
+        self._u = np.zeros((0, n, r1))                # U of every set, (·, n, r + 1)
+        self._gap = np.zeros((0, n, r1))              # C·U − M
+        self._masks = np.zeros((0, n), dtype=bool)    # S
+        self._au = np.zeros((0, r1))                  # A·U
+        self._reach: np.ndarray | None = None         # R (n,) bool (:meth:`_set_reach`)
+        self._reach_index = np.zeros(0, dtype=int)
+        self._h_reach: np.ndarray | None = None       # (C_RR)⁻¹
+        self._hm_reach = np.zeros((0, 0))
+        self._c_beyond = np.zeros((0, 0))
+
+    @property
+    def inverse(self) -> np.ndarray:
+        """H = C⁻¹, 1/(mm/MPa)."""
+        if self._inverse is None:
+            self._inverse = influence_inverse(self.influence)
+        return self._inverse
+
+    def solve(self, coefficients: np.ndarray, load_N: np.ndarray,
+              max_iterations: int = 60) -> tuple[np.ndarray, np.ndarray]:
+        """Pressures (MPa, (m, n)) and approaches (mm, (m,)) of the contacts g_k = Σ_r c_kr·f_r
+        (``coefficients`` (m, r)) under the loads Q_k (N, (m,)).
+
+        Active-set iterations as in :func:`solve_slices` (drop the slices in tension, add the
+        penetrating ones, until neither is left), in waves (:data:`WAVE_STRIDES`): every 64th
+        contact in the order of load (and then of the coefficients) starts with every slice in
+        contact; the others start from the final set of their nearest solved neighbour in that
+        order, which is mostly their own, so that few intermediate sets are solved. The start does
+        not change the answer, only how soon it is found: the iterations end where the contact
+        conditions hold."""
+        coef = np.atleast_2d(np.asarray(coefficients, dtype=float))
+        q = np.asarray(load_N, dtype=float).reshape(-1)
+        m = q.size
+        n = self.modes.shape[0]
+        p = np.zeros((m, n))
+        delta = np.zeros(m)
+        active = np.ones((m, n), dtype=bool)
+        order = np.lexsort(tuple(coef.T[::-1]) + (q,))
+        solved = np.zeros(m, dtype=bool)
+        with _single_threaded_blas():
+            for stride in WAVE_STRIDES:
+                wave = np.zeros(m, dtype=bool)
+                wave[order[::stride]] = True
+                wave[order[-1]] = True
+                wave &= ~solved
+                if solved.any():                 # start from the nearest solved contact in the order
+                    place = np.flatnonzero(solved[order])
+                    where = np.flatnonzero(wave[order])
+                    k = np.clip(np.searchsorted(place, where), 1, place.size) - 1
+                    after = np.minimum(k + 1, place.size - 1)
+                    k = np.where(np.abs(place[after] - where) < np.abs(place[k] - where), after, k)
+                    active[order[where]] = active[order[place[k]]]
+                rows = np.flatnonzero(wave)
+                self._iterate(rows, coef, q, active, p, delta, max_iterations)
+                solved |= wave
+                if self._reach is None:
+                    self._set_reach(coef, delta[rows])
+        return np.clip(p, 0.0, None), delta
+
+    def _iterate(self, pending, coef, q, active, p, delta, max_iterations) -> None:
+        """Active-set iterations of the contacts ``pending`` from their sets in ``active``;
+        writes the pressures, approaches and final sets into ``p``, ``delta`` and ``active``."""
+        n, r = self.modes.shape
+        shapes = self.modes[:, 1:]
+        for _ in range(max_iterations):
+            if pending.size == 0:
+                return
+            ids = self._set_ids(active[pending])
+            chunk = max(1, _BATCH_ELEMENTS // (2 * n * r))
+            for lo in range(0, pending.size, chunk):
+                rows = pending[lo:lo + chunk]
+                sid = ids[lo:lo + chunk]
+                u = self._u[sid]                                               # (b, n, r + 1)
+                au = self._au[sid]                                             # A·U, (b, r + 1)
+                d = (q[rows] - np.einsum("br,br->b", au[:, 1:], coef[rows])) / au[:, 0]
+                v = np.concatenate([d[:, None], coef[rows]], axis=1)[:, :, None]
+                p[rows] = (u @ v)[..., 0]
+                delta[rows] = d
+                gap = (self._gap[sid] @ v)[..., 0]                             # w − s: negative = penetration
+                act = active[rows]
+                negative = act & (p[rows] < 0.0)
+                penetrating = ~act & (gap < -1e-12 * np.maximum(np.abs(d[:, None]), 1e-9))
+                new = act & ~negative | penetrating
+                empty = ~new.any(axis=1)       # never leave a contact without a slice: keep the most interfering one
+                if empty.any():
+                    new[empty, np.argmax(coef[rows[empty]] @ shapes.T, axis=1)] = True
+                active[rows] = new
+            pending = pending[(active[pending] != self._set_masks(ids)).any(axis=1)]
+        if pending.size:
+            raise RuntimeError(f"slice contact did not settle in {max_iterations} active-set iterations")
+
+    def _set_masks(self, ids: np.ndarray) -> np.ndarray:
+        """The active sets of the given set numbers, (len(ids), n) bool."""
+        n = self.modes.shape[0]
+        return self._masks[ids]
+
+    def _set_ids(self, act: np.ndarray) -> np.ndarray:
+        """The number of every row's active set, solving the sets not seen yet (:meth:`_solve_sets`)."""
+        packed = np.ascontiguousarray(np.packbits(act, axis=1))
+        keys = [row.tobytes() for row in packed]
+        new: dict[bytes, int] = {}
+        for k, key in enumerate(keys):
+            if key not in self._sets and key not in new:
+                new[key] = k
+        if new:
+            first = np.fromiter(new.values(), dtype=int, count=len(new))
+            start = self._count
+            self._solve_sets(act[first])
+            for j, key in enumerate(new):
+                self._sets[key] = start + j
+        return np.fromiter((self._sets[key] for key in keys), dtype=int, count=len(keys))
+
+    def _set_reach(self, coef: np.ndarray, delta: np.ndarray) -> None:
+        """The slices R that a contact of this solver may touch, and (C_RR)⁻¹: those whose
+        interference g_j comes within twice the largest approach of the first wave (which holds
+        the heaviest contact) of the surface, for some contact of the call. A slice beyond it is out
+        of contact in every set met so far; its gap is checked like any other, so that a set
+        reaching past R is still solved, through all of C⁻¹ (:meth:`_solve_sets`)."""
+        n = self.modes.shape[0]
+        g = coef @ self.modes[:, 1:].T
+        reach = g.max(axis=0, initial=-np.inf) + 2.0 * max(float(np.max(delta, initial=0.0)), 0.0) > 0.0
+        self._reach = reach
+        if reach.all() or not reach.any():
+            return
+        index = np.flatnonzero(reach)
+        self._reach_index = index
+        self._h_reach = np.linalg.inv(self.influence[np.ix_(index, index)])
+        self._hm_reach = self._h_reach @ self.modes[index]
+        self._c_beyond = self.influence[~reach]
+
+    def _solve_sets(self, masks: np.ndarray) -> None:
+        """U and C·U − M of the active sets ``masks`` (s, n), appended in their order: batches of
+        the sets with the same system and number of unknowns k: C_SS (k = |S|), the block inverse
+        of (C_RR)⁻¹ when S lies within the reach R (k = |R \\ S|) or of C⁻¹ (k = |I|), whichever
+        has the fewest."""
+        s_count, n = masks.shape
+        size = masks.sum(axis=1)
+        method = np.zeros(s_count, dtype=int)                 # 0: C_SS; 1: C⁻¹; 2: (C_RR)⁻¹
+        unknowns = size.copy()
+        outside = n - size
+        use = outside < unknowns
+        method[use], unknowns[use] = 1, outside[use]
+        if self._h_reach is not None:
+            within = ~(masks & ~self._reach).any(axis=1)
+            rest = self._reach_index.size - size
+            use = within & (rest < unknowns)
+            method[use], unknowns[use] = 2, rest[use]
+        r = self.modes.shape[1]
+        u_all = np.zeros((s_count, n, r))
+        gap_all = np.zeros((s_count, n, r))
+        key = method * (n + 1) + unknowns
+        for kk in np.unique(key):
+            rows = np.flatnonzero(key == kk)
+            how, k = divmod(int(kk), n + 1)
+            batch = max(1, _BATCH_ELEMENTS // max(k * k, k * n, n * r))
+            for lo in range(0, rows.size, batch):
+                part = rows[lo:lo + batch]
+                if how == 0:
+                    u_all[part], gap_all[part] = self._direct(masks[part], k)
+                elif how == 1:
+                    u_all[part], gap_all[part] = self._through_inverse(masks[part], k)
+                else:
+                    u_all[part], gap_all[part] = self._through_reach(masks[part], k)
+        end = self._count + s_count
+        if end > self._u.shape[0]:                    # grow the stores (doubling)
+            size = max(end, 2 * self._u.shape[0], 64)
+            for name in ("_u", "_gap", "_masks", "_au"):
+                old = getattr(self, name)
+                grown = np.zeros((size,) + old.shape[1:], dtype=old.dtype)
+                grown[:self._count] = old[:self._count]
+                setattr(self, name, grown)
+        self._u[self._count:end] = u_all
+        self._gap[self._count:end] = gap_all
+        self._masks[self._count:end] = masks
+        self._au[self._count:end] = self.area @ u_all
+        self._count = end
+
+    def _direct(self, mask: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """U and C·U − M of sets of k slices in contact: U_S = C_SS⁻¹·M_S."""
+        m, n = mask.shape
+        c, modes = self.influence, self.modes
+        at = np.arange(m)[:, None]
+        s = np.nonzero(mask)[1].reshape(m, k)
+        u_s = np.linalg.solve(c[s[:, :, None], s[:, None, :]], modes[s])         # (m, k, r + 1)
+        u = np.zeros((m, n, modes.shape[1]))
+        u[at, s] = u_s
+        gap = c[:, s].transpose(1, 0, 2) @ u_s - modes[None]
+        gap[at, s] = 0.0                                                        # C_SS·U_S = M_S
+        return u, gap
+
+    def _through_inverse(self, mask: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """U and C·U − M of sets with k slices out of contact (I): U = (H − H_:I·H_II⁻¹·H_I:)·M'
+        with M' = M zero on I, i.e. Y = H·M − H_:I·M_I, U = Y − H_:I·H_II⁻¹·Y_I."""
+        m, n = mask.shape
+        if self._hm is None:
+            self._hm = self.inverse @ self.modes
+        u = _block_inverse_solve(self.inverse, self._hm, self.modes, mask, k)
+        gap = np.zeros_like(u)
+        if k:
+            at = np.arange(m)[:, None]
+            i = np.nonzero(~mask)[1].reshape(m, k)
+            gap[at, i] = self.influence[i] @ u - self.modes[i]                  # C_IS·U_S − M_I
+        return u, gap
+
+    def _through_reach(self, mask: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_through_inverse` within the reach R: the block inverse of (C_RR)⁻¹ with the k
+        slices of R out of contact; the gaps beyond R from their rows of C."""
+        m, n = mask.shape
+        index = self._reach_index
+        modes = self.modes
+        u = np.zeros((m, n, modes.shape[1]))
+        local = mask[:, index]
+        u[:, index] = _block_inverse_solve(self._h_reach, self._hm_reach, modes[index], local, k)
+        gap = np.zeros_like(u)
+        if k:
+            at = np.arange(m)[:, None]
+            i = index[np.nonzero(~local)[1].reshape(m, k)]
+            gap[at, i] = self.influence[i] @ u - modes[i]
+        gap[:, ~self._reach] = self._c_beyond @ u - modes[~self._reach]
+        return u, gap
 
 
-def _solve_group(c, h, h1, a, g, hg, q, act, rows, k, direct, p, delta):
-    """The contacts ``rows`` of :func:`_solve_masked`, each with k unknowns: |S| = k (``direct``,
-    C_SS) or |I| = k (H_II, ``h1`` = H·1); writes their pressures and approaches into ``p`` and
-    ``delta``."""
-    mask = act[rows]
+def _block_inverse_solve(h: np.ndarray, hm: np.ndarray, modes: np.ndarray, mask: np.ndarray, k: int) -> np.ndarray:
+    """U = C_SS⁻¹·M_S (zero on I) for sets with k slices out of contact, from H = C⁻¹ and H·M:
+    C_SS⁻¹ = H_SS − H_SI·H_II⁻¹·H_IS, so with Y = H·M − H_:I·M_I (H applied to M zero on I),
+    U = Y − H_:I·H_II⁻¹·Y_I, (m, n, r + 1)."""
     m, n = mask.shape
+    if k == 0:
+        return np.broadcast_to(hm, (m,) + hm.shape).copy()
     at = np.arange(m)[:, None]
-    if direct:
-        s = np.nonzero(mask)[1].reshape(m, k)                       # the slices in contact
-        u = np.linalg.solve(c[s[:, :, None], s[:, None, :]],
-                            np.stack([np.ones((m, k)), g[rows[:, None], s]], axis=-1))   # K_S·[1, g_S]
-        u1, ug, a_s = u[..., 0], u[..., 1], a[s]
-        d = (q[rows] - np.einsum("rk,rk->r", a_s, ug)) / np.einsum("rk,rk->r", a_s, u1)
-        p[rows[:, None], s] = d[:, None] * u1 + ug
-        delta[rows] = d
-        return
-    y1 = np.broadcast_to(h1, (m, n))
-    yg = hg[rows]
-    if k:
-        i = np.nonzero(~mask)[1].reshape(m, k)                      # the slices out of contact
-        h_i = h.T[i]                                                # (m, k, n): the columns H_:I
-        # H·v with v zero on I: H·1 − H_:I·1_I and H·g − H_:I·g_I
-        y1 = y1 - h_i.sum(axis=1)
-        yg = yg - np.einsum("rkn,rk->rn", h_i, g[rows[:, None], i])
-        z = np.linalg.solve(h[i[:, :, None], i[:, None, :]], np.stack([y1[at, i], yg[at, i]], axis=-1))
-        y1 = y1 - np.einsum("rkn,rk->rn", h_i, z[..., 0])            # − H_:I·H_II⁻¹·(H·v)_I
-        yg = yg - np.einsum("rkn,rk->rn", h_i, z[..., 1])
-    u1 = np.where(mask, y1, 0.0)
-    ug = np.where(mask, yg, 0.0)
-    d = (q[rows] - ug @ a) / (u1 @ a)
-    p[rows] = d[:, None] * u1 + ug
-    delta[rows] = d
-
-
-def _solve_dense(c, a, g, q, act):
-    """:func:`_solve_masked` of few slices: for every distinct active set S one solve of
-    [C_SS, −1; A_S, 0]·[p_S; δ] = [g_S; Q] with all its contacts as right-hand sides."""
-    m, n = g.shape
-    packed = np.ascontiguousarray(np.packbits(act, axis=1))
-    keys = packed.view(np.dtype((np.void, packed.shape[1]))).reshape(-1)
-    _, first, which = np.unique(keys, return_index=True, return_inverse=True)
-    if 4 * first.size > m:                      # mostly distinct sets: one batched solve
-        return _solve_batched(c, a, g, q, act)
-    order = np.argsort(which, kind="stable")
-    bounds = np.searchsorted(which[order], np.arange(first.size + 1))
-    p = np.zeros((m, n))
-    delta = np.zeros(m)
-    for k in range(first.size):
-        rows = order[bounds[k]:bounds[k + 1]]
-        s = np.flatnonzero(act[first[k]])
-        mat = np.zeros((s.size + 1, s.size + 1))
-        mat[:-1, :-1] = c[np.ix_(s, s)]
-        mat[:-1, -1] = -1.0
-        mat[-1, :-1] = a[s]
-        rhs = np.concatenate([g[np.ix_(rows, s)].T, q[None, rows]], axis=0)
-        sol = np.linalg.solve(mat, rhs)
-        p[np.ix_(rows, s)] = sol[:-1].T
-        delta[rows] = sol[-1]
-    return p, delta
-
-
-def _solve_batched(c, a, g, q, act):
-    """:func:`_solve_dense` with one system per contact (inactive rows and columns replaced by the
-    identity, p = 0 there), solved as a batch."""
-    m, n = g.shape
-    eye = np.eye(n)
-    mat = np.empty((m, n + 1, n + 1))
-    both = act[:, :, None] & act[:, None, :]
-    mat[:, :n, :n] = np.where(both, c[None], eye[None])
-    mat[:, :n, n] = np.where(act, -1.0, 0.0)
-    mat[:, n, :n] = np.where(act, a[None, :], 0.0)
-    mat[:, n, n] = 0.0
-    rhs = np.concatenate([np.where(act, g, 0.0), q[:, None]], axis=1)
-    sol = np.linalg.solve(mat, rhs[..., None])[..., 0]
-    return sol[:, :n], sol[:, n]
-
-
-def _active_set(c, h, a, g, hg, q, active, max_iterations):
-    """Active-set iterations of :func:`solve_slices` for the contacts not fully in contact: drop
-    the slices in tension, add the penetrating ones, until neither is left (every iteration one
-    :func:`_solve_masked` of the contacts not settled; ``h`` = C⁻¹, ``hg`` = H·g)."""
-    m, n = g.shape
-    p = np.zeros((m, n))
-    delta = np.zeros(m)
-    pending = np.arange(m)
-    for _ in range(max_iterations):
-        act = active[pending]
-        pk, dk = _solve_masked(c, h, a, g[pending], hg[pending], q[pending], act)
-        gap = pk @ c.T - (dk[:, None] + g[pending])       # w − s: negative = penetration
-        negative = act & (pk < 0.0)
-        penetrating = ~act & (gap < -1e-12 * np.maximum(np.abs(dk[:, None]), 1e-9))
-        done = ~(negative.any(axis=1) | penetrating.any(axis=1))
-        p[pending[done]] = pk[done]
-        delta[pending[done]] = dk[done]
-        new = act & ~negative | penetrating
-        # never leave a contact without a slice: keep the most interfering one
-        empty = ~new.any(axis=1)
-        if empty.any():
-            new[empty, np.argmax(g[pending[empty]], axis=1)] = True
-        active[pending] = new
-        pending = pending[~done]
-        if pending.size == 0:
-            break
-    if pending.size:
-        raise RuntimeError(f"slice contact did not settle in {max_iterations} active-set iterations")
-    return np.clip(p, 0.0, None), delta
+    i = np.nonzero(~mask)[1].reshape(m, k)
+    h_i = h[:, i].transpose(1, 0, 2)                                               # (m, n, k): H_:I
+    y = hm[None] - h_i @ modes[i]
+    z = np.linalg.solve(h[i[:, :, None], i[:, None, :]], y[at, i])
+    u = y - h_i @ z
+    u[at, i] = 0.0
+    return u
 
 
 def hertz_peak_from_line_load(line_load_N_per_mm, reduced_radius_mm: float, composite_modulus_MPa: float):
