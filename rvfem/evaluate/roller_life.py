@@ -341,7 +341,10 @@ def damage_location(x_mm, widths_mm, lamina_damage, length_mm: float,
     if not total > 0:
         return None
     density = d / dx
-    r, k = np.unravel_index(int(np.argmax(density)), density.shape)
+    # the first of the laminae within round-off of the largest (a symmetric roller's two ends
+    # carry the same damage; which end is reported must not depend on the last bit)
+    top = float(np.max(density))
+    r, k = np.unravel_index(int(np.argmax(density >= top * (1.0 - 1e-12))), density.shape)
     peak = float(density[r, k])
     mean = float(np.sum(d[r])) / length_mm
     spread = float(np.sum(dx[density[r] >= 0.5 * peak]))

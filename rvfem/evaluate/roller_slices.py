@@ -409,6 +409,10 @@ def rectangle_influence(x_mm, widths_mm, half_width_mm: float, composite_modulus
     dx = x[:, None] - x[None, :]
     dy = y[:, None] - y[None, :]
     total = np.zeros(dx.shape)
+    if y_mm is None:            # all on one line: the corner function is odd in v, so the ±v terms are one
+        for sx in (-1.0, 1.0):
+            total += 2.0 * sx * _love(dx + sx * hw[None, :], np.broadcast_to(hh[None, :], dx.shape))
+        return total / (math.pi * composite_modulus_MPa)
     for sx in (-1.0, 1.0):
         for sy in (-1.0, 1.0):
             total += sx * sy * _love(dx + sx * hw[None, :], dy + sy * hh[None, :])
@@ -665,7 +669,10 @@ class SliceSolver:
             return
         index = np.flatnonzero(reach)
         self._reach_index = index
-        self._h_reach = np.linalg.inv(self.influence[np.ix_(index, index)])
+        beyond = np.flatnonzero(~reach)
+        h = self.inverse                                   # (C_RR)⁻¹ = H_RR − H_RT·H_TT⁻¹·H_TR
+        self._h_reach = h[np.ix_(index, index)] - h[np.ix_(index, beyond)] @ np.linalg.solve(
+            h[np.ix_(beyond, beyond)], h[np.ix_(beyond, index)])
         self._hm_reach = self._h_reach @ self.modes[index]
         self._c_beyond = self.influence[~reach]
 
