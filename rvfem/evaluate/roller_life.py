@@ -487,7 +487,7 @@ def _peak(case, theta, loads, tilts, slice_loads, geoms):
 
 def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.ndarray, equivalent_load_N: float,
                   bearing_speed_rpm: float, rating_N: float, bearing: int, model: str,
-                  cache: dict | None = None) -> BearingDepth:
+                  cache: dict | None = None, progress: Callable[[], None] | None = None) -> BearingDepth:
     """Slice model, lubrication and lives of one bearing over a load cycle.
 
     Parameters
@@ -505,6 +505,8 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     model : str
     cache : dict, optional
         Influence matrices kept between calls (:func:`cycle_slices`).
+    progress : callable, optional
+        ``progress()`` after the slices of each raceway.
 
     Returns
     -------
@@ -513,7 +515,11 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     b = case.crank_bearing
     prof = b.profile
     geoms = raceways(case)
-    slice_loads = [cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache) for g in geoms]
+    slice_loads = []
+    for g in geoms:
+        slice_loads.append(cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache))
+        if progress is not None:
+            progress()
     x, dx = roller_slices.slice_layout(prof, b.roller_length)
     _, r, k, j, _ = _peak(case, theta, roller_loads, tilts, slice_loads, geoms)
     g = geoms[r]
@@ -599,8 +605,8 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
         The rigid column already computed at the same angles (:func:`rigid_bearing_depths`, as the
         rigid handbook evaluation has it); computed here when not given.
     progress : callable, optional
-        ``progress(done, total)`` after each bearing's flexible slices and after the rigid column
-        (when computed here).
+        ``progress(done, total)`` after the flexible slices of each raceway of each bearing and after
+        the rigid column (when computed here).
     """
     if cycle.roller_loads is None or cycle.roller_angles is None:
         return None
@@ -611,13 +617,19 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
     flexible: list[BearingDepth] = []
     cache: dict = {}
     have_rigid = isinstance(rigid_forces, np.ndarray) and np.all(np.isfinite(rigid_forces))
-    steps = len(comparison.bearings) + int(have_rigid and rigid_depths is None)
+    steps = 2 * len(comparison.bearings) + int(have_rigid and rigid_depths is None)
+    done = 0
+
+    def step() -> None:
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, steps)
+
     for bc in comparison.bearings:
         i = bc.bearing
         flexible.append(bearing_depth(case, theta, cycle.roller_loads[:, i], tilts[:, i], bc.flexible.equivalent_N,
-                                      speed_rpm, rating_N, i, "flexible", cache))
-        if progress is not None:
-            progress(len(flexible), steps)
+                                      speed_rpm, rating_N, i, "flexible", cache, progress=step))
     rigid = () if rigid_depths is None else rigid_depths
     if have_rigid and rigid_depths is None:
         equivalent = {bc.bearing: bc.rigid.equivalent_N for bc in comparison.bearings if bc.rigid is not None}
@@ -652,7 +664,7 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
     cache : dict, optional
         Influence matrices kept between calls (:func:`cycle_slices`).
     progress : callable, optional
-        ``progress(done, total)`` after each bearing.
+        ``progress(done, total)`` after the slices of each raceway of each bearing.
     """
     loads = roller_slices.case_rigid_roller_loads(case, theta, rigid_forces)
     angles = roller_angles(case, np.asarray(theta, dtype=float))
@@ -660,10 +672,17 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
                          1e-3 * case.crank_bearing.profile.misalignment_mrad)
     cache = {} if cache is None else cache
     depths = []
-    for i, p in sorted(equivalent_loads_N.items()):
-        depths.append(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache))
+    done, steps = 0, 2 * len(equivalent_loads_N)
+
+    def step() -> None:
+        nonlocal done
+        done += 1
         if progress is not None:
-            progress(len(depths), len(equivalent_loads_N))
+            progress(done, steps)
+
+    for i, p in sorted(equivalent_loads_N.items()):
+        depths.append(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache,
+                                    progress=step))
     return tuple(depths)
 
 

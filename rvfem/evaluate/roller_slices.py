@@ -598,7 +598,7 @@ class SliceSolver:
                 rows = np.flatnonzero(wave)
                 self._iterate(rows, coef, q, active, p, delta, max_iterations)
                 solved |= wave
-                if self._reach is None:
+                if self._reach is None and not solved.all():     # worth it for many contacts only
                     self._set_reach(coef, delta[rows])
         return np.clip(p, 0.0, None), delta
 
