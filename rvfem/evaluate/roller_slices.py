@@ -548,7 +548,8 @@ class SliceSolver:
         self._gap = np.zeros((0, n, r1))              # C·U − M
         self._masks = np.zeros((0, n), dtype=bool)    # S
         self._au = np.zeros((0, r1))                  # A·U
-        self._reach: np.ndarray | None = None         # R (n,) bool (:meth:`_set_reach`)
+        self._reach = np.ones(n, dtype=bool)          # R (:meth:`_set_reach`)
+        self._reach_known = False
         self._reach_index = np.zeros(0, dtype=int)
         self._h_reach: np.ndarray | None = None       # (C_RR)⁻¹
         self._hm_reach = np.zeros((0, 0))
@@ -598,7 +599,7 @@ class SliceSolver:
                 rows = np.flatnonzero(wave)
                 self._iterate(rows, coef, q, active, p, delta, max_iterations)
                 solved |= wave
-                if self._reach is None and not solved.all():     # worth it for many contacts only
+                if not self._reach_known and not solved.all():   # worth it for many contacts only
                     self._set_reach(coef, delta[rows])
         return np.clip(p, 0.0, None), delta
 
@@ -665,6 +666,7 @@ class SliceSolver:
         g = coef @ self.modes[:, 1:].T
         reach = g.max(axis=0, initial=-np.inf) + 2.0 * max(float(np.max(delta, initial=0.0)), 0.0) > 0.0
         self._reach = reach
+        self._reach_known = True
         if reach.all() or not reach.any():
             return
         index = np.flatnonzero(reach)
@@ -756,6 +758,7 @@ class SliceSolver:
         m, n = mask.shape
         index = self._reach_index
         modes = self.modes
+        assert self._h_reach is not None              # only sets within a reach come here
         u = np.zeros((m, n, modes.shape[1]))
         local = mask[:, index]
         u[:, index] = _block_inverse_solve(self._h_reach, self._hm_reach, modes[index], local, k)

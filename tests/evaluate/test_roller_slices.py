@@ -342,7 +342,7 @@ def test_slice_solver_equals_one_dense_solve_per_contact(kind):
             p_ref, d_ref = _dense_contact(c, area, tilts[k] * x - z, loads[k])
             np.testing.assert_allclose(p[k], p_ref, rtol=0, atol=1e-9 * p_ref.max())
             assert delta[k] == pytest.approx(d_ref, rel=1e-9)
-    assert solver._reach is not None and not solver._reach.all()      # the reach was used ...
+    assert solver._reach_known and not solver._reach.all()            # the reach was used ...
     heavy = solver._masks[:solver._count] & ~solver._reach
     assert heavy.any()                                                 # ... and passed by the heavy loads
 
