@@ -163,10 +163,12 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
 
     The contacts are grouped by the Hertz half-width b of their nominal line load (groups a factor
     ``bin_ratio`` wide, each solved with the influence matrix of its geometric-mean width) and
-    every group is solved at once (:func:`rvfem.evaluate.roller_slices.solve_slices`). Contacts
-    lighter than ``light_fraction`` of the heaviest share the group of that load (their
-    rectangles are then a little too wide; they carry under 10⁻⁵ of the damage). ``cache`` keeps
-    the influence matrices and their inverses between calls (key: group, E*, L, slices).
+    every group is solved at once (:class:`rvfem.evaluate.slice_solver.SliceSolver`, the
+    interferences ψ·x − z combinations of x and the drop z). Contacts lighter than
+    ``light_fraction`` of the heaviest share the group of that load (their rectangles are then a
+    little too wide; they carry under 10⁻⁵ of the damage). ``cache`` keeps each group's solver
+    (its influence matrix, inverse and the active sets solved) between calls (key: group, E*, L,
+    slices).
     """
     q = np.asarray(roller_loads, dtype=float)
     shape = q.shape
