@@ -2,15 +2,18 @@
 
 Runs the load cycle of a case once (default ``cases/rv40e_fanholes.toml``, 360 angles, no stress
 re-solve, no attribution), then times :func:`rvfem.evaluate.roller_life.crank_bearing_depth` (both
-raceways of every bearing, rigid and flexible, plus the worst roller's re-solve, film and lives)
-and the flexible slices alone (:func:`rvfem.evaluate.roller_life.cycle_slices` on both raceways of
-every bearing), best of ``--repeat``, for each roller profile (``--kinds``) with the case's number of
-slices or ``--slices N``. Prints the number of roller contacts solved and the time per contact.
+raceways of every bearing, rigid and flexible, plus the worst roller's re-solve, film and lives:
+the whole cycle) and the flexible slices alone (:func:`rvfem.evaluate.roller_life.cycle_slices` on
+both raceways of every bearing), the median of ``--repeat`` (the machine is shared), for each
+roller profile (``--kinds``, default the case's) at each number of slices (``--slices``, default
+30 100 400), with the ratio of the whole cycle's time to that at the first count. Prints the
+number of roller contacts solved and the time per contact.
 
-Run: ``python benchmarks/bench_roller_slices.py [CASE] [--repeat 5] [--slices 400] [--kinds logarithmic]``
-(about half a minute with the case's 30 slices).
+Run: ``python benchmarks/bench_roller_slices.py [CASE] [--repeat 3] [--slices 30 100 400] [--kinds logarithmic]``
+(a few minutes). Measurements with one solve per distinct active set: benchmarks/README.md,
+"Roller slices".
 
-Measured on two shared cores (rv40e_fanholes, logarithmic profile, 400 slices, rigid + flexible
+Earlier, Measured on two shared cores (rv40e_fanholes, logarithmic profile, 400 slices, rigid + flexible
 with film and lives): with one dense solve of n + 1 unknowns per contact and active-set iteration,
 48–89 s for every fourth angle (90 angles; the 360 angles of a run took 365 s), and far longer
 with two BLAS threads contending for the cores; with the block inverse through C⁻¹
