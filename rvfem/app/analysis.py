@@ -140,7 +140,7 @@ def analyse_rigid(case: Case, theta: np.ndarray | None = None,
         Crank angles, rad; default one turn at ``analysis.angle_step_deg``
         (:func:`rvfem.evaluate.rigid.load_cycle_angles`).
     progress : callable, optional
-        ``progress(done, total)`` after the slices of each bearing (bearing model ``rollers``).
+        ``progress(done, total)`` after the slices of each raceway of each bearing (bearing model ``rollers``).
 
     Returns
     -------

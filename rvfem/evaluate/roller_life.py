@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
 
 from rvfem.evaluate import lubrication, roller_slices
 from rvfem.solve.models import roller_angles
@@ -162,10 +163,12 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
 
     The contacts are grouped by the Hertz half-width b of their nominal line load (groups a factor
     ``bin_ratio`` wide, each solved with the influence matrix of its geometric-mean width) and
-    every group is solved at once (:func:`rvfem.evaluate.roller_slices.solve_slices`). Contacts
-    lighter than ``light_fraction`` of the heaviest share the group of that load (their
-    rectangles are then a little too wide; they carry under 10⁻⁵ of the damage). ``cache`` keeps
-    the influence matrices and their inverses between calls (key: group, E*, L, slices).
+    every group is solved at once (:class:`rvfem.evaluate.slice_solver.SliceSolver`, the
+    interferences ψ·x − z combinations of x and the drop z). Contacts lighter than
+    ``light_fraction`` of the heaviest share the group of that load (their rectangles are then a
+    little too wide; they carry under 10⁻⁵ of the damage). ``cache`` keeps each group's solver
+    (its influence matrix, inverse and the active sets solved) between calls (key: group, E*, L,
+    slices).
     """
     q = np.asarray(roller_loads, dtype=float)
     shape = q.shape
@@ -183,18 +186,21 @@ def cycle_slices(roller_loads: np.ndarray, tilts: np.ndarray, length_mm: float, 
     _, b = roller_slices.hertz_peak_from_line_load(q_bin / length_mm, r_red, e_star)   # Hertz half-width of Q/L
     group = np.floor(np.log(b) / math.log(bin_ratio)).astype(int)
     cache = {} if cache is None else cache
+    shapes = np.stack([x, drop])                     # g = ψ·x − z: the coefficients (ψ, −1)
     for key in np.unique(group):
         idx = loaded[group == key]
         b_g = bin_ratio ** (key + 0.5)
         ckey = (int(key), bin_ratio, e_star, length_mm, x.size)
-        if ckey not in cache:   # C and C⁻¹ (the solver's block inverse uses it)
-            influence = roller_slices.rectangle_influence(x, dx, b_g, e_star)
-            cache[ckey] = influence, roller_slices.influence_inverse(influence)
-        influence, inverse = cache[ckey]
-        p, _ = roller_slices.solve_slices(influence, 2.0 * b_g * dx,
-                                          flat_t[idx, None] * x[None, :] - drop[None, :], flat_q[idx],
-                                          inverse=inverse)
-        out[idx] = (p * 2.0 * b_g) @ roller_slices.section_window(x, dx, b_g).T
+        solver = cache.get(ckey)
+        if solver is None:
+            solver = roller_slices.SliceSolver(roller_slices.rectangle_influence(x, dx, b_g, e_star),
+                                               2.0 * b_g * dx, shapes)
+        elif not np.array_equal(solver.modes[:, 1:].T, shapes):      # another profile: C and C⁻¹ kept
+            solver = roller_slices.SliceSolver(solver.influence, 2.0 * b_g * dx, shapes, inverse=solver.inverse)
+        cache[ckey] = solver
+        coef = np.stack([flat_t[idx], np.full(idx.size, -1.0)], axis=1)
+        p, _ = solver.solve(coef, flat_q[idx])
+        out[idx] = sparse.csr_matrix(roller_slices.section_window(x, dx, b_g)).dot((p * 2.0 * b_g).T).T
     return out.reshape(shape + (x.size,))
 
 
@@ -337,7 +343,10 @@ def damage_location(x_mm, widths_mm, lamina_damage, length_mm: float,
     if not total > 0:
         return None
     density = d / dx
-    r, k = np.unravel_index(int(np.argmax(density)), density.shape)
+    # the first of the laminae within round-off of the largest (a symmetric roller's two ends
+    # carry the same damage; which end is reported must not depend on the last bit)
+    top = float(np.max(density))
+    r, k = np.unravel_index(int(np.argmax(density >= top * (1.0 - 1e-12))), density.shape)
     peak = float(density[r, k])
     mean = float(np.sum(d[r])) / length_mm
     spread = float(np.sum(dx[density[r] >= 0.5 * peak]))
@@ -471,16 +480,16 @@ def _peak(case, theta, loads, tilts, slice_loads, geoms):
     """(raceway index, angle, roller, p(x) array) of the largest slice pressure of one bearing."""
     best = None
     for r, (geom, q) in enumerate(zip(geoms, slice_loads)):
-        ph, _ = roller_slices.hertz_peak_from_line_load(q, geom.reduced_radius_mm, geom.composite_modulus_MPa)
-        k, j, s = np.unravel_index(int(np.argmax(ph)), ph.shape)
-        if best is None or ph[k, j, s] > best[0]:
-            best = (float(ph[k, j, s]), r, int(k), int(j), ph[k, j])
+        k, j, s = np.unravel_index(int(np.argmax(q)), q.shape)       # p_h grows with q
+        ph, _ = roller_slices.hertz_peak_from_line_load(q[k, j], geom.reduced_radius_mm, geom.composite_modulus_MPa)
+        if best is None or ph[s] > best[0]:
+            best = (float(ph[s]), r, int(k), int(j), ph)
     return best
 
 
 def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.ndarray, equivalent_load_N: float,
                   bearing_speed_rpm: float, rating_N: float, bearing: int, model: str,
-                  cache: dict | None = None) -> BearingDepth:
+                  cache: dict | None = None, progress: Callable[[], None] | None = None) -> BearingDepth:
     """Slice model, lubrication and lives of one bearing over a load cycle.
 
     Parameters
@@ -498,6 +507,8 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     model : str
     cache : dict, optional
         Influence matrices kept between calls (:func:`cycle_slices`).
+    progress : callable, optional
+        ``progress()`` after the slices of each raceway.
 
     Returns
     -------
@@ -506,7 +517,11 @@ def bearing_depth(case, theta: np.ndarray, roller_loads: np.ndarray, tilts: np.n
     b = case.crank_bearing
     prof = b.profile
     geoms = raceways(case)
-    slice_loads = [cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache) for g in geoms]
+    slice_loads = []
+    for g in geoms:
+        slice_loads.append(cycle_slices(roller_loads, tilts, b.roller_length, g, prof, cache=cache))
+        if progress is not None:
+            progress()
     x, dx = roller_slices.slice_layout(prof, b.roller_length)
     _, r, k, j, _ = _peak(case, theta, roller_loads, tilts, slice_loads, geoms)
     g = geoms[r]
@@ -592,8 +607,8 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
         The rigid column already computed at the same angles (:func:`rigid_bearing_depths`, as the
         rigid handbook evaluation has it); computed here when not given.
     progress : callable, optional
-        ``progress(done, total)`` after each bearing's flexible slices and after the rigid column
-        (when computed here).
+        ``progress(done, total)`` after the flexible slices of each raceway of each bearing and after
+        the rigid column (when computed here).
     """
     if cycle.roller_loads is None or cycle.roller_angles is None:
         return None
@@ -604,13 +619,19 @@ def crank_bearing_depth(case, theta: np.ndarray, cycle, rigid_forces, comparison
     flexible: list[BearingDepth] = []
     cache: dict = {}
     have_rigid = isinstance(rigid_forces, np.ndarray) and np.all(np.isfinite(rigid_forces))
-    steps = len(comparison.bearings) + int(have_rigid and rigid_depths is None)
+    steps = 2 * len(comparison.bearings) + int(have_rigid and rigid_depths is None)
+    done = 0
+
+    def step() -> None:
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, steps)
+
     for bc in comparison.bearings:
         i = bc.bearing
         flexible.append(bearing_depth(case, theta, cycle.roller_loads[:, i], tilts[:, i], bc.flexible.equivalent_N,
-                                      speed_rpm, rating_N, i, "flexible", cache))
-        if progress is not None:
-            progress(len(flexible), steps)
+                                      speed_rpm, rating_N, i, "flexible", cache, progress=step))
     rigid = () if rigid_depths is None else rigid_depths
     if have_rigid and rigid_depths is None:
         equivalent = {bc.bearing: bc.rigid.equivalent_N for bc in comparison.bearings if bc.rigid is not None}
@@ -645,7 +666,7 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
     cache : dict, optional
         Influence matrices kept between calls (:func:`cycle_slices`).
     progress : callable, optional
-        ``progress(done, total)`` after each bearing.
+        ``progress(done, total)`` after the slices of each raceway of each bearing.
     """
     loads = roller_slices.case_rigid_roller_loads(case, theta, rigid_forces)
     angles = roller_angles(case, np.asarray(theta, dtype=float))
@@ -653,10 +674,17 @@ def rigid_bearing_depths(case, theta: np.ndarray, rigid_forces: np.ndarray, equi
                          1e-3 * case.crank_bearing.profile.misalignment_mrad)
     cache = {} if cache is None else cache
     depths = []
-    for i, p in sorted(equivalent_loads_N.items()):
-        depths.append(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache))
+    done, steps = 0, 2 * len(equivalent_loads_N)
+
+    def step() -> None:
+        nonlocal done
+        done += 1
         if progress is not None:
-            progress(len(depths), len(equivalent_loads_N))
+            progress(done, steps)
+
+    for i, p in sorted(equivalent_loads_N.items()):
+        depths.append(bearing_depth(case, theta, loads[:, i], tilts[:, i], p, speed_rpm, rating_N, i, "rigid", cache,
+                                    progress=step))
     return tuple(depths)
 
 

@@ -47,11 +47,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import ThreadpoolController
 
 from rvfem.case.definition import ROLLER_PROFILE_KINDS, RollerProfile
 from rvfem.evaluate.hertz import hertz_half_width
 from rvfem.evaluate.rigid_rings import case_rigid_roller_loads, rigid_ring_roller_loads
+from rvfem.evaluate.slice_solver import SliceSolver, influence_inverse, solve_slices
 
 __all__ = [
     "PROFILE_KINDS",
@@ -71,6 +71,7 @@ __all__ = [
     "hertz_peak_from_line_load",
     "roller_contact",
     "influence_inverse",
+    "SliceSolver",
     "rigid_ring_roller_loads",
     "case_rigid_roller_loads",
 ]
@@ -409,223 +410,14 @@ def rectangle_influence(x_mm, widths_mm, half_width_mm: float, composite_modulus
     dx = x[:, None] - x[None, :]
     dy = y[:, None] - y[None, :]
     total = np.zeros(dx.shape)
+    if y_mm is None:            # all on one line: the corner function is odd in v, so the ±v terms are one
+        for sx in (-1.0, 1.0):
+            total += 2.0 * sx * _love(dx + sx * hw[None, :], np.broadcast_to(hh[None, :], dx.shape))
+        return total / (math.pi * composite_modulus_MPa)
     for sx in (-1.0, 1.0):
         for sy in (-1.0, 1.0):
             total += sx * sy * _love(dx + sx * hw[None, :], dy + sy * hh[None, :])
     return total / (math.pi * composite_modulus_MPa)
-
-
-def solve_slices(influence: np.ndarray, area_mm2: np.ndarray, interference_mm: np.ndarray,
-                 load_N: np.ndarray, max_iterations: int = 60, *,
-                 inverse: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Pressures of many slice contacts sharing one influence matrix (active-set method).
-
-    For every contact k: p ≥ 0 and C·p = δ_k + g_k on the slices in contact, C·p ≥ δ_k + g_k on
-    the others, Σ p·A = Q_k.
-
-    Parameters
-    ----------
-    influence : ndarray (n, n)
-        C, mm/MPa (:func:`rectangle_influence`).
-    area_mm2 : ndarray (n,)
-        Area A_j of each slice's rectangle, mm².
-    interference_mm : ndarray (m, n)
-        g_k,j = ψ_k·x_j − z(x_j), mm (the approach of slice j relative to mid-length).
-    load_N : ndarray (m,)
-        Q_k > 0, N.
-    max_iterations : int
-        Active-set iterations.
-    inverse : ndarray (n, n), optional
-        C⁻¹, when the caller keeps it with C (computed here otherwise).
-
-    Returns
-    -------
-    pressure : ndarray (m, n)
-        p, MPa.
-    approach : ndarray (m,)
-        δ, mm.
-    """
-    c = np.asarray(influence, dtype=float)
-    g = np.atleast_2d(np.asarray(interference_mm, dtype=float))
-    q = np.asarray(load_N, dtype=float).reshape(-1)
-    a = np.asarray(area_mm2, dtype=float)
-    with _single_threaded_blas():
-        h = np.linalg.inv(c) if inverse is None else np.asarray(inverse, dtype=float)
-        # all slices in contact: p = H·(δ·1 + g), H = C⁻¹, δ from the load balance
-        h1 = h.sum(axis=1)
-        hg = g @ h.T
-        delta = (q - hg @ a) / (h1 @ a)
-        p = delta[:, None] * h1[None, :] + hg
-        todo = np.flatnonzero((p < 0.0).any(axis=1))
-        if todo.size:
-            p_t, d_t = _active_set(c, h, a, g[todo], hg[todo], q[todo], p[todo] > 0.0, max_iterations)
-            p[todo] = p_t
-            delta[todo] = d_t
-    return p, delta
-
-
-def influence_inverse(influence: np.ndarray) -> np.ndarray:
-    """C⁻¹ of an influence matrix (:func:`rectangle_influence`), for :func:`solve_slices`'s
-    ``inverse``, 1/(mm/MPa)."""
-    with _single_threaded_blas():
-        return np.linalg.inv(np.asarray(influence, dtype=float))
-
-
-_BLAS: ThreadpoolController | None = None
-
-
-def _single_threaded_blas():
-    """A context with BLAS single-threaded. The systems are small (n ≤ 400) and many: threaded
-    BLAS only contends for the cores there (benchmarks/README.md, "Roller slices"). The libraries
-    are found once: reading the process's memory map costs about as much as a 30-slice group's
-    solve."""
-    global _BLAS
-    if _BLAS is None:
-        _BLAS = ThreadpoolController()
-    return _BLAS.limit(limits=1, user_api="blas")
-
-
-DENSE_SLICES = 60
-"""Up to this many slices an active set is solved by one dense system per contact
-(:func:`_solve_dense`); with more, through C⁻¹ (:func:`_solve_masked`)."""
-
-_BATCH_ELEMENTS = 1 << 21
-"""Largest temporary array of one batch of :func:`_solve_group` (elements; 16 MB)."""
-
-
-def _solve_masked(c, h, a, g, hg, q, act):
-    """Pressures and approaches of contacts with the given active sets S (I the slices out of
-    contact): p_S = K_S·(δ·1 + g_S), p_I = 0, with K_S = C_SS⁻¹ and δ from A_S·p_S = Q.
-
-    K_S is applied through the smaller of two systems: C_SS itself (|S| unknowns), or the block
-    inverse of C with H = C⁻¹, C_SS⁻¹ = H_SS − H_SI·H_II⁻¹·H_IS (|I| unknowns; a heavily loaded
-    roller has only a few slices out of contact), using H·1 and H·g (``hg``) of every slice in
-    contact. Contacts with the same number of unknowns k = min(|S|, |I|) are solved as one batch
-    (:func:`_solve_group`): O(n·k + k³) per contact where one dense solve costs O(n³)."""
-    m, n = g.shape
-    if n <= DENSE_SLICES:
-        return _solve_dense(c, a, g, q, act)
-    p = np.zeros((m, n))
-    delta = np.zeros(m)
-    size = act.sum(axis=1)
-    direct = size <= n - size
-    key = np.where(direct, size, -1 - (n - size))        # ≥ 0: |S| unknowns; < 0: |I| unknowns
-    h1 = h.sum(axis=1)
-    for k in np.unique(key):
-        rows = np.flatnonzero(key == k)
-        unknowns = int(k if k >= 0 else -1 - k)
-        batch = max(1, _BATCH_ELEMENTS // max(unknowns * unknowns, unknowns * n, n))
-        for lo in range(0, rows.size, batch):
-            _solve_group(c, h, h1, a, g, hg, q, act, rows[lo:lo + batch], unknowns, bool(k >= 0), p, delta)
-    return p, delta
-
-
-def _solve_group(c, h, h1, a, g, hg, q, act, rows, k, direct, p, delta):
-    """The contacts ``rows`` of :func:`_solve_masked`, each with k unknowns: |S| = k (``direct``,
-    C_SS) or |I| = k (H_II, ``h1`` = H·1); writes their pressures and approaches into ``p`` and
-    ``delta``."""
-    mask = act[rows]
-    m, n = mask.shape
-    at = np.arange(m)[:, None]
-    if direct:
-        s = np.nonzero(mask)[1].reshape(m, k)                       # the slices in contact
-        u = np.linalg.solve(c[s[:, :, None], s[:, None, :]],
-                            np.stack([np.ones((m, k)), g[rows[:, None], s]], axis=-1))   # K_S·[1, g_S]
-        u1, ug, a_s = u[..., 0], u[..., 1], a[s]
-        d = (q[rows] - np.einsum("rk,rk->r", a_s, ug)) / np.einsum("rk,rk->r", a_s, u1)
-        p[rows[:, None], s] = d[:, None] * u1 + ug
-        delta[rows] = d
-        return
-    y1 = np.broadcast_to(h1, (m, n))
-    yg = hg[rows]
-    if k:
-        i = np.nonzero(~mask)[1].reshape(m, k)                      # the slices out of contact
-        h_i = h.T[i]                                                # (m, k, n): the columns H_:I
-        # H·v with v zero on I: H·1 − H_:I·1_I and H·g − H_:I·g_I
-        y1 = y1 - h_i.sum(axis=1)
-        yg = yg - np.einsum("rkn,rk->rn", h_i, g[rows[:, None], i])
-        z = np.linalg.solve(h[i[:, :, None], i[:, None, :]], np.stack([y1[at, i], yg[at, i]], axis=-1))
-        y1 = y1 - np.einsum("rkn,rk->rn", h_i, z[..., 0])            # − H_:I·H_II⁻¹·(H·v)_I
-        yg = yg - np.einsum("rkn,rk->rn", h_i, z[..., 1])
-    u1 = np.where(mask, y1, 0.0)
-    ug = np.where(mask, yg, 0.0)
-    d = (q[rows] - ug @ a) / (u1 @ a)
-    p[rows] = d[:, None] * u1 + ug
-    delta[rows] = d
-
-
-def _solve_dense(c, a, g, q, act):
-    """:func:`_solve_masked` of few slices: for every distinct active set S one solve of
-    [C_SS, −1; A_S, 0]·[p_S; δ] = [g_S; Q] with all its contacts as right-hand sides."""
-    m, n = g.shape
-    packed = np.ascontiguousarray(np.packbits(act, axis=1))
-    keys = packed.view(np.dtype((np.void, packed.shape[1]))).reshape(-1)
-    _, first, which = np.unique(keys, return_index=True, return_inverse=True)
-    if 4 * first.size > m:                      # mostly distinct sets: one batched solve
-        return _solve_batched(c, a, g, q, act)
-    order = np.argsort(which, kind="stable")
-    bounds = np.searchsorted(which[order], np.arange(first.size + 1))
-    p = np.zeros((m, n))
-    delta = np.zeros(m)
-    for k in range(first.size):
-        rows = order[bounds[k]:bounds[k + 1]]
-        s = np.flatnonzero(act[first[k]])
-        mat = np.zeros((s.size + 1, s.size + 1))
-        mat[:-1, :-1] = c[np.ix_(s, s)]
-        mat[:-1, -1] = -1.0
-        mat[-1, :-1] = a[s]
-        rhs = np.concatenate([g[np.ix_(rows, s)].T, q[None, rows]], axis=0)
-        sol = np.linalg.solve(mat, rhs)
-        p[np.ix_(rows, s)] = sol[:-1].T
-        delta[rows] = sol[-1]
-    return p, delta
-
-
-def _solve_batched(c, a, g, q, act):
-    """:func:`_solve_dense` with one system per contact (inactive rows and columns replaced by the
-    identity, p = 0 there), solved as a batch."""
-    m, n = g.shape
-    eye = np.eye(n)
-    mat = np.empty((m, n + 1, n + 1))
-    both = act[:, :, None] & act[:, None, :]
-    mat[:, :n, :n] = np.where(both, c[None], eye[None])
-    mat[:, :n, n] = np.where(act, -1.0, 0.0)
-    mat[:, n, :n] = np.where(act, a[None, :], 0.0)
-    mat[:, n, n] = 0.0
-    rhs = np.concatenate([np.where(act, g, 0.0), q[:, None]], axis=1)
-    sol = np.linalg.solve(mat, rhs[..., None])[..., 0]
-    return sol[:, :n], sol[:, n]
-
-
-def _active_set(c, h, a, g, hg, q, active, max_iterations):
-    """Active-set iterations of :func:`solve_slices` for the contacts not fully in contact: drop
-    the slices in tension, add the penetrating ones, until neither is left (every iteration one
-    :func:`_solve_masked` of the contacts not settled; ``h`` = C⁻¹, ``hg`` = H·g)."""
-    m, n = g.shape
-    p = np.zeros((m, n))
-    delta = np.zeros(m)
-    pending = np.arange(m)
-    for _ in range(max_iterations):
-        act = active[pending]
-        pk, dk = _solve_masked(c, h, a, g[pending], hg[pending], q[pending], act)
-        gap = pk @ c.T - (dk[:, None] + g[pending])       # w − s: negative = penetration
-        negative = act & (pk < 0.0)
-        penetrating = ~act & (gap < -1e-12 * np.maximum(np.abs(dk[:, None]), 1e-9))
-        done = ~(negative.any(axis=1) | penetrating.any(axis=1))
-        p[pending[done]] = pk[done]
-        delta[pending[done]] = dk[done]
-        new = act & ~negative | penetrating
-        # never leave a contact without a slice: keep the most interfering one
-        empty = ~new.any(axis=1)
-        if empty.any():
-            new[empty, np.argmax(g[pending[empty]], axis=1)] = True
-        active[pending] = new
-        pending = pending[~done]
-        if pending.size == 0:
-            break
-    if pending.size:
-        raise RuntimeError(f"slice contact did not settle in {max_iterations} active-set iterations")
-    return np.clip(p, 0.0, None), delta
 
 
 def hertz_peak_from_line_load(line_load_N_per_mm, reduced_radius_mm: float, composite_modulus_MPa: float):
