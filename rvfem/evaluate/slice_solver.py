@@ -9,7 +9,8 @@ and its cost are described in docs/theory.md § 12 ("The solver and its cost").
 from __future__ import annotations
 
 import numpy as np
-from threadpoolctl import ThreadpoolController
+
+from rvfem._arrays import single_threaded_blas
 
 __all__ = ["SliceSolver", "solve_slices", "influence_inverse", "WAVE_STRIDES"]
 
@@ -66,22 +67,8 @@ _SHAPES_PER_SOLVER = 4
 def influence_inverse(influence: np.ndarray) -> np.ndarray:
     """C⁻¹ of an influence matrix (:func:`rvfem.evaluate.roller_slices.rectangle_influence`), for :func:`solve_slices`'s
     ``inverse``, 1/(mm/MPa)."""
-    with _single_threaded_blas():
+    with single_threaded_blas():
         return np.linalg.inv(np.asarray(influence, dtype=float))
-
-
-_BLAS: ThreadpoolController | None = None
-
-
-def _single_threaded_blas():
-    """A context with BLAS single-threaded. The systems are small (n ≤ 400) and many: threaded
-    BLAS only contends for the cores there (benchmarks/README.md, "Roller slices"). The libraries
-    are found once: reading the process's memory map costs about as much as a 30-slice group's
-    solve."""
-    global _BLAS
-    if _BLAS is None:
-        _BLAS = ThreadpoolController()
-    return _BLAS.limit(limits=1, user_api="blas")
 
 
 _BATCH_ELEMENTS = 1 << 21
@@ -178,7 +165,7 @@ class SliceSolver:
         active = np.ones((m, n), dtype=bool)
         order = np.lexsort(tuple(coef.T[::-1]) + (q,))
         solved = np.zeros(m, dtype=bool)
-        with _single_threaded_blas():
+        with single_threaded_blas():
             for stride in WAVE_STRIDES:
                 wave = np.zeros(m, dtype=bool)
                 wave[order[::stride]] = True
