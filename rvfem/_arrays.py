@@ -156,22 +156,34 @@ def single_threaded_blas():
     return _blas_libraries().limit(limits=1, user_api="blas")
 
 
-def points_in_polygon(points: np.ndarray, vertices: np.ndarray, chunk: int = 1 << 22) -> np.ndarray:
+def points_in_polygon(points: np.ndarray, vertices: np.ndarray, bins: int = 64) -> np.ndarray:
     """Which of ``points`` (m, 2) lie inside the closed polygon ``vertices`` (n, 2), by the
     even-odd rule: a horizontal ray from the point crosses the polygon's edges an odd number of
     times (a point on an edge may count either way).
 
-    The edges are vectorised against the points, at most ``chunk`` point-edge pairs at a time.
+    The points are sorted into ``bins`` horizontal bands, and each band's points are tested
+    against the edges that reach into it only (vectorised per band): a profile of 10⁴ edges
+    against 10³ points costs a few milliseconds.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     v = np.asarray(vertices, dtype=float)
     a, b = v, np.roll(v, -1, axis=0)
     inside = np.zeros(len(p), dtype=bool)
-    rows = max(1, chunk // max(1, len(v)))
-    for i in range(0, len(p), rows):
-        x, y = p[i:i + rows, :1], p[i:i + rows, 1:]
-        straddles = (a[:, 1] > y) != (b[:, 1] > y)
+    if len(p) == 0 or len(v) < 3:
+        return inside
+    lo, hi = np.minimum(a[:, 1], b[:, 1]), np.maximum(a[:, 1], b[:, 1])
+    y0, y1 = float(v[:, 1].min()), float(v[:, 1].max())
+    width = (y1 - y0) / bins or 1.0
+    band = np.clip(((p[:, 1] - y0) // width).astype(int), -1, bins)
+    for k in np.unique(band):
+        if k < 0 or k >= bins:
+            continue                                      # above or below every edge: outside
+        at = np.flatnonzero(band == k)
+        e = np.flatnonzero((hi >= y0 + k * width) & (lo <= y0 + (k + 1) * width))
+        x, y = p[at, :1], p[at, 1:]
+        ea, eb = a[e], b[e]
+        straddles = (ea[:, 1] > y) != (eb[:, 1] > y)
         with np.errstate(divide="ignore", invalid="ignore"):
-            cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-        inside[i:i + rows] = np.count_nonzero(straddles & (x < cross), axis=1) % 2 == 1
+            cross = ea[:, 0] + (y - ea[:, 1]) * (eb[:, 0] - ea[:, 0]) / (eb[:, 1] - ea[:, 1])
+        inside[at] = np.count_nonzero(straddles & (x < cross), axis=1) % 2 == 1
     return inside

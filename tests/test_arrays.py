@@ -19,9 +19,9 @@ def test_points_in_a_convex_polygon_are_those_inside_every_edge():
 
 
 def test_points_in_a_star_shaped_polygon_follow_its_radius():
-    """A finely sampled lobed outline r(φ) = 10 + 3 sin 7φ (both orientations, small chunks):
+    """A finely sampled lobed outline r(φ) = 10 + 3 sin 7φ (both orientations):
     points well inside or outside (1 % away from the outline's radius at their angle) are
-    classified by comparing their radius with it."""
+    classified by comparing their radius with it; also with a single band."""
     phi = np.linspace(0.0, 2.0 * np.pi, 4000, endpoint=False)
     r = 10.0 + 3.0 * np.sin(7.0 * phi)
     outline = np.c_[r * np.cos(phi), r * np.sin(phi)]
@@ -30,7 +30,8 @@ def test_points_in_a_star_shaped_polygon_follow_its_radius():
     at = 10.0 + 3.0 * np.sin(7.0 * np.arctan2(pts[:, 1], pts[:, 0]))
     clear = np.abs(rad / at - 1.0) > 0.01
     for poly in (outline, outline[::-1]):
-        inside = points_in_polygon(pts, poly, chunk=1 << 16)
+        inside = points_in_polygon(pts, poly)
+        assert np.array_equal(points_in_polygon(pts, poly, bins=1), inside)
         assert np.array_equal(inside[clear], (rad < at)[clear])
 
 
