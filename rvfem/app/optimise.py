@@ -135,6 +135,25 @@ class OptParameter:
 
 
 @dataclass(frozen=True)
+class Screening:
+    """Screening on a coarse mesh (the ``[screening]`` table; module docstring, "Screening").
+
+    Attributes
+    ----------
+    mesh_scale : float
+        Every element size of the base case's ``[mesh]`` table (``size_flank``, ``size_bore``,
+        ``size_interior`` and ``size_hole``/``size_fillet`` where set) times this for the coarse
+        designs (> 1).
+    band_factor : float
+        The coarse–fine error band of a response is this times the largest coarse–fine difference
+        of that response over every design evaluated on both meshes (≥ 1).
+    """
+
+    mesh_scale: float = 2.0
+    band_factor: float = 2.0
+
+
+@dataclass(frozen=True)
 class Problem:
     """A validated optimisation file (module docstring)."""
 
@@ -150,15 +169,18 @@ class Problem:
     trials: int
     seed: int
     batch: int | None = None
+    screening: Screening | None = None
 
 
 @dataclass(frozen=True)
 class DesignTask:
-    """What a worker needs for one design: the parameters and, for a case, its variant task."""
+    """What a worker needs for one design: the parameters, for a case its variant task, and the
+    fidelity (``"fine"``, or ``"coarse"`` when screening)."""
 
     trial_id: str
     params: tuple[tuple[str, float], ...]
     variant: VariantTask | None = None
+    fidelity: str = "fine"
 
 
 @dataclass(frozen=True)
@@ -217,7 +239,20 @@ def _read_budgets(where: str, raw: Any) -> tuple[tuple[str, float], ...]:
 
 
 _TOP_KEYS = {"name", "description", "problem", "base_case", "objective", "trials", "seed", "batch", "overrides",
-             "parameter", "budget"}
+             "parameter", "budget", "screening"}
+
+
+def _read_screening(where: str, raw: Any) -> Screening | None:
+    if raw is None:
+        return None
+    if not isinstance(raw, dict) or set(raw) - {"mesh_scale", "band_factor"}:
+        raise _fail(where, "screening", "expected a table of mesh_scale (> 1) and band_factor (≥ 1)")
+    out = Screening(**{k: _number(where, f"screening.{k}", v) for k, v in raw.items()})
+    if not out.mesh_scale > 1.0:
+        raise _fail(where, "screening.mesh_scale", f"must exceed 1 (the coarse mesh's sizes / the case's), got {out.mesh_scale:g}")
+    if not out.band_factor >= 1.0:
+        raise _fail(where, "screening.band_factor", f"must be at least 1, got {out.band_factor:g}")
+    return out
 
 
 def load_problem(path: str | os.PathLike, extra_overrides: Sequence[str] = (), trials: int | None = None) -> Problem:
@@ -260,20 +295,36 @@ def load_problem(path: str | os.PathLike, extra_overrides: Sequence[str] = (), t
                       path=path.resolve(), kind=kind, base_case=base, overrides=overrides, objective=objective,
                       parameters=_read_parameters(where, data.get("parameter")),
                       budgets=_read_budgets(where, data.get("budget", {})), trials=max(1, n),
-                      seed=int(data.get("seed", 0)), batch=None if data.get("batch") is None else int(data["batch"]))
+                      seed=int(data.get("seed", 0)), batch=None if data.get("batch") is None else int(data["batch"]),
+                      screening=_read_screening(where, data.get("screening")))
     if base is not None:
         middle = tuple((p.key, 0.5 * (p.low + p.high)) for p in problem.parameters)
         _load_design(problem, middle)
     return problem
 
 
-def _design_overrides(problem: Problem, params: Sequence[tuple[str, float]]) -> tuple[str, ...]:
-    return problem.overrides + tuple(f"{k}={toml_literal(float(v))}" for k, v in params)
+def _design_overrides(problem: Problem, params: Sequence[tuple[str, float]], fidelity: str = "fine") -> tuple[str, ...]:
+    coarse = _coarse_overrides(problem) if fidelity == "coarse" else ()
+    return problem.overrides + tuple(f"{k}={toml_literal(float(v))}" for k, v in params) + coarse
 
 
-def _load_design(problem: Problem, params: Sequence[tuple[str, float]]):
+def _load_design(problem: Problem, params: Sequence[tuple[str, float]], fidelity: str = "fine"):
     assert problem.base_case is not None   # a case problem has its base case (load_problem)
-    return load_case(problem.base_case, _design_overrides(problem, params))
+    return load_case(problem.base_case, _design_overrides(problem, params, fidelity))
+
+
+MESH_SIZE_KEYS = ("size_flank", "size_bore", "size_interior", "size_hole", "size_fillet")
+"""The ``[mesh]`` sizes a coarse design scales (those left at None follow the others)."""
+
+
+def _coarse_overrides(problem: Problem) -> tuple[str, ...]:
+    """The overrides of the coarse mesh: every size of the base case's mesh times the screening's
+    ``mesh_scale`` (none without screening)."""
+    if problem.screening is None or problem.base_case is None:
+        return ()
+    mesh = load_case(problem.base_case, problem.overrides).mesh
+    return tuple(f"mesh.{k}={toml_literal(getattr(mesh, k) * problem.screening.mesh_scale)}"
+                 for k in MESH_SIZE_KEYS if getattr(mesh, k) is not None)
 
 
 # --------------------------------------------------------------------------------------------
@@ -281,11 +332,24 @@ def _load_design(problem: Problem, params: Sequence[tuple[str, float]]):
 # --------------------------------------------------------------------------------------------
 
 
-def analytic_responses(params: dict[str, float]) -> dict[str, float]:
+ANALYTIC_COARSE_ERROR = 0.05
+"""Amplitude of the stand-in for a coarse mesh's error of the analytic problem (its ``coarse``
+fidelity): f and g each off by at most this."""
+
+
+def analytic_responses(params: dict[str, float], fidelity: str = "fine") -> dict[str, float]:
     """The analytic check problem: minimise f = (x − 1)² + (y − 2)² subject to g = x + y ≤ 2.
-    Known optimum: the projection of (1, 2) onto the line x + y = 2, (0.5, 1.5), f* = 0.5."""
+    Known optimum: the projection of (1, 2) onto the line x + y = 2, (0.5, 1.5), f* = 0.5.
+
+    At fidelity ``"coarse"`` (screening) f and g carry a smooth error of amplitude
+    :data:`ANALYTIC_COARSE_ERROR` (ε·sin(7x + 3y) and ε·cos(5x − 2y)): the stand-in for a coarse
+    mesh, with which the screening's front is checked against the fine one."""
     x, y = float(params["x"]), float(params["y"])
-    return {"objective": (x - 1.0) ** 2 + (y - 2.0) ** 2, "g": x + y}
+    f, g = (x - 1.0) ** 2 + (y - 2.0) ** 2, x + y
+    if fidelity == "coarse":
+        f += ANALYTIC_COARSE_ERROR * math.sin(7.0 * x + 3.0 * y)
+        g += ANALYTIC_COARSE_ERROR * math.cos(5.0 * x - 2.0 * y)
+    return {"objective": f, "g": g}
 
 
 def design_responses(summary: dict) -> dict[str, float | None]:
@@ -316,12 +380,13 @@ def evaluate_design(task: DesignTask) -> dict:
     with ``status`` ``"failed"`` or ``"error"`` and its message."""
     started = time.perf_counter()
     if task.variant is None:
-        record: dict[str, Any] = {"status": "ok", "error": "", "computed": True, "responses": analytic_responses(dict(task.params))}
+        record: dict[str, Any] = {"status": "ok", "error": "", "computed": True,
+                                  "responses": analytic_responses(dict(task.params), task.fidelity)}
     else:
         record = run_variant(task.variant)
         summary = record.pop("summary", None)
         record["responses"] = design_responses(summary) if summary else {}
-    record.update(id=task.trial_id, wall_time_s=time.perf_counter() - started)
+    record.update(id=task.trial_id, wall_time_s=time.perf_counter() - started, fidelity=task.fidelity)
     return record
 
 
@@ -360,7 +425,7 @@ def _row(problem: Problem, number: int, params: Sequence[tuple[str, float]], rec
     row.update({k: float(v) for k, v in params})
     row.update({k: responses.get(k) for k in _response_keys(problem)})
     row.update(error=record.get("error", ""), computed=bool(record.get("computed", False)),
-               wall_time_s=record.get("wall_time_s"), digest=digest)
+               wall_time_s=record.get("wall_time_s"), digest=digest, fidelity=record.get("fidelity", "fine"))
     return row
 
 
@@ -373,7 +438,7 @@ def _response_keys(problem: Problem) -> tuple[str, ...]:
 
 def _columns(problem: Problem) -> list[str]:
     return (["number", "id", "status", "feasible", "objective", "violation"] + [p.key for p in problem.parameters]
-            + list(_response_keys(problem)) + ["error", "computed", "wall_time_s", "digest"])
+            + list(_response_keys(problem)) + ["error", "computed", "wall_time_s", "digest", "fidelity"])
 
 
 def _csv_text(problem: Problem, rows: Sequence[dict]) -> str:
@@ -402,6 +467,7 @@ def read_trials(path: str | os.PathLike) -> list[dict]:
     for r in rows:
         for k in ("id", "status", "error", "digest"):
             r[k] = "" if r.get(k) is None else str(r[k])
+        r["fidelity"] = str(r.get("fidelity") or "fine")
     return rows
 
 
@@ -416,12 +482,12 @@ def _key(params: Sequence[tuple[str, float]]) -> str:
 
 
 def _earlier(problem: Problem, rows: Sequence[dict]) -> dict[str, dict]:
-    """Designs of an earlier run by parameters (ok or rejected, not interrupted ones)."""
+    """Designs of an earlier run by fidelity and parameters (ok or rejected, not interrupted ones)."""
     out = {}
     for r in rows:
         if r.get("status") not in ("ok", "failed") or any(r.get(p.key) is None for p in problem.parameters):
             continue
-        out[_key([(p.key, r[p.key]) for p in problem.parameters])] = r
+        out[r.get("fidelity", "fine") + _key([(p.key, r[p.key]) for p in problem.parameters])] = r
     return out
 
 
@@ -464,34 +530,41 @@ def _dask_client(scheduler: str | None, workers: int | None, client, connect_tim
             cluster.close()
 
 
-def _task(problem: Problem, trial_id: str, params: tuple, trials_dir: Path, cache: Path) -> tuple[DesignTask | None, str, dict | None]:
+def _trial_folder(trials_dir: Path, trial_id: str, fidelity: str) -> Path:
+    """``trials/<id>/``, or ``trials/<id>-coarse/`` for a design screened on the coarse mesh."""
+    return trials_dir / (trial_id if fidelity == "fine" else f"{trial_id}-{fidelity}")
+
+
+def _task(problem: Problem, trial_id: str, params: tuple, trials_dir: Path, cache: Path, fidelity: str = "fine",
+          design_only: bool = True) -> tuple[DesignTask | None, str, dict | None]:
     """(task, case digest, record of a design the case validation rejects)."""
     if problem.kind == "analytic":
-        return DesignTask(trial_id, params), "", None
+        return DesignTask(trial_id, params, fidelity=fidelity), "", None
     try:
-        case = _load_design(problem, params)
+        case = _load_design(problem, params, fidelity)
     except RvfemError as exc:
         return None, "", {"id": trial_id, "status": "failed", "error": _one_line(f"{type(exc).__name__}: {exc}"),
-                          "computed": True, "responses": {}, "wall_time_s": 0.0}
+                          "computed": True, "responses": {}, "wall_time_s": 0.0, "rejected": True,
+                          "fidelity": fidelity}
     digest = case.digest()
-    variant = VariantTask(trial_id, str(problem.base_case), _design_overrides(problem, params), digest,
-                          str(trials_dir / trial_id), str(cache))
-    return DesignTask(trial_id, params, variant), digest, None
+    variant = VariantTask(trial_id, str(problem.base_case), _design_overrides(problem, params, fidelity), digest,
+                          str(_trial_folder(trials_dir, trial_id, fidelity)), str(cache), design_only=design_only)
+    return DesignTask(trial_id, params, variant, fidelity), digest, None
 
 
 def _run_batch(problem: Problem, client, batch: Sequence[tuple[str, tuple]], earlier: dict, trials_dir: Path,
-               cache: Path) -> list[tuple[dict, str]]:
+               cache: Path, fidelity: str = "fine", design_only: bool = True) -> list[tuple[dict, str]]:
     """(record, digest) of every design of a batch, in order: taken from an earlier run where
-    its parameters and case digest match, else run on the client."""
+    its parameters, fidelity and case digest match, else run on the client."""
     out: list = [None] * len(batch)
     futures = {}
     for i, (trial_id, params) in enumerate(batch):
-        task, digest, rejected = _task(problem, trial_id, params, trials_dir, cache)
-        old = earlier.get(_key(params))
+        task, digest, rejected = _task(problem, trial_id, params, trials_dir, cache, fidelity, design_only)
+        old = earlier.get(fidelity + _key(params))
         if old is not None and (old.get("digest") or "") == digest:
             responses = {k: old.get(k) for k in (*_response_keys(problem), problem.objective)}
             out[i] = ({"id": trial_id, "status": old["status"], "error": old.get("error", ""), "computed": False,
-                       "responses": responses if old["status"] == "ok" else {},
+                       "responses": responses if old["status"] == "ok" else {}, "fidelity": fidelity,
                        "wall_time_s": old.get("wall_time_s")}, digest)
         elif rejected is not None:
             out[i] = (rejected, digest)
@@ -504,6 +577,7 @@ def _run_batch(problem: Problem, client, batch: Sequence[tuple[str, tuple]], ear
         except Exception as exc:   # the task itself raised (a worker lost): recorded, never fatal
             out[i] = ({"id": batch[i][0], "status": "failed", "computed": True, "responses": {},
                        "error": _one_line(f"{type(exc).__name__}: {exc}"), "wall_time_s": float("nan")}, digest)
+        out[i][0]["fidelity"] = fidelity
     return out
 
 
@@ -546,8 +620,11 @@ def _tell_constraints(problem: Problem, trial, violations: Sequence[float]) -> N
 
 
 def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, fallback: float,
-          progress: ProgressCallback | None, head: Sequence[dict] = ()) -> list[dict]:
-    """Ask a batch, run it, tell it in order; ``trials.csv`` after every batch."""
+          progress: ProgressCallback | None, head: Sequence[dict] = (), design_only: bool = True) -> list[dict]:
+    """Ask a batch, run it (on the coarse mesh when screening), tell it in order; ``trials.csv``
+    (``screening.csv`` when screening) after every batch."""
+    fidelity = "coarse" if problem.screening is not None else "fine"
+    table = out_dir / ("screening.csv" if fidelity == "coarse" else "trials.csv")
     study = _sampler(problem)
     rows: list[dict] = []
     batch = problem.batch or max(1, len(client.scheduler_info().get("workers", {})) or 1)
@@ -556,7 +633,7 @@ def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, f
         params = [tuple((p.key, _tidy(t.suggest_float(p.key, p.low, p.high, step=p.step), p)) for p in problem.parameters)
                   for t in trials]
         done = _run_batch(problem, client, [(f"t{t.number:03d}", prm) for t, prm in zip(trials, params)], earlier,
-                          out_dir / "trials", cache)
+                          out_dir / "trials", cache, fidelity, design_only)
         for t, prm, (record, digest) in zip(trials, params, done):
             row = _row(problem, t.number, prm, record, digest)
             _tell_constraints(problem, t, _violations(problem, record.get("responses") or {})
@@ -565,31 +642,168 @@ def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, f
             rows.append(row)
             if progress is not None:
                 progress(len(rows), problem.trials, row)
-        write_text_atomic(out_dir / "trials.csv", _csv_text(problem, [*head, *rows]))
+        write_text_atomic(table, _csv_text(problem, [*head, *rows]))
     return rows
 
 
-def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows: Sequence[dict]) -> dict | None:
+def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows: Sequence[dict],
+              fidelity: str = "fine", design_only: bool = True) -> dict | None:
     """The base case itself (``trials/base``), the reference of the report and the value told
-    for failed designs; None for an analytic problem."""
+    for failed designs (on the coarse mesh, ``trials/base-coarse``, the first coarse–fine pair of
+    a screening); None for an analytic problem."""
     if problem.kind == "analytic":
         return None
     assert problem.base_case is not None   # not analytic, checked just above
-    case = load_case(problem.base_case, problem.overrides)
+    overrides = _design_overrides(problem, (), fidelity)
+    case = load_case(problem.base_case, overrides)
     old = next((r for r in earlier_rows if r.get("id") == "base" and r.get("digest") == case.digest()
                 and r.get("status") == "ok"), None)
     if old is not None:
         return {**old, "computed": False}
-    task = DesignTask("base", (), VariantTask("base", str(problem.base_case), problem.overrides, case.digest(),
-                                              str(out_dir / "trials" / "base"), str(cache)))
+    task = DesignTask("base", (), VariantTask("base", str(problem.base_case), overrides, case.digest(),
+                                              str(_trial_folder(out_dir / "trials", "base", fidelity)), str(cache),
+                                              design_only=design_only), fidelity)
     record = client.submit(evaluate_design, task, key=f"rvfem-design-base-{os.urandom(4).hex()}", pure=False).result()
     return _row(problem, -1, (), record, case.digest())
+
+
+# --------------------------------------------------------------------------------------------
+# Screening: the coarse designs whose results could change the front or the best, on the fine mesh
+# --------------------------------------------------------------------------------------------
+
+
+FRONT_AXES = {"case": ("disc_mass_kg", "life_ratio"), "analytic": ("objective", "g")}
+"""The Pareto front's axes by problem kind: (smaller is better, larger is better)."""
+
+
+def _screened_keys(problem: Problem) -> tuple[str, ...]:
+    """The responses the reported results depend on: the objective, the front's axes and every
+    budget's response."""
+    keys = [problem.objective, *FRONT_AXES[problem.kind], *(BUDGETS[name][0] for name, _ in problem.budgets)]
+    return tuple(dict.fromkeys(keys))
+
+
+def _value(row: dict, key: str) -> float | None:
+    v = row.get(key)
+    return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
+
+
+def error_bands(problem: Problem, pairs: Sequence[tuple[dict, dict]]) -> dict[str, float]:
+    """The coarse–fine error band of every screened response: ``band_factor`` times the largest
+    |coarse − fine| over the designs evaluated on both meshes (``pairs`` of rows; 0 without one)."""
+    assert problem.screening is not None
+    out = {}
+    for key in _screened_keys(problem):
+        diffs = [abs(c - f) for c, f in ((_value(a, key), _value(b, key)) for a, b in pairs)
+                 if c is not None and f is not None]
+        out[key] = problem.screening.band_factor * max(diffs, default=0.0)
+    return out
+
+
+def _interval(row: dict, key: str, bands: dict[str, float]) -> tuple[float, float]:
+    """Where the fine value of ``key`` can be: the value itself for a fine row, the coarse value ±
+    its band for a coarse one, anywhere when the coarse run gave none."""
+    v = _value(row, key)
+    if v is None:
+        return (-math.inf, math.inf) if row.get("fidelity") == "coarse" else (math.nan, math.nan)
+    band = bands.get(key, 0.0) if row.get("fidelity") == "coarse" else 0.0
+    return v - band, v + band
+
+
+def to_confirm(problem: Problem, rows: Sequence[dict], bands: dict[str, float]) -> list[dict]:
+    """The coarse rows whose fine result could change the reported front or best design.
+
+    A coarse row is kept on the coarse mesh only if, wherever in its band the fine values lie,
+    it is neither the best feasible design nor on the Pareto front: it is surely infeasible
+    (a budget broken even at the favourable end of the band) or some other design surely beats
+    it (a surely feasible design with a smaller objective at the unfavourable ends of both
+    bands; for the front, a design better in both axes at the unfavourable ends). Every other
+    coarse row is returned. A coarse run that failed after the case validation is returned too
+    (the fine mesh may succeed); one the validation rejected is the same on both meshes.
+
+    When every fine value lies within its band, the front and the best design of the rows with
+    every returned row replaced by its fine result are those of all rows evaluated on the fine
+    mesh: every row left coarse is dominated (or beaten, or infeasible) in both.
+    """
+    x, y = FRONT_AXES[problem.kind]
+
+    def ok(r: dict) -> bool:
+        return r.get("status") == "ok"
+
+    def possibly_feasible(r: dict) -> bool:
+        for name, limit in problem.budgets:
+            key, sense = BUDGETS[name]
+            lo, hi = _interval(r, key, bands)
+            if math.isnan(lo) or (lo > limit if sense == "max" else hi < limit):
+                return False
+        return True
+
+    def surely_feasible(r: dict) -> bool:
+        for name, limit in problem.budgets:
+            key, sense = BUDGETS[name]
+            lo, hi = _interval(r, key, bands)
+            if math.isnan(lo) or not (hi <= limit if sense == "max" else lo >= limit):
+                return False
+        return True
+
+    good = [r for r in rows if ok(r)]
+    bound = min((_interval(r, problem.objective, bands)[1] for r in good if surely_feasible(r)), default=math.inf)
+    boxes = {id(r): (_interval(r, x, bands), _interval(r, y, bands)) for r in good}
+
+    def beaten_on_front(r: dict) -> bool:
+        (xlo, _), (_, yhi) = boxes[id(r)]
+        for s in good:
+            if s is r:
+                continue
+            (_, sxhi), (sylo, _) = boxes[id(s)]
+            if sxhi <= xlo and sylo >= yhi and (sxhi < xlo or sylo > yhi):
+                return True
+        return False
+
+    out = []
+    for r in rows:
+        if r.get("fidelity") != "coarse":
+            continue
+        if not ok(r):
+            if r.get("digest"):   # failed after the validation (which gives no digest): try the fine mesh
+                out.append(r)
+            continue
+        best = possibly_feasible(r) and _interval(r, problem.objective, bands)[0] <= bound
+        if best or not beaten_on_front(r):
+            out.append(r)
+    return out
+
+
+def _confirm(problem: Problem, client, out_dir: Path, cache: Path, rows: list[dict], pairs: list[tuple[dict, dict]],
+             earlier: dict, design_only: bool) -> tuple[list[dict], dict[str, float], int]:
+    """Re-evaluate on the fine mesh every coarse row :func:`to_confirm` returns, widen the bands
+    with the new coarse–fine pairs and repeat until no coarse row is left to confirm. Returns the
+    rows (confirmed ones replaced by their fine result), the final bands and how many rows were
+    confirmed."""
+    confirmed = 0
+    while True:
+        bands = error_bands(problem, pairs)
+        todo = to_confirm(problem, rows, bands)
+        if not todo:
+            return rows, bands, confirmed
+        log.info("%s: %d designs within the coarse-fine band of the front or the best, on the fine mesh",
+                 problem.name, len(todo))
+        params = [tuple((p.key, r[p.key]) for p in problem.parameters) for r in todo]
+        done = _run_batch(problem, client, [(r["id"], prm) for r, prm in zip(todo, params)], earlier,
+                          out_dir / "trials", cache, "fine", design_only)
+        index = {id(r): i for i, r in enumerate(rows)}
+        for coarse, prm, (record, digest) in zip(todo, params, done):
+            fine = _row(problem, int(coarse["number"]), prm, record, digest)
+            if coarse.get("status") == "ok" and fine["status"] == "ok":
+                pairs.append((coarse, fine))
+            rows[index[id(coarse)]] = fine
+            confirmed += 1
 
 
 def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.PathLike, *,
                      scheduler: str | None = None, workers: int | None = None, client=None,
                      cache_dir: str | os.PathLike = "meshes", progress: ProgressCallback | None = None,
-                     plots: bool = True) -> OptimisationResult:
+                     plots: bool = True, design_only: bool = True) -> OptimisationResult:
     """Run an optimisation (module docstring) and write its folder.
 
     Parameters
@@ -599,6 +813,10 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
         Folder; a rerun into it resumes (designs already in ``trials.csv`` are not run again).
     scheduler, workers, client, cache_dir, progress, plots
         As :func:`rvfem.app.study.run_study`.
+    design_only : bool
+        Each design computes and writes only what its responses read
+        (:func:`rvfem.app.design.run_design`; the same responses); False runs every design as a
+        full ``rvfem run`` (every result, table and plot in ``trials/<id>/``, several times the cost).
 
     Raises
     ------
@@ -616,16 +834,36 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
         lock = _acquire_lock(out_dir)
         try:
             _remove_partials(out_dir / "trials")
-            earlier_rows = read_trials(out_dir / "trials.csv")
+            earlier_rows = read_trials(out_dir / "trials.csv") + read_trials(out_dir / "screening.csv")
+            earlier = _earlier(problem, earlier_rows)
+            screening = None
             with _dask_client(scheduler, workers, client) as c:
-                base = _base_row(problem, c, out_dir, cache, earlier_rows)
+                base = _base_row(problem, c, out_dir, cache, earlier_rows, design_only=design_only)
                 fallback = base["objective"] if base and base.get("objective") is not None else 0.0
-                rows = _loop(problem, c, out_dir, cache, _earlier(problem, earlier_rows), fallback, progress,
-                             head=[base] if base else [])
+                pairs: list[tuple[dict, dict]] = []
+                coarse_head = []
+                if problem.screening is not None and base is not None:
+                    coarse_base = _base_row(problem, c, out_dir, cache, earlier_rows, "coarse", design_only)
+                    assert coarse_base is not None   # a case problem
+                    coarse_head = [coarse_base]
+                    if coarse_base["status"] == "ok" and base["status"] == "ok":
+                        pairs.append((coarse_base, base))
+                rows = _loop(problem, c, out_dir, cache, earlier, fallback, progress,
+                             head=coarse_head if problem.screening is not None else [base] if base else [],
+                             design_only=design_only)
+                if problem.screening is not None:
+                    screened = list(rows)
+                    rows, bands, confirmed = _confirm(problem, c, out_dir, cache, list(rows), pairs, earlier,
+                                                      design_only)
+                    screening = {"mesh_scale": problem.screening.mesh_scale,
+                                 "band_factor": problem.screening.band_factor, "bands": bands,
+                                 "pairs": len(pairs), "confirmed_on_fine_mesh": confirmed,
+                                 "coarse_designs": sum(1 for r in screened if r.get("status") == "ok")}
             all_rows = ([base] if base else []) + rows
             write_text_atomic(out_dir / "trials.csv", _csv_text(problem, all_rows))
             best = min((r for r in rows if r["feasible"]), key=lambda r: r["objective"], default=None)
-            files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started)
+            files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started,
+                                   screening)
         finally:
             lock.unlink(missing_ok=True)
     return OptimisationResult(out_dir=out_dir, problem=problem, rows=tuple(rows), best=best, files=files,
@@ -732,7 +970,7 @@ def _report(problem: Problem, rows: Sequence[dict], base: dict | None, best: dic
 
 
 def _write_outputs(problem: Problem, out_dir: Path, rows: list[dict], base: dict | None, best: dict | None,
-                   plots: bool, wall_s: float) -> dict:
+                   plots: bool, wall_s: float, screening: dict | None = None) -> dict:
     files = {"csv": out_dir / "trials.csv"}
     if best is not None and problem.kind == "case":
         params = tuple((p.key, best[p.key]) for p in problem.parameters)
@@ -749,7 +987,8 @@ def _write_outputs(problem: Problem, out_dir: Path, rows: list[dict], base: dict
     doc = {"name": problem.name, "objective": problem.objective, "seed": problem.seed, "trials": problem.trials,
            "parameters": [vars(p) for p in problem.parameters], "budgets": dict(problem.budgets),
            "overrides": list(problem.overrides), "base": base, "best": best,
-           "designs": len(rows), "feasible": sum(1 for r in rows if r["feasible"]), "wall_time_s": wall_s}
+           "designs": len(rows), "feasible": sum(1 for r in rows if r["feasible"]), "wall_time_s": wall_s,
+           "screening": screening}
     write_text_atomic(files["json"], json.dumps(doc, indent=2, default=str) + "\n")
     files["report"] = out_dir / "report.html"
     write_text_atomic(files["report"], _report(problem, rows, base, best, png, wall_s))
