@@ -26,6 +26,30 @@ budgets::
     fatigue_safety_factor = 1.5                 # at least
     static_safety_factor = 2.0                  # at least
 
+    [screening]                                 # optional: screen on a coarse mesh (below)
+    mesh_scale = 2.0                            # the coarse mesh: every [mesh] size × this
+    band_factor = 2.0                           # the error band: this × the largest coarse–fine difference
+
+Each design is a design-only analysis (:func:`rvfem.app.design.run_design`): the mesh, the load
+cycle, the P2 structural peak and the mass and strength at the case's own fidelity, without the
+sections and files no response reads (attribution, crank bearing in depth, accuracy, Hertz and
+pin-flank checks, tables, VTK, plots); the responses are those of a full ``rvfem run``.
+
+**Screening.** With a ``[screening]`` table every design runs on the coarse mesh (the sampler is
+told the coarse results); the base case runs on both meshes. Then every coarse design whose fine
+result could change what is reported — the best feasible design or the Pareto front of the report
+(mass against life ratio; objective against g for the analytic problem) — is re-evaluated on the
+fine mesh (:func:`to_confirm`): each screened response's fine value is taken to lie within
+``band_factor`` × the largest coarse–fine difference of that response over every design run on
+both meshes (:func:`error_bands`); a coarse design stays coarse only if, anywhere in those bands,
+it is surely infeasible, or surely beaten by a surely feasible design, and surely dominated on
+the front. Each confirmation adds a coarse–fine pair, the bands are recomputed and the test is
+repeated until no coarse design is left to confirm. The reported front and best design are then
+fine-mesh results, and they are those of evaluating every design on the fine mesh whenever the
+coarse errors lie within the bands (``tests/app/test_optimise.py`` checks this against the fine
+evaluation of every design). ``trials.csv`` says per design which mesh its row comes from
+(``fidelity``), ``screening.csv`` holds every coarse result and ``optimisation.json`` the bands.
+
 The responses of a design come from its ``summary.json`` (:func:`design_responses`): the
 objective keys, the safety factors and, per bearing, the deltas of the flexible loads against the
 case's rigid reference (``bearings[].delta_max_percent``, ``bearings[].life_ratio``; the
@@ -44,7 +68,7 @@ stopped, and a finished optimisation with more ``trials`` goes on from its end.
 
 Outputs in DIR: ``trials.csv`` (one row per design: parameters, responses, feasibility, status),
 ``best.toml`` (the best feasible design as a complete case file), ``trials/<id>/`` (every design's
-result folder), ``pareto.png`` (mass against life ratio coloured by the fatigue safety factor, the
+result folder: ``summary.json`` and ``case.json``; ``trials/<id>-coarse/`` when screened), ``pareto.png`` (mass against life ratio coloured by the fatigue safety factor, the
 feasible Pareto front drawn), ``optimisation.json`` and ``report.html``.
 
 ``analytic`` problems (``problem = "analytic"``, no base case) evaluate :func:`analytic_responses`
