@@ -318,8 +318,7 @@ def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None
         leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`):
         :func:`rvfem.app.run.run_case` computes it while the output files are drawn.
     sections : tuple of str, optional
-        Compute only these result sections and those they require (:func:`selected_sections`);
-        the others stay None. Default: every section.
+        Only these result sections and those they require (:func:`selected_sections`; default all).
     on_model : callable, optional
         ``on_model(system)`` with the disc's :class:`rvfem.solve.cycle.DiscSystem` once it is built,
         before the load cycle (:func:`rvfem.app.run.run_case` has the mesh picture drawn meanwhile).
@@ -339,7 +338,6 @@ def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None
     except TypeError as exc:
         raise TypeError(f"analyse(): {exc}; the choices are the fields of AnalysisOptions "
                         f"({', '.join(f.name for f in dataclasses.fields(AnalysisOptions))})") from None
-    selected_sections(options.sections)   # an unknown section name is said before any work
     stages = Stages(progress)
     checked = _checked_case(case, provenance, stages, overrides, options)
     case = checked.case
@@ -383,7 +381,9 @@ class _CheckedCase:
 def _checked_case(case: Case | str | os.PathLike[str], provenance: CaseProvenance | None, stages: Stages,
                   overrides: tuple[str, ...], options: AnalysisOptions) -> _CheckedCase:
     """The ``check`` stage of :func:`analyse`: the case resolved with its options and its angles
-    checked; without the stage when ``provenance`` is given (``case`` is then resolved already)."""
+    checked; without the stage when ``provenance`` is given (``case`` is then resolved already).
+    An unknown result section among the options is said here, before any work."""
+    selected_sections(options.sections)
     if provenance is None:
         t = stages.start("check")
         case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=options.angle_step_deg,
