@@ -31,7 +31,7 @@ import logging
 import math
 import os
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
@@ -319,6 +319,8 @@ def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None
         Compute the attribution (:func:`rvfem.evaluate.attribution.attribution`, stage ``attribution``). False
         leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`):
         :func:`rvfem.app.run.run_case` computes it while the output files are drawn.
+    sections : tuple of str, optional
+        Only these result sections and those they require (:func:`selected_sections`; default all).
     on_model : callable, optional
         ``on_model(system)`` with the disc's :class:`rvfem.solve.cycle.DiscSystem` once it is built,
         before the load cycle (:func:`rvfem.app.run.run_case` has the mesh picture drawn meanwhile).
@@ -381,7 +383,9 @@ class _CheckedCase:
 def _checked_case(case: Case | str | os.PathLike[str], provenance: CaseProvenance | None, stages: Stages,
                   overrides: tuple[str, ...], options: AnalysisOptions) -> _CheckedCase:
     """The ``check`` stage of :func:`analyse`: the case resolved with its options and its angles
-    checked; without the stage when ``provenance`` is given (``case`` is then resolved already)."""
+    checked; without the stage when ``provenance`` is given (``case`` is then resolved already).
+    An unknown result section among the options is said here, before any work."""
+    selected_sections(options.sections)
     if provenance is None:
         t = stages.start("check")
         case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=options.angle_step_deg,
@@ -479,7 +483,8 @@ def _analyse_from_model(case: Case, provenance: CaseProvenance, stages: Stages, 
                    lambda system_, cycle_, mesh_, band, away: recover_structural_peak(system_, cycle_, mesh_, band, away, p2)),
         }
         stages.end("evaluation", t)
-        computed, seconds = _compute_sections(available, stages, background, release={"stress": p2})
+        computed, seconds = _compute_sections(available, stages, background, release={"stress": p2},
+                                              only=options.sections)
     finally:
         if p2 is not None:          # the P2 model (a few hundred MB) is not needed any more
             p2.close()
@@ -525,8 +530,36 @@ def _stage_rank(stage: str | None) -> int:
     return order.index(stage) if stage in order else len(order)
 
 
+def selected_sections(only: Sequence[str] | None) -> tuple[Section, ...]:
+    """The result sections an analysis computes: every one for None, else those named in ``only``
+    and, recursively, the sections they require (by name), in the registry's order.
+
+    Raises
+    ------
+    CaseError
+        A name that is no result section (the message lists the known ones).
+    """
+    every = sections_registry.sections()
+    if only is None:
+        return every
+    by_name = {s.name: s for s in every}
+    unknown = [name for name in only if name not in by_name]
+    if unknown:
+        raise CaseError(f"no result section {unknown[0]!r}; known: {', '.join(by_name)}")
+    wanted: set[str] = set()
+    todo = list(only)
+    while todo:
+        name = todo.pop()
+        if name in wanted:
+            continue
+        wanted.add(name)
+        todo += [r for r in by_name[name].requires if r in by_name]
+    return tuple(s for s in every if s.name in wanted)
+
+
 def _compute_sections(available: dict[str, Any], stages: Stages, background: ThreadPoolExecutor,
-                      release: Mapping[str, Any] = MappingProxyType({})) -> tuple[dict[str, Any], dict[str, float]]:
+                      release: Mapping[str, Any] = MappingProxyType({}),
+                      only: Sequence[str] | None = None) -> tuple[dict[str, Any], dict[str, float]]:
     """Compute every result section that has a ``compute`` (:func:`rvfem.results.registry.sections`).
 
     The order: by their stage among :data:`STAGES` (the order the user sees), those without a stage
@@ -534,11 +567,14 @@ def _compute_sections(available: dict[str, Any], stages: Stages, background: Thr
     sections' order. A ``thread`` section starts on ``background`` as soon as the front is done and
     is waited for (its stage) at its turn. ``release[name].close()`` is called once section
     ``name`` is done (the P2 model after the stress). Returns the results by section name and the
-    wall time of the thread sections' own work (s), by name.
+    wall time of the thread sections' own work (s), by name. With ``only``, just the sections of
+    :func:`selected_sections` (the others are left out of the results: None in the analysis).
     """
-    chosen = [s for s in sections_registry.sections() if s.compute is not None]
+    chosen = [s for s in selected_sections(only) if s.compute is not None]
     order = sorted(chosen, key=lambda s: ("analysis" in s.requires, _stage_rank(s.stage)))
-    results: dict[str, Any] = {}
+    # the sections left out are None, as those that do not apply
+    results: dict[str, Any] = {s.name: None for s in sections_registry.sections()
+                               if s.compute is not None and s not in chosen}
     seconds: dict[str, float] = {}
 
     def inputs(section: Section, progress: Callable[[int, int], None] | None = None) -> dict[str, Any]:

@@ -26,6 +26,30 @@ budgets::
     fatigue_safety_factor = 1.5                 # at least
     static_safety_factor = 2.0                  # at least
 
+    [screening]                                 # optional: screen on a coarse mesh (below)
+    mesh_scale = 2.0                            # the coarse mesh: every [mesh] size × this
+    band_factor = 2.0                           # the error band: this × the largest coarse–fine difference
+
+Each design is a design-only analysis (:func:`rvfem.app.design.run_design`): the mesh, the load
+cycle, the P2 structural peak and the mass and strength at the case's own fidelity, without the
+sections and files no response reads (attribution, crank bearing in depth, accuracy, Hertz and
+pin-flank checks, tables, VTK, plots); the responses are those of a full ``rvfem run``.
+
+**Screening.** With a ``[screening]`` table every design runs on the coarse mesh (the sampler is
+told the coarse results); the base case runs on both meshes. Then every coarse design whose fine
+result could change what is reported — the best feasible design or the Pareto front of the report
+(mass against life ratio; objective against g for the analytic problem) — is re-evaluated on the
+fine mesh (:func:`to_confirm`): each screened response's fine value is taken to lie within
+``band_factor`` × the largest coarse–fine difference of that response over every design run on
+both meshes (:func:`error_bands`); a coarse design stays coarse only if, anywhere in those bands,
+it is surely infeasible, or surely beaten by a surely feasible design, and surely dominated on
+the front. Each confirmation adds a coarse–fine pair, the bands are recomputed and the test is
+repeated until no coarse design is left to confirm. The reported front and best design are then
+fine-mesh results, and they are those of evaluating every design on the fine mesh whenever the
+coarse errors lie within the bands (``tests/app/test_optimise.py`` checks this against the fine
+evaluation of every design). ``trials.csv`` says per design which mesh its row comes from
+(``fidelity``), ``screening.csv`` holds every coarse result and ``optimisation.json`` the bands.
+
 The responses of a design come from its ``summary.json`` (:func:`design_responses`): the
 objective keys, the safety factors and, per bearing, the deltas of the flexible loads against the
 case's rigid reference (``bearings[].delta_max_percent``, ``bearings[].life_ratio``; the
@@ -44,7 +68,7 @@ stopped, and a finished optimisation with more ``trials`` goes on from its end.
 
 Outputs in DIR: ``trials.csv`` (one row per design: parameters, responses, feasibility, status),
 ``best.toml`` (the best feasible design as a complete case file), ``trials/<id>/`` (every design's
-result folder), ``pareto.png`` (mass against life ratio coloured by the fatigue safety factor, the
+result folder: ``summary.json`` and ``case.json``; ``trials/<id>-coarse/`` when screened), ``pareto.png`` (mass against life ratio coloured by the fatigue safety factor, the
 feasible Pareto front drawn), ``optimisation.json`` and ``report.html``.
 
 ``analytic`` problems (``problem = "analytic"``, no base case) evaluate :func:`analytic_responses`
@@ -61,7 +85,6 @@ import logging
 import math
 import os
 import time
-import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -80,9 +103,22 @@ from rvfem.app.study_run import (
     local_cluster,
     run_variant,
 )
-from rvfem.case.definition import case_to_dict, load_case, parse_override
+from rvfem.app.optimise_problem import (
+    BUDGETS,
+    INFEASIBLE_VIOLATION,
+    OBJECTIVES,
+    OptParameter,
+    Problem,
+    _design_overrides,
+    _load_design,
+    error_bands,
+    Screening,
+    load_problem,
+    to_confirm,
+)
+from rvfem.case.definition import case_to_dict, load_case
 from rvfem.case.schema import toml_literal
-from rvfem.errors import CaseError, OutputError, RvfemError
+from rvfem.errors import RvfemError
 from rvfem.outputs.csvfile import csv_text
 from rvfem.outputs.figures import new_figure, save_figure
 from rvfem.outputs.report import png_data_uri, template_environment
@@ -105,60 +141,21 @@ __all__ = [
     "run_optimisation",
     "case_file_text",
     "pareto_front",
+    "Screening",
+    "error_bands",
+    "to_confirm",
 ]
-
-OBJECTIVES = ("disc_mass_kg", "disc_polar_inertia_kg_mm2", "objective")
-"""What can be minimised (``objective`` is the analytic problem's)."""
-
-BUDGETS = {
-    "max_load_delta_percent": ("max_load_delta_percent", "max"),
-    "life_ratio": ("life_ratio", "min"),
-    "fatigue_safety_factor": ("fatigue_safety_factor", "min"),
-    "static_safety_factor": ("static_safety_factor", "min"),
-    "g": ("g", "max"),
-}
-"""Budget name → (response, ``"max"``: the response may not exceed the limit, ``"min"``: may not
-fall below it). ``g`` is the analytic problem's constraint."""
-
-INFEASIBLE_VIOLATION = 1.0e3
-"""Constraint violation told to the sampler for a design that failed (rejected geometry)."""
-
-
-@dataclass(frozen=True)
-class OptParameter:
-    """A varied case key over [low, high] (on a grid of ``step`` if given)."""
-
-    key: str
-    low: float
-    high: float
-    step: float | None = None
-
-
-@dataclass(frozen=True)
-class Problem:
-    """A validated optimisation file (module docstring)."""
-
-    name: str
-    description: str
-    path: Path | None
-    kind: str                       # "case" or "analytic"
-    base_case: Path | None
-    overrides: tuple[str, ...]
-    objective: str
-    parameters: tuple[OptParameter, ...]
-    budgets: tuple[tuple[str, float], ...]
-    trials: int
-    seed: int
-    batch: int | None = None
 
 
 @dataclass(frozen=True)
 class DesignTask:
-    """What a worker needs for one design: the parameters and, for a case, its variant task."""
+    """What a worker needs for one design: the parameters, for a case its variant task, and the
+    fidelity (``"fine"``, or ``"coarse"`` when screening)."""
 
     trial_id: str
     params: tuple[tuple[str, float], ...]
     variant: VariantTask | None = None
+    fidelity: str = "fine"
 
 
 @dataclass(frozen=True)
@@ -177,115 +174,28 @@ class OptimisationResult:
 
 
 # --------------------------------------------------------------------------------------------
-# The file
-# --------------------------------------------------------------------------------------------
-
-
-def _fail(where: str, key: str, message: str) -> CaseError:
-    return CaseError(f"{where}: {key}: {message}")
-
-
-def _number(where: str, key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise _fail(where, key, f"expected a number, got {value!r}")
-    return float(value)
-
-
-def _read_parameters(where: str, raw: Any) -> tuple[OptParameter, ...]:
-    if not isinstance(raw, list) or not raw:
-        raise _fail(where, "parameter", "give at least one [[parameter]] table with key, low and high")
-    out = []
-    for i, p in enumerate(raw, start=1):
-        w = f"parameter {i}"
-        if not isinstance(p, dict) or set(p) - {"key", "low", "high", "step", "label"} or "key" not in p:
-            raise _fail(where, w, "expected a table of key, low, high and optionally step")
-        low, high = _number(where, f"{w}.low", p.get("low")), _number(where, f"{w}.high", p.get("high"))
-        if not low < high:
-            raise _fail(where, f"{w}.high", f"must exceed low ({low:g}), got {high:g}")
-        step = None if p.get("step") is None else _number(where, f"{w}.step", p["step"])
-        out.append(OptParameter(str(p["key"]), low, high, step))
-    return tuple(out)
-
-
-def _read_budgets(where: str, raw: Any) -> tuple[tuple[str, float], ...]:
-    if not isinstance(raw, dict):
-        raise _fail(where, "budget", "expected a table, e.g. life_ratio = 0.75")
-    for name in raw:
-        if name not in BUDGETS:
-            raise _fail(where, f"budget.{name}", f"unknown budget; known: {', '.join(BUDGETS)}")
-    return tuple((name, _number(where, f"budget.{name}", v)) for name, v in raw.items())
-
-
-_TOP_KEYS = {"name", "description", "problem", "base_case", "objective", "trials", "seed", "batch", "overrides",
-             "parameter", "budget"}
-
-
-def load_problem(path: str | os.PathLike, extra_overrides: Sequence[str] = (), trials: int | None = None) -> Problem:
-    """Read and check an optimisation file; the base case and one design at the middle of the
-    ranges are loaded (unknown case keys get their one-line error here).
-
-    Raises
-    ------
-    CaseError
-        One line naming the file and the key.
-    """
-    path = Path(path)
-    where = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise CaseError(f"{where}: cannot read the optimisation file ({exc.strerror or exc})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise CaseError(f"{where}: not a valid TOML file ({exc})") from None
-    unknown = set(data) - _TOP_KEYS
-    if unknown:
-        raise _fail(where, sorted(unknown)[0], f"unknown key; known: {', '.join(sorted(_TOP_KEYS))}")
-    kind = data.get("problem", "case")
-    if kind not in ("case", "analytic"):
-        raise _fail(where, "problem", f"expected \"case\" or \"analytic\", got {kind!r}")
-    objective = data.get("objective", "disc_mass_kg" if kind == "case" else "objective")
-    if objective not in OBJECTIVES:
-        raise _fail(where, "objective", f"expected one of {', '.join(OBJECTIVES)}, got {objective!r}")
-    overrides = tuple(f"{k}={toml_literal(v)}" for k, v in (data.get("overrides") or {}).items())
-    overrides += tuple(extra_overrides)
-    for text in overrides:
-        parse_override(text)
-    base = None
-    if kind == "case":
-        if "base_case" not in data:
-            raise _fail(where, "base_case", "missing: the case file the designs vary")
-        base = (path.parent / str(data["base_case"])).resolve()
-    n = int(trials if trials is not None else data.get("trials", 30))
-    problem = Problem(name=str(data.get("name", path.stem)), description=str(data.get("description", "")),
-                      path=path.resolve(), kind=kind, base_case=base, overrides=overrides, objective=objective,
-                      parameters=_read_parameters(where, data.get("parameter")),
-                      budgets=_read_budgets(where, data.get("budget", {})), trials=max(1, n),
-                      seed=int(data.get("seed", 0)), batch=None if data.get("batch") is None else int(data["batch"]))
-    if base is not None:
-        middle = tuple((p.key, 0.5 * (p.low + p.high)) for p in problem.parameters)
-        _load_design(problem, middle)
-    return problem
-
-
-def _design_overrides(problem: Problem, params: Sequence[tuple[str, float]]) -> tuple[str, ...]:
-    return problem.overrides + tuple(f"{k}={toml_literal(float(v))}" for k, v in params)
-
-
-def _load_design(problem: Problem, params: Sequence[tuple[str, float]]):
-    assert problem.base_case is not None   # a case problem has its base case (load_problem)
-    return load_case(problem.base_case, _design_overrides(problem, params))
-
-
-# --------------------------------------------------------------------------------------------
 # One design (runs in a Dask worker)
 # --------------------------------------------------------------------------------------------
 
 
-def analytic_responses(params: dict[str, float]) -> dict[str, float]:
+ANALYTIC_COARSE_ERROR = 0.05
+"""Amplitude of the stand-in for a coarse mesh's error of the analytic problem (its ``coarse``
+fidelity): f and g each off by at most this."""
+
+
+def analytic_responses(params: dict[str, float], fidelity: str = "fine") -> dict[str, float]:
     """The analytic check problem: minimise f = (x − 1)² + (y − 2)² subject to g = x + y ≤ 2.
-    Known optimum: the projection of (1, 2) onto the line x + y = 2, (0.5, 1.5), f* = 0.5."""
+    Known optimum: the projection of (1, 2) onto the line x + y = 2, (0.5, 1.5), f* = 0.5.
+
+    At fidelity ``"coarse"`` (screening) f and g carry a smooth error of amplitude
+    :data:`ANALYTIC_COARSE_ERROR` (ε·sin(7x + 3y) and ε·cos(5x − 2y)): the stand-in for a coarse
+    mesh, with which the screening's front is checked against the fine one."""
     x, y = float(params["x"]), float(params["y"])
-    return {"objective": (x - 1.0) ** 2 + (y - 2.0) ** 2, "g": x + y}
+    f, g = (x - 1.0) ** 2 + (y - 2.0) ** 2, x + y
+    if fidelity == "coarse":
+        f += ANALYTIC_COARSE_ERROR * math.sin(7.0 * x + 3.0 * y)
+        g += ANALYTIC_COARSE_ERROR * math.cos(5.0 * x - 2.0 * y)
+    return {"objective": f, "g": g}
 
 
 def design_responses(summary: dict) -> dict[str, float | None]:
@@ -316,12 +226,13 @@ def evaluate_design(task: DesignTask) -> dict:
     with ``status`` ``"failed"`` or ``"error"`` and its message."""
     started = time.perf_counter()
     if task.variant is None:
-        record: dict[str, Any] = {"status": "ok", "error": "", "computed": True, "responses": analytic_responses(dict(task.params))}
+        record: dict[str, Any] = {"status": "ok", "error": "", "computed": True,
+                                  "responses": analytic_responses(dict(task.params), task.fidelity)}
     else:
         record = run_variant(task.variant)
         summary = record.pop("summary", None)
         record["responses"] = design_responses(summary) if summary else {}
-    record.update(id=task.trial_id, wall_time_s=time.perf_counter() - started)
+    record.update(id=task.trial_id, wall_time_s=time.perf_counter() - started, fidelity=task.fidelity)
     return record
 
 
@@ -360,7 +271,7 @@ def _row(problem: Problem, number: int, params: Sequence[tuple[str, float]], rec
     row.update({k: float(v) for k, v in params})
     row.update({k: responses.get(k) for k in _response_keys(problem)})
     row.update(error=record.get("error", ""), computed=bool(record.get("computed", False)),
-               wall_time_s=record.get("wall_time_s"), digest=digest)
+               wall_time_s=record.get("wall_time_s"), digest=digest, fidelity=record.get("fidelity", "fine"))
     return row
 
 
@@ -373,7 +284,7 @@ def _response_keys(problem: Problem) -> tuple[str, ...]:
 
 def _columns(problem: Problem) -> list[str]:
     return (["number", "id", "status", "feasible", "objective", "violation"] + [p.key for p in problem.parameters]
-            + list(_response_keys(problem)) + ["error", "computed", "wall_time_s", "digest"])
+            + list(_response_keys(problem)) + ["error", "computed", "wall_time_s", "digest", "fidelity"])
 
 
 def _csv_text(problem: Problem, rows: Sequence[dict]) -> str:
@@ -402,6 +313,7 @@ def read_trials(path: str | os.PathLike) -> list[dict]:
     for r in rows:
         for k in ("id", "status", "error", "digest"):
             r[k] = "" if r.get(k) is None else str(r[k])
+        r["fidelity"] = str(r.get("fidelity") or "fine")
     return rows
 
 
@@ -416,12 +328,12 @@ def _key(params: Sequence[tuple[str, float]]) -> str:
 
 
 def _earlier(problem: Problem, rows: Sequence[dict]) -> dict[str, dict]:
-    """Designs of an earlier run by parameters (ok or rejected, not interrupted ones)."""
+    """Designs of an earlier run by fidelity and parameters (ok or rejected, not interrupted ones)."""
     out = {}
     for r in rows:
         if r.get("status") not in ("ok", "failed") or any(r.get(p.key) is None for p in problem.parameters):
             continue
-        out[_key([(p.key, r[p.key]) for p in problem.parameters])] = r
+        out[r.get("fidelity", "fine") + _key([(p.key, r[p.key]) for p in problem.parameters])] = r
     return out
 
 
@@ -464,34 +376,41 @@ def _dask_client(scheduler: str | None, workers: int | None, client, connect_tim
             cluster.close()
 
 
-def _task(problem: Problem, trial_id: str, params: tuple, trials_dir: Path, cache: Path) -> tuple[DesignTask | None, str, dict | None]:
+def _trial_folder(trials_dir: Path, trial_id: str, fidelity: str) -> Path:
+    """``trials/<id>/``, or ``trials/<id>-coarse/`` for a design screened on the coarse mesh."""
+    return trials_dir / (trial_id if fidelity == "fine" else f"{trial_id}-{fidelity}")
+
+
+def _task(problem: Problem, trial_id: str, params: tuple, trials_dir: Path, cache: Path, fidelity: str = "fine",
+          design_only: bool = True) -> tuple[DesignTask | None, str, dict | None]:
     """(task, case digest, record of a design the case validation rejects)."""
     if problem.kind == "analytic":
-        return DesignTask(trial_id, params), "", None
+        return DesignTask(trial_id, params, fidelity=fidelity), "", None
     try:
-        case = _load_design(problem, params)
+        case = _load_design(problem, params, fidelity)
     except RvfemError as exc:
         return None, "", {"id": trial_id, "status": "failed", "error": _one_line(f"{type(exc).__name__}: {exc}"),
-                          "computed": True, "responses": {}, "wall_time_s": 0.0}
+                          "computed": True, "responses": {}, "wall_time_s": 0.0, "rejected": True,
+                          "fidelity": fidelity}
     digest = case.digest()
-    variant = VariantTask(trial_id, str(problem.base_case), _design_overrides(problem, params), digest,
-                          str(trials_dir / trial_id), str(cache))
-    return DesignTask(trial_id, params, variant), digest, None
+    variant = VariantTask(trial_id, str(problem.base_case), _design_overrides(problem, params, fidelity), digest,
+                          str(_trial_folder(trials_dir, trial_id, fidelity)), str(cache), design_only=design_only)
+    return DesignTask(trial_id, params, variant, fidelity), digest, None
 
 
 def _run_batch(problem: Problem, client, batch: Sequence[tuple[str, tuple]], earlier: dict, trials_dir: Path,
-               cache: Path) -> list[tuple[dict, str]]:
+               cache: Path, fidelity: str = "fine", design_only: bool = True) -> list[tuple[dict, str]]:
     """(record, digest) of every design of a batch, in order: taken from an earlier run where
-    its parameters and case digest match, else run on the client."""
+    its parameters, fidelity and case digest match, else run on the client."""
     out: list = [None] * len(batch)
     futures = {}
     for i, (trial_id, params) in enumerate(batch):
-        task, digest, rejected = _task(problem, trial_id, params, trials_dir, cache)
-        old = earlier.get(_key(params))
+        task, digest, rejected = _task(problem, trial_id, params, trials_dir, cache, fidelity, design_only)
+        old = earlier.get(fidelity + _key(params))
         if old is not None and (old.get("digest") or "") == digest:
             responses = {k: old.get(k) for k in (*_response_keys(problem), problem.objective)}
             out[i] = ({"id": trial_id, "status": old["status"], "error": old.get("error", ""), "computed": False,
-                       "responses": responses if old["status"] == "ok" else {},
+                       "responses": responses if old["status"] == "ok" else {}, "fidelity": fidelity,
                        "wall_time_s": old.get("wall_time_s")}, digest)
         elif rejected is not None:
             out[i] = (rejected, digest)
@@ -504,6 +423,7 @@ def _run_batch(problem: Problem, client, batch: Sequence[tuple[str, tuple]], ear
         except Exception as exc:   # the task itself raised (a worker lost): recorded, never fatal
             out[i] = ({"id": batch[i][0], "status": "failed", "computed": True, "responses": {},
                        "error": _one_line(f"{type(exc).__name__}: {exc}"), "wall_time_s": float("nan")}, digest)
+        out[i][0]["fidelity"] = fidelity
     return out
 
 
@@ -546,8 +466,11 @@ def _tell_constraints(problem: Problem, trial, violations: Sequence[float]) -> N
 
 
 def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, fallback: float,
-          progress: ProgressCallback | None, head: Sequence[dict] = ()) -> list[dict]:
-    """Ask a batch, run it, tell it in order; ``trials.csv`` after every batch."""
+          progress: ProgressCallback | None, head: Sequence[dict] = (), design_only: bool = True) -> list[dict]:
+    """Ask a batch, run it (on the coarse mesh when screening), tell it in order; ``trials.csv``
+    (``screening.csv`` when screening) after every batch."""
+    fidelity = "coarse" if problem.screening is not None else "fine"
+    table = out_dir / ("screening.csv" if fidelity == "coarse" else "trials.csv")
     study = _sampler(problem)
     rows: list[dict] = []
     batch = problem.batch or max(1, len(client.scheduler_info().get("workers", {})) or 1)
@@ -556,7 +479,7 @@ def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, f
         params = [tuple((p.key, _tidy(t.suggest_float(p.key, p.low, p.high, step=p.step), p)) for p in problem.parameters)
                   for t in trials]
         done = _run_batch(problem, client, [(f"t{t.number:03d}", prm) for t, prm in zip(trials, params)], earlier,
-                          out_dir / "trials", cache)
+                          out_dir / "trials", cache, fidelity, design_only)
         for t, prm, (record, digest) in zip(trials, params, done):
             row = _row(problem, t.number, prm, record, digest)
             _tell_constraints(problem, t, _violations(problem, record.get("responses") or {})
@@ -565,31 +488,61 @@ def _loop(problem: Problem, client, out_dir: Path, cache: Path, earlier: dict, f
             rows.append(row)
             if progress is not None:
                 progress(len(rows), problem.trials, row)
-        write_text_atomic(out_dir / "trials.csv", _csv_text(problem, [*head, *rows]))
+        write_text_atomic(table, _csv_text(problem, [*head, *rows]))
     return rows
 
 
-def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows: Sequence[dict]) -> dict | None:
+def _base_row(problem: Problem, client, out_dir: Path, cache: Path, earlier_rows: Sequence[dict],
+              fidelity: str = "fine", design_only: bool = True) -> dict | None:
     """The base case itself (``trials/base``), the reference of the report and the value told
-    for failed designs; None for an analytic problem."""
+    for failed designs (on the coarse mesh, ``trials/base-coarse``, the first coarse–fine pair of
+    a screening); None for an analytic problem."""
     if problem.kind == "analytic":
         return None
     assert problem.base_case is not None   # not analytic, checked just above
-    case = load_case(problem.base_case, problem.overrides)
+    overrides = _design_overrides(problem, (), fidelity)
+    case = load_case(problem.base_case, overrides)
     old = next((r for r in earlier_rows if r.get("id") == "base" and r.get("digest") == case.digest()
                 and r.get("status") == "ok"), None)
     if old is not None:
         return {**old, "computed": False}
-    task = DesignTask("base", (), VariantTask("base", str(problem.base_case), problem.overrides, case.digest(),
-                                              str(out_dir / "trials" / "base"), str(cache)))
+    task = DesignTask("base", (), VariantTask("base", str(problem.base_case), overrides, case.digest(),
+                                              str(_trial_folder(out_dir / "trials", "base", fidelity)), str(cache),
+                                              design_only=design_only), fidelity)
     record = client.submit(evaluate_design, task, key=f"rvfem-design-base-{os.urandom(4).hex()}", pure=False).result()
     return _row(problem, -1, (), record, case.digest())
+
+
+def _confirm(problem: Problem, client, out_dir: Path, cache: Path, rows: list[dict], pairs: list[tuple[dict, dict]],
+             earlier: dict, design_only: bool) -> tuple[list[dict], dict[str, float], int]:
+    """Re-evaluate on the fine mesh every coarse row :func:`to_confirm` returns, widen the bands
+    with the new coarse–fine pairs and repeat until no coarse row is left to confirm. Returns the
+    rows (confirmed ones replaced by their fine result), the final bands and how many rows were
+    confirmed."""
+    confirmed = 0
+    while True:
+        bands = error_bands(problem, pairs)
+        todo = to_confirm(problem, rows, bands)
+        if not todo:
+            return rows, bands, confirmed
+        log.info("%s: %d designs within the coarse-fine band of the front or the best, on the fine mesh",
+                 problem.name, len(todo))
+        params = [tuple((p.key, r[p.key]) for p in problem.parameters) for r in todo]
+        done = _run_batch(problem, client, [(r["id"], prm) for r, prm in zip(todo, params)], earlier,
+                          out_dir / "trials", cache, "fine", design_only)
+        index = {id(r): i for i, r in enumerate(rows)}
+        for coarse, prm, (record, digest) in zip(todo, params, done):
+            fine = _row(problem, int(coarse["number"]), prm, record, digest)
+            if coarse.get("status") == "ok" and fine["status"] == "ok":
+                pairs.append((coarse, fine))
+            rows[index[id(coarse)]] = fine
+            confirmed += 1
 
 
 def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.PathLike, *,
                      scheduler: str | None = None, workers: int | None = None, client=None,
                      cache_dir: str | os.PathLike = "meshes", progress: ProgressCallback | None = None,
-                     plots: bool = True) -> OptimisationResult:
+                     plots: bool = True, design_only: bool = True) -> OptimisationResult:
     """Run an optimisation (module docstring) and write its folder.
 
     Parameters
@@ -599,6 +552,10 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
         Folder; a rerun into it resumes (designs already in ``trials.csv`` are not run again).
     scheduler, workers, client, cache_dir, progress, plots
         As :func:`rvfem.app.study.run_study`.
+    design_only : bool
+        Each design computes and writes only what its responses read
+        (:func:`rvfem.app.design.run_design`; the same responses); False runs every design as a
+        full ``rvfem run`` (every result, table and plot in ``trials/<id>/``, several times the cost).
 
     Raises
     ------
@@ -616,16 +573,36 @@ def run_optimisation(problem: Problem | str | os.PathLike, out_dir: str | os.Pat
         lock = _acquire_lock(out_dir)
         try:
             _remove_partials(out_dir / "trials")
-            earlier_rows = read_trials(out_dir / "trials.csv")
+            earlier_rows = read_trials(out_dir / "trials.csv") + read_trials(out_dir / "screening.csv")
+            earlier = _earlier(problem, earlier_rows)
+            screening = None
             with _dask_client(scheduler, workers, client) as c:
-                base = _base_row(problem, c, out_dir, cache, earlier_rows)
+                base = _base_row(problem, c, out_dir, cache, earlier_rows, design_only=design_only)
                 fallback = base["objective"] if base and base.get("objective") is not None else 0.0
-                rows = _loop(problem, c, out_dir, cache, _earlier(problem, earlier_rows), fallback, progress,
-                             head=[base] if base else [])
+                pairs: list[tuple[dict, dict]] = []
+                coarse_head = []
+                if problem.screening is not None and base is not None:
+                    coarse_base = _base_row(problem, c, out_dir, cache, earlier_rows, "coarse", design_only)
+                    assert coarse_base is not None   # a case problem
+                    coarse_head = [coarse_base]
+                    if coarse_base["status"] == "ok" and base["status"] == "ok":
+                        pairs.append((coarse_base, base))
+                rows = _loop(problem, c, out_dir, cache, earlier, fallback, progress,
+                             head=coarse_head if problem.screening is not None else [base] if base else [],
+                             design_only=design_only)
+                if problem.screening is not None:
+                    screened = list(rows)
+                    rows, bands, confirmed = _confirm(problem, c, out_dir, cache, list(rows), pairs, earlier,
+                                                      design_only)
+                    screening = {"mesh_scale": problem.screening.mesh_scale,
+                                 "band_factor": problem.screening.band_factor, "bands": bands,
+                                 "pairs": len(pairs), "confirmed_on_fine_mesh": confirmed,
+                                 "coarse_designs": sum(1 for r in screened if r.get("status") == "ok")}
             all_rows = ([base] if base else []) + rows
             write_text_atomic(out_dir / "trials.csv", _csv_text(problem, all_rows))
             best = min((r for r in rows if r["feasible"]), key=lambda r: r["objective"], default=None)
-            files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started)
+            files = _write_outputs(problem, out_dir, rows, base, best, plots, time.perf_counter() - started,
+                                   screening)
         finally:
             lock.unlink(missing_ok=True)
     return OptimisationResult(out_dir=out_dir, problem=problem, rows=tuple(rows), best=best, files=files,
@@ -732,7 +709,7 @@ def _report(problem: Problem, rows: Sequence[dict], base: dict | None, best: dic
 
 
 def _write_outputs(problem: Problem, out_dir: Path, rows: list[dict], base: dict | None, best: dict | None,
-                   plots: bool, wall_s: float) -> dict:
+                   plots: bool, wall_s: float, screening: dict | None = None) -> dict:
     files = {"csv": out_dir / "trials.csv"}
     if best is not None and problem.kind == "case":
         params = tuple((p.key, best[p.key]) for p in problem.parameters)
@@ -749,7 +726,8 @@ def _write_outputs(problem: Problem, out_dir: Path, rows: list[dict], base: dict
     doc = {"name": problem.name, "objective": problem.objective, "seed": problem.seed, "trials": problem.trials,
            "parameters": [vars(p) for p in problem.parameters], "budgets": dict(problem.budgets),
            "overrides": list(problem.overrides), "base": base, "best": best,
-           "designs": len(rows), "feasible": sum(1 for r in rows if r["feasible"]), "wall_time_s": wall_s}
+           "designs": len(rows), "feasible": sum(1 for r in rows if r["feasible"]), "wall_time_s": wall_s,
+           "screening": screening}
     write_text_atomic(files["json"], json.dumps(doc, indent=2, default=str) + "\n")
     files["report"] = out_dir / "report.html"
     write_text_atomic(files["report"], _report(problem, rows, base, best, png, wall_s))

@@ -46,6 +46,7 @@ from typing import Callable
 from threadpoolctl import threadpool_limits
 
 from rvfem._files import write_text_atomic
+from rvfem.app.design import run_design
 from rvfem.app.run import run_case
 from rvfem.app.study_definition import Study, Variant, load_study
 from rvfem.app.study_outputs import report_html, study_csv_text, study_dict, study_rows, write_plots
@@ -91,6 +92,9 @@ class VariantTask:
         Absolute path of the variant's result folder (on a file system shared with the client).
     cache_dir : str
         Absolute path of the mesh cache.
+    design_only : bool
+        Compute and write only what an optimiser design reads (:func:`rvfem.app.design.run_design`)
+        instead of the full :func:`~rvfem.app.run.run_case`.
     """
 
     variant_id: str
@@ -99,6 +103,7 @@ class VariantTask:
     digest: str
     out_dir: str
     cache_dir: str
+    design_only: bool = False
 
 
 class _Cancelled(Exception):
@@ -151,9 +156,12 @@ def run_variant(task: VariantTask) -> dict:
         if case.digest() != task.digest:
             raise CaseError(f"{task.base_case}: the case file changed since the study was checked "
                             "(the variant's case digest differs); run the study again")
-        result = run_case(case, task.out_dir, images=False, overwrite=True, cache_dir=task.cache_dir,
-                          progress=_cancellation_check())
-        record["summary"] = result.summary
+        if task.design_only:
+            record["summary"] = run_design(case, task.out_dir, cache_dir=task.cache_dir, progress=_cancellation_check())
+        else:
+            result = run_case(case, task.out_dir, images=False, overwrite=True, cache_dir=task.cache_dir,
+                              progress=_cancellation_check())
+            record["summary"] = result.summary
     except _Cancelled as exc:
         record.update(status="cancelled", error=str(exc))
     except RvfemError as exc:

@@ -67,6 +67,11 @@ class AnalysisOptions:
         Solve the flexible cycle at every other duty-cycle torque (stage ``duty_cycle``).
     attribute : bool
         Compute the attribution (stage ``attribution``).
+    sections : tuple of str, optional
+        Compute only these result sections (:func:`rvfem.results.registry.sections`, by name) and
+        the sections they require; the others are left None. None (the default) computes every
+        section. A design of ``rvfem optimise`` computes only what its responses read (the stress
+        and the mass and strength): the same numbers, without the stages nobody reads.
     """
 
     angle_step_deg: float | None = None
@@ -76,6 +81,7 @@ class AnalysisOptions:
     recover_stress: bool = True
     duty_fe: bool = True
     attribute: bool = True
+    sections: tuple[str, ...] | None = None
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@ client as the case designs, reproducibly and resumably; the case path records re
 
 from __future__ import annotations
 
-import dataclasses
+import json
 import math
 from pathlib import Path
 
@@ -169,3 +169,103 @@ def test_without_optuna_the_command_says_how_to_install_it(tmp_path, monkeypatch
     with pytest.raises(RvfemError, match=r"pip install 'rvfem\[optimise\]'"):
         run_optimisation(_problem(tmp_path, 5), tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+SCREENED = ANALYTIC + """
+[screening]
+band_factor = {band_factor}
+"""
+
+
+def _fine_front_and_best(rows):
+    """The front and the best feasible design of ``rows`` with every design evaluated at the fine
+    fidelity (the analytic functions themselves): the reference of the screening."""
+    from rvfem.app.optimise import analytic_responses
+
+    fine = []
+    for r in rows:
+        resp = analytic_responses({"x": r["x"], "y": r["y"]})
+        fine.append({"id": r["id"], "objective": resp["objective"], "g": resp["g"], "feasible": resp["g"] <= 2.0})
+    best = min((r for r in fine if r["feasible"]), key=lambda r: r["objective"])
+    return fine, pareto_front(fine, "objective", "g"), best
+
+
+def test_screened_front_and_best_are_those_of_the_fine_evaluation(client, tmp_path):
+    """Screening on the coarse fidelity (f and g off by up to 0.05): every design whose coarse
+    result lies within the coarse–fine band of the front or the best is re-evaluated on the fine
+    one, so the reported front (objective against g) and the best feasible design are exactly
+    those of every design evaluated on the fine fidelity, with fine values; the band covers the
+    coarse error (2 × the largest difference seen ≥ the amplitude); most designs stay coarse."""
+    path = tmp_path / "screened.toml"
+    path.write_text(SCREENED.format(trials=60, band_factor=2.0), encoding="utf-8")
+    r = run_optimisation(load_problem(path), tmp_path / "out", client=client)
+    fine, front, best = _fine_front_and_best(r.rows)
+    reported_front = pareto_front(list(r.rows), "objective", "g")
+    assert [row["id"] for row in reported_front] == [row["id"] for row in front]
+    for row, ref in zip(reported_front, front):
+        assert row["fidelity"] == "fine"
+        assert (row["objective"], row["g"]) == pytest.approx((ref["objective"], ref["g"]), rel=1e-12)
+    assert r.best is not None and r.best["id"] == best["id"] and r.best["fidelity"] == "fine"
+    assert r.best["objective"] == pytest.approx(best["objective"], rel=1e-12)
+    # every design either fine or with its coarse value within the band of its fine value
+    doc = json.loads((tmp_path / "out" / "optimisation.json").read_text(encoding="utf-8"))
+    bands = doc["screening"]["bands"]
+    assert min(bands.values()) >= 0.05
+    for row, ref in zip(r.rows, fine):
+        if row["fidelity"] == "coarse":
+            assert abs(row["objective"] - ref["objective"]) <= bands["objective"]
+            assert abs(row["g"] - ref["g"]) <= bands["g"]
+    confirmed = sum(1 for row in r.rows if row["fidelity"] == "fine")
+    assert doc["screening"]["confirmed_on_fine_mesh"] == confirmed < len(r.rows) / 2
+    assert len(read_trials(tmp_path / "out" / "screening.csv")) == 60
+
+
+def test_screened_front_equals_the_fine_only_optimisation_on_the_same_designs(client, tmp_path):
+    """Within the sampler's random start-up (8 designs) both runs propose the same designs: the
+    screened optimisation reports the front and best of the fine-only one, value for value."""
+    fine_only = run_optimisation(_problem(tmp_path, 8), tmp_path / "fine", client=client)
+    path = tmp_path / "screened.toml"
+    path.write_text(SCREENED.format(trials=8, band_factor=2.0), encoding="utf-8")
+    screened = run_optimisation(load_problem(path), tmp_path / "screened", client=client)
+    assert [(r["x"], r["y"]) for r in screened.rows] == [(r["x"], r["y"]) for r in fine_only.rows]
+
+    def front(rows):
+        return [(r["id"], r["objective"], r["g"]) for r in pareto_front(list(rows), "objective", "g")]
+
+    assert front(screened.rows) == front(fine_only.rows)
+    assert screened.best is not None and fine_only.best is not None
+    assert (screened.best["id"], screened.best["objective"]) == (fine_only.best["id"], fine_only.best["objective"])
+
+
+def test_screening_table_is_checked(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text(SCREENED.format(trials=5, band_factor=0.5), encoding="utf-8")
+    with pytest.raises(CaseError, match="screening.band_factor: must be at least 1"):
+        load_problem(path)
+    path.write_text(SCREENED.format(trials=5, band_factor=2.0).replace("band_factor", "mesh_scale"), encoding="utf-8")
+    load_problem(path)
+    path.write_text(SCREENED.format(trials=5, band_factor=2.0) + "extra = 1\n", encoding="utf-8")
+    with pytest.raises(CaseError, match="screening: expected a table of mesh_scale"):
+        load_problem(path)
+
+
+def test_a_design_computes_the_responses_of_a_full_run(tmp_path):
+    """A design computes only the sections its responses read (rvfem.app.design): the responses
+    are those of the full ``rvfem run`` of the same case, number for number (coarse mesh, 30°
+    steps), and the stages nobody reads are not computed."""
+    from rvfem.app.design import run_design
+    from rvfem.app.optimise import design_responses
+    from rvfem.app.run import run_case
+
+    base = tmp_path / "coarse.toml"
+    base.write_text(case_file_text(coarse_case("rv40e_fanholes")), encoding="utf-8")
+    case = load_case(base, ("analysis.angle_step_deg=30.0",))
+    lean = run_design(case, tmp_path / "lean", cache_dir=tmp_path / "meshes")
+    full = run_case(case, tmp_path / "full", images=False, cache_dir=tmp_path / "meshes").summary
+    assert design_responses(lean) == design_responses(full)
+    assert all(v is not None for v in design_responses(lean).values())
+    assert lean["design_only"] and sorted(p.name for p in (tmp_path / "lean").iterdir()
+                                                 if not p.name.startswith(".")) == ["case.json", "summary.json"]
+    assert "accuracy" not in lean["timings_s"] and "roller_slices" not in lean["timings_s"]
+    assert lean["bearings"] == full["bearings"] and lean["mass_strength"] == full["mass_strength"]
+    assert lean["stress"]["hot_spots"] == full["stress"]["hot_spots"]
