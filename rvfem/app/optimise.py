@@ -93,11 +93,11 @@ from typing import Any, Callable, Sequence
 from rvfem._files import write_text_atomic
 from rvfem.app.study_run import (
     ClusterError,
-    SingleThreadedBlas,
     VariantTask,
     _acquire_lock,
     _connect,
     _one_line,
+    _single_threaded_blas_plugin,
     _remove_partials,
     _removed_if_new_on,
     local_cluster,
@@ -366,7 +366,7 @@ def _dask_client(scheduler: str | None, workers: int | None, client, connect_tim
         own = Client(cluster, set_as_default=False)
     try:
         try:
-            own.register_plugin(SingleThreadedBlas())
+            own.register_plugin(_single_threaded_blas_plugin())
         except Exception:
             log.debug("could not register the single-threaded BLAS plugin", exc_info=True)
         yield own

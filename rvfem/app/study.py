@@ -30,12 +30,12 @@ from rvfem.app.study_outputs import (
     study_rows,
     study_table_columns,
 )
+from rvfem.app import study_run as _study_run
 from rvfem.app.study_run import (
     BLAS_THREAD_VARIABLES,
     LOCK_NAME,
     ClusterError,
     ProgressCallback,
-    SingleThreadedBlas,
     StudyResult,
     VariantTask,
     local_cluster,
@@ -69,3 +69,10 @@ __all__ = [
     "read_study_csv",
     "toml_literal",
 ]
+
+
+def __getattr__(name: str):
+    """``SingleThreadedBlas`` on first use (a Dask class: :func:`rvfem.app.study_run._plugin_class`)."""
+    if name == "SingleThreadedBlas":
+        return _study_run.SingleThreadedBlas
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -31,6 +31,7 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
+import functools
 import math
 import os
 import shutil
@@ -246,13 +247,7 @@ def _existing_record(variant: Variant, folder: Path) -> dict | None:
 # --------------------------------------------------------------------------------------------
 
 
-try:  # a declared dependency; the base class lets the plugin be registered by type
-    from distributed import WorkerPlugin as _WorkerPluginBase
-except ImportError:  # pragma: no cover
-    _WorkerPluginBase = object  # type: ignore[misc,assignment]
-
-
-class SingleThreadedBlas(_WorkerPluginBase):
+class _SingleThreadedBlasSetup:
     """Worker plugin: one worker, one core.
 
     Limits the BLAS/OpenMP thread pools of the worker to one thread (also in workers started by
@@ -285,6 +280,29 @@ class SingleThreadedBlas(_WorkerPluginBase):
                 log.debug("could not pin worker %s to a core", worker.name, exc_info=True)
 
 
+@functools.cache
+def _plugin_class() -> type:
+    """``SingleThreadedBlas``: the plugin's behaviour on Dask's ``WorkerPlugin`` base class, which
+    Dask needs to register it by type, made on first use and named after this module, so that
+    it pickles by reference to the workers."""
+    from distributed import WorkerPlugin  # Dask is a heavy import (about 0.5 s): studies and optimisations only
+    return type("SingleThreadedBlas", (_SingleThreadedBlasSetup, WorkerPlugin),
+                {"__module__": __name__, "__doc__": _SingleThreadedBlasSetup.__doc__})
+
+
+def __getattr__(name: str):
+    """``SingleThreadedBlas`` (:func:`_plugin_class`), made on first use: no command but the studies
+    and the optimiser pays for Dask's import."""
+    if name == "SingleThreadedBlas":
+        return _plugin_class()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _single_threaded_blas_plugin(pin_core: bool = False):
+    """A ``SingleThreadedBlas`` plugin (:func:`_plugin_class`)."""
+    return _plugin_class()(pin_core=pin_core)
+
+
 def local_cluster(workers: int | None = None):
     """A :class:`distributed.LocalCluster` for studies: ``workers`` processes (default: one per
     core), one thread each, BLAS/OpenMP pinned to one thread and each worker to its own core,
@@ -310,7 +328,7 @@ def local_cluster(workers: int | None = None):
             return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                 scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                 env=env, silence_logs=logging.ERROR, host="127.0.0.1",
-                                plugins=(SingleThreadedBlas(pin_core=True),))
+                                plugins=(_single_threaded_blas_plugin(pin_core=True),))
     except Exception as exc:
         raise ClusterError(f"cannot start a local Dask cluster of {n} workers: {_one_line(exc)}") from None
 
@@ -597,7 +615,7 @@ def _compute(study: Study, todo: list[Variant], variants_dir: Path, cache: Path,
     interrupted = False
     try:
         try:
-            client.register_plugin(SingleThreadedBlas())
+            client.register_plugin(_single_threaded_blas_plugin())
         except Exception:
             log.debug("could not register the single-threaded BLAS plugin", exc_info=True)
         token = uuid.uuid4().hex[:8]
