@@ -1,6 +1,7 @@
 # rvfem: two commands for a fresh machine.
 #   make run    create .venv if missing, install rvfem, run the main job on the default case
-#   make test   create .venv if missing, install rvfem with the dev extra, run the test suite
+#   make test   create .venv if missing, install rvfem with the dev extra, run the test suite on
+#               parallel workers (TEST_WORKERS, default one per core; TEST_WORKERS=0 runs it in one process)
 # Both are idempotent: the installation is redone only when pyproject.toml changes.
 
 PYTHON ?= python3
@@ -10,17 +11,20 @@ BIN    := $(VENV)/bin
 # The main job: arguments of the `rvfem` command that `make run` executes.
 MAIN_JOB ?= run cases/rv40e_fanholes.toml -o results/rv40e_fanholes --overwrite
 
+# Parallel pytest workers of `make test` (pytest-xdist's -n: a number, auto = one per core, 0 = none).
+TEST_WORKERS ?= auto
+
 .PHONY: run test install install-dev help
 
 help:
 	@echo "make run    - install (if needed) and run: rvfem $(MAIN_JOB)"
-	@echo "make test   - install with the dev extra (if needed) and run pytest"
+	@echo "make test   - install with the dev extra (if needed) and run pytest on $(TEST_WORKERS) workers"
 
 run: $(VENV)/.installed
 	$(BIN)/rvfem $(MAIN_JOB)
 
 test: $(VENV)/.installed-dev
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(TEST_WORKERS)
 
 install: $(VENV)/.installed
 

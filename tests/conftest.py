@@ -12,13 +12,25 @@ Test folders are not packages: every test module's file name is unique across th
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-import pytest
+BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+"""With parallel workers (``pytest -n N``, pytest-xdist sets ``PYTEST_XDIST_WORKER_COUNT`` before
+this file is imported), each worker and the processes it starts get an equal share of the cores
+for their BLAS threads unless the variables are set already: N workers of as many BLAS threads
+as there are cores would oversubscribe the machine. Set before NumPy is imported."""
+
+if int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1")) > 1:
+    _share = max(1, (os.cpu_count() or 1) // int(os.environ["PYTEST_XDIST_WORKER_COUNT"]))
+    for _name in BLAS_THREAD_VARIABLES:
+        os.environ.setdefault(_name, str(_share))
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES_DIR = ROOT / "cases"
@@ -158,12 +170,38 @@ fuzzed command line) rather than one stage of the science core: every test in th
 ``slow``."""
 
 
+WIDER_SCOPES = ("class", "module", "package")
+"""Fixture scopes whose value a module's tests share (a whole run of the job, a mesh, a solved
+cycle): with parallel workers (pytest-xdist, ``make test``) such a test runs on the worker that
+computed the value for its module, so that it is computed once per test run."""
+
+
+def shared_fixture_group(item) -> str | None:
+    """The ``xdist_group`` of a test: its module's path when it uses a fixture of a scope in
+    :data:`WIDER_SCOPES` (directly or through another fixture), None otherwise (the test may run
+    on any worker). Session fixtures are per worker and not counted: they must be cheap or cached
+    across processes (see :func:`shared_mesh_cache`)."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return None
+    for name in item.fixturenames:
+        if any(d.scope in WIDER_SCOPES for d in info.name2fixturedefs.get(name, ())):
+            return item.path.relative_to(ROOT).as_posix()
+    return None
+
+
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Mark the tests under :data:`END_TO_END_DIR` ``slow`` (tests elsewhere carry the marker
-    themselves), so that ``pytest -m "not slow"`` runs the science core only."""
+    themselves), so that ``pytest -m "not slow"`` runs the science core only; and put the tests
+    that share a module's fixtures in one ``xdist_group`` (:func:`shared_fixture_group`), which
+    ``--dist loadgroup`` (``make test``) runs on one worker."""
     for item in items:
         if END_TO_END_DIR in item.path.resolve().parents:
             item.add_marker(pytest.mark.slow)
+        group = shared_fixture_group(item)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
 
 
 def _registry_tables() -> tuple[dict, ...]:

@@ -24,10 +24,18 @@ import fuzz_cases  # noqa: E402
 OK = ("exit 0", "exit 2")
 
 
-@settings(max_examples=2000, deadline=None, derandomize=True, database=None,
+EXAMPLES = 2000
+"""Mutated inputs in all, drawn in :data:`SHARDS` parts of equal size: hypothesis gives every
+parametrized instance its own derandomized seed (from its test id), so the parts draw different
+inputs, and parallel workers (``make test``) share them."""
+SHARDS = 4
+
+
+@pytest.mark.parametrize("shard", range(SHARDS))
+@settings(max_examples=EXAMPLES // SHARDS, deadline=None, derandomize=True, database=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(rng=st.randoms(use_true_random=False))
-def test_mutated_cases_exit_cleanly(rng, tmp_path):
+def test_mutated_cases_exit_cleanly(shard, rng, tmp_path):
     description, content = fuzz_cases.fuzz_input(rng)
     path = tmp_path / "case.toml"
     path.write_bytes(content)
