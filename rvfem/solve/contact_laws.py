@@ -14,7 +14,10 @@ import numpy as np
 from scipy.special import lambertw
 
 ForceLaw = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
-"""A force law of spring contacts, vectorised: approach δ (mm) → (force q (N), slope dq/dδ (N/mm))."""
+"""A force law of spring contacts, vectorised: approach δ (mm) → (force q (N), slope dq/dδ (N/mm)).
+A law whose ``elementwise`` attribute is True gives each contact's force from its own approach
+alone, for an array of any shape (no per-contact data): the contact problem evaluates the contacts
+of every body that share it in one call (:class:`rvfem.solve.contact_newton.ContactProblem`)."""
 
 
 PALMGREN_COEFFICIENT = 3.84e-5
@@ -42,6 +45,7 @@ def palmgren_law(length: float, contacts: int = 2):
         dq = np.where(d > 0, p / c * (d / c) ** (p - 1.0), 0.0)
         return q, dq
 
+    law.elementwise = True  # type: ignore[attr-defined]
     return law
 
 
@@ -61,6 +65,7 @@ def linear_law(stiffness: float, bilateral: bool = False, open_fraction: float =
             return k * delta, k
         return stiffness * np.maximum(delta, 0.0), np.where(delta > 0, stiffness, 0.0)
 
+    law.elementwise = True  # type: ignore[attr-defined]
     return law
 
 
@@ -276,15 +281,17 @@ def _roller_bore_approach_of(length: float, reduced_radius_bore: float, disc_mod
     ln_w = np.log(w)
     a_denominator = np.pi * e_star * length                          # a² = 4QR'/(πE*L)
 
-    def approach(Q):
+    def approach(Q, slope_only: bool = False):
         Q = np.maximum(np.asarray(Q, dtype=float), 0.0)
         beyond = Q > q_lim
         q = np.maximum(np.where(beyond, q_lim, Q), 1e-300)
         ln_wa = ln_w - 0.5 * np.log(4.0 * q * reduced_radius_bore / a_denominator)
-        q09 = q**0.9
         q01 = q**-0.1
-        d = 2.0 * c1 * q09 - (0.5 * c1 * q09 - k * q * ln_wa) / s
         dd = 1.8 * c1 * q01 - (0.45 * c1 * q01 - k * (ln_wa - 0.5)) / s
+        if slope_only:
+            return None, dd
+        q09 = q**0.9
+        d = 2.0 * c1 * q09 - (0.5 * c1 * q09 - k * q * ln_wa) / s
         if beyond.any():
             d = np.where(beyond, d + dd * (Q - q_lim), d)
         return np.where(Q > 0.0, d, 0.0), dd
@@ -335,9 +342,10 @@ def roller_bore_law(*, length: float, reduced_radius_bore: float, disc_modulus: 
         qp = np.exp(ln_q)
         if lin.any():
             qp = np.where(lin, q_lim + (dp - d_lim) / slope_lim, qp)
-        _, slope = approach(qp)
+        _, slope = approach(qp, slope_only=True)
         q[pos] = qp
         dq[pos] = 1.0 / slope
         return q, dq
 
+    law.elementwise = True  # type: ignore[attr-defined]
     return law

@@ -9,6 +9,7 @@ primal–dual active set for the rigid pins) on this small dense system (:class:
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -106,9 +107,8 @@ class ContactProblem:
         subs = [_weights(k, b, offs, dropped, Rc, RL, Rfull) for k, b in enumerate(bodies)]
         sig = np.concatenate([c.signorini for c in csets])
         lever = np.concatenate([c.lever for c in csets])
-        # a law's contacts as a slice where they are consecutive (a view instead of a gather)
-        laws = [(_as_slice(offs[k] + np.asarray(idx, dtype=int)), law)
-                for k, c in enumerate(csets) for idx, law in c.laws]
+        laws = _grouped_laws([(offs[k] + np.asarray(idx, dtype=int), law)
+                              for k, c in enumerate(csets) for idx, law in c.laws])
         spring = ~sig
         si = np.flatnonzero(spring)
         r_typ = max(float(np.abs(lever).max()), 1.0)
@@ -512,6 +512,24 @@ def _weights(k: int, body, offs: np.ndarray, dropped: list, Rc: np.ndarray, RL: 
     return touched, Wsub_T, WL_dense, WL_dense != 0
 
 
+def _grouped_laws(laws: list) -> list:
+    """The (contacts, law) groups of a problem, those of one elementwise law
+    (:data:`rvfem.solve.contact_laws.ForceLaw`: a bearing's, shared by every crank angle and disc)
+    joined, so that it is evaluated once for all of them; a group's contacts as a slice where they
+    are consecutive (a view instead of a gather)."""
+    joined: dict = {}
+    out: list = []
+    for idx, law in laws:
+        if getattr(law, "elementwise", False) and id(law) in joined:
+            k = joined[id(law)]
+            out[k] = (np.concatenate([out[k][0], idx]), law)
+            continue
+        if getattr(law, "elementwise", False):
+            joined[id(law)] = len(out)
+        out.append((idx, law))
+    return [(_as_slice(idx), law) for idx, law in out]
+
+
 def _as_slice(idx: np.ndarray) -> slice | np.ndarray:
     """``idx`` as a slice if it is a run of consecutive indices, else itself."""
     if idx.size and idx[-1] - idx[0] == idx.size - 1 and np.all(np.diff(idx) == 1):
@@ -573,8 +591,25 @@ def _carries_tension(law, delta: float) -> bool:
     return bool(np.all(law(np.array([-delta]))[0] < 0))
 
 
+_SECANTS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+"""The secant stiffnesses found so far, per force law (while it lives) and force: a bearing's law
+is one object for every crank angle, and each cold start of a hysteresis loop or TE asks again."""
+
+
 def _secant(law, q_ref: float) -> float:
-    """Secant stiffness q_ref/δ of a force law at the force q_ref (bisection for δ in (0, 1] mm)."""
+    """Secant stiffness q_ref/δ of a force law at the force q_ref (bisection for δ in (0, 1] mm);
+    remembered per law and force (:data:`_SECANTS`)."""
+    try:
+        known = _SECANTS.setdefault(law, {})
+    except TypeError:                            # a law that cannot be weakly referenced
+        return _bisected_secant(law, q_ref)
+    if q_ref not in known:
+        known[q_ref] = _bisected_secant(law, q_ref)
+    return known[q_ref]
+
+
+def _bisected_secant(law, q_ref: float) -> float:
+    """:func:`_secant` by bisection."""
     lo, hi = 0.0, 1.0
     for _ in range(80):
         mid = 0.5 * (lo + hi)
