@@ -382,8 +382,7 @@ def newton_step(problem: ContactProblem, it: NewtonIterate, kappa: float, colsca
     ContactError
         If even that system is a mechanism (no contact at all can hold the body).
     """
-    Jm, r = newton_matrix(problem, it, it.q, it.dq, kappa)
-    step = _reduced_step(Jm, r, colscale, known_rows(problem, it.active, it.dq))
+    step = reduced_newton_step(problem, it, it.q, it.dq, kappa, colscale)
     if step is not None:
         return step
     opened = problem.spring & (it.dq == 0)
@@ -391,8 +390,7 @@ def newton_step(problem: ContactProblem, it: NewtonIterate, kappa: float, colsca
     q = it.q.copy()
     q[opened] = k_open[opened] * np.minimum(it.delta[opened], 0.0)
     dq = np.where(opened, k_open, it.dq)
-    Jm, r = newton_matrix(problem, it, q, dq, kappa)
-    step = _reduced_step(Jm, r, colscale, known_rows(problem, it.active, dq))
+    step = reduced_newton_step(problem, it, q, dq, kappa, colscale)
     if step is None:
         raise ContactError(
             f"the contact problem {label}is a mechanism: no contact holds the disc or the carrier "
@@ -467,6 +465,52 @@ def _newton(bodies, torque, coupling, start, options: NewtonOptions, engaged=Non
     raise _not_settled(problem, it, history, spring_history, options)
 
 
+def reduced_newton_step(problem: ContactProblem, it: NewtonIterate, q: np.ndarray, dq: np.ndarray, kappa: float,
+                        colscale: np.ndarray) -> np.ndarray | None:
+    """:func:`_reduced_step` of :func:`newton_matrix` with :func:`known_rows`, the same numbers,
+    without the rows of the known steps: only the rows of the unknown steps (loaded springs,
+    active rigid contacts, the equilibrium and carrier rows) are built, those of the open springs
+    and inactive rigid contacts (identity rows, about half the contacts) are not."""
+    p = problem
+    nc, nr, n = p.nc, p.nr, p.n
+    lam, active = it.lam, it.active
+    known = known_rows(p, active, dq)
+    fixed, free = np.flatnonzero(known), np.flatnonzero(~known)
+    J = np.flatnonzero(active | (p.spring & (dq > 0)) | (lam != 0))   # the forces that move the approaches
+    G = p.G_full(J).reshape(-1)                  # G[i, j] at i·nc + j (a C-ordered view)
+    m = int(np.searchsorted(free, nc))           # free[:m]: the contacts' rows, then eq and carrier
+    rows = free[:m]
+    is_spring = p.spring[rows]
+    ps, pa = np.flatnonzero(is_spring), np.flatnonzero(~is_spring)   # loaded springs, active rigid
+    si, ai = rows[ps], rows[pa]
+    Jf = np.zeros((free.size, n))                # the rows `free` of newton_matrix's Jm
+    flat = Jf.reshape(-1)
+    Jf[m:] = p.newton_template[nc:]
+    dqs = dq[si]
+    flat[ps * n + si] = 1.0
+    flat[ps[:, None] * n + J] += dqs[:, None] * G.take(si[:, None] * nc + J)
+    Jf[ps, nc:nc + nr] = dqs[:, None] * p.Rc[si]
+    if p.carrier:
+        Jf[ps, nc + nr] = -dqs * p.lever[si]
+    flat[pa[:, None] * n + J] = kappa * G.take(ai[:, None] * nc + J)
+    Jf[pa, nc:nc + nr] = kappa * p.Rc[ai]
+    r = np.empty(n)
+    r[:nc] = lam - q                             # springs, and the known rigid rows (q = 0 there)
+    r[ai] = kappa * (p.gap0[ai] + it.v[ai])
+    inactive = p.sig & ~active
+    r[:nc][inactive] = lam[inactive]
+    r[nc:nc + nr] = (p.RL.T @ lam) * p.row_scale
+    if p.carrier:
+        r[nc + nr] = (p.lever @ lam - p.torque) / p.r_typ
+    step = np.zeros(n)
+    step[fixed] = -r[fixed]
+    cscale = colscale[free]
+    at = np.arange(free.size)[:, None] * n
+    A = flat.take(at + free) * cscale[None, :]
+    rhs = -r[free] - flat.take(at + fixed) @ step[fixed]
+    return _solved_step(A, rhs, cscale, step, free)
+
+
 def _reduced_step(Jm: np.ndarray, r: np.ndarray, colscale: np.ndarray, known: np.ndarray) -> np.ndarray | None:
     """The Newton step of the system ``Jm·step = −r``: the ``known`` rows' steps are −r (their
     rows are identity rows), the rest solved with the columns scaled by ``colscale``. None if that
@@ -479,6 +523,13 @@ def _reduced_step(Jm: np.ndarray, r: np.ndarray, colscale: np.ndarray, known: np
     flat = Jm.reshape(-1)
     A = flat.take(rows + free) * cscale[None, :]
     rhs = -r[free] - flat.take(rows + fixed) @ step[fixed]
+    return _solved_step(A, rhs, cscale, step, free)
+
+
+def _solved_step(A: np.ndarray, rhs: np.ndarray, cscale: np.ndarray, step: np.ndarray,
+                 free: np.ndarray) -> np.ndarray | None:
+    """``step`` with its ``free`` entries from A·y = rhs (y scaled by ``cscale``), or None if that
+    system is singular and inconsistent (:func:`_reduced_step`)."""
     try:
         y = np.linalg.solve(A, rhs)
     except np.linalg.LinAlgError:
