@@ -447,6 +447,24 @@ def _prefetch_stage(stage: ReducerStage, systems: list, thetas: np.ndarray, solv
         s.compliance.ensure(likely_columns(s, sets, stage.carrier_torque_Nmm(op)))
 
 
+def prefetch_columns(stage: ReducerStage, thetas, op: OperatingPoint, torques_Nmm=None) -> None:
+    """Build the contacts of both discs at the stage's crank angles ``thetas`` (rad) in one sweep
+    per disc model, and compute the compliance columns solves there will likely need
+    (:func:`likely_columns`, for each carrier torque in ``torques_Nmm``, N·mm; default the
+    operating point's) in one parallel sweep per model, instead of a few at a time as each solve
+    first needs them. For solves outside a load cycle at many crank angles (the transmission
+    error over a revolution); columns missed here are still computed when first needed."""
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    angles = [_disc_angles(stage, float(t)) for t in np.atleast_1d(thetas)]
+    torques = [stage.carrier_torque_Nmm(op)] if torques_Nmm is None else list(torques_Nmm)
+    for d, s in enumerate(systems):
+        contact_sets(s, [a[d] for a in angles], op)
+    for s in {id(s): s for s in systems}.values():
+        ks = [k for k, t in enumerate(systems) if t is s]
+        sets = [stage_contact_set(stage, systems[k], a[k], op)[0] for a in angles for k in ks]
+        s.compliance.ensure(np.unique(np.concatenate([likely_columns(s, sets, T) for T in torques])))
+
+
 def _stage_angle(stage: ReducerStage, pair: PairResult, swap: int, k: int, theta: float, order: int,
                  op: OperatingPoint) -> tuple:
     """Disc A's result at θ and (bearing forces, torques, eccentric displacements) of the stage,

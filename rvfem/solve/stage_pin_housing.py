@@ -352,8 +352,10 @@ def _closed_form_law(params: dict[str, Any], seat_form: tuple[float, float, floa
 
     def law(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         delta = np.asarray(delta, dtype=float)
-        if isinstance(A, np.ndarray) and delta.shape == A.shape:    # one approach per pin: no broadcasting needed
-            d, b_all, ab_all, dl = delta, B_pins, A_over_B, d_lim_pins
+        if isinstance(A, np.ndarray) and (delta.shape == A.shape or (delta.size == 1 and delta.ndim <= A.ndim)):
+            # one approach per pin, or one for every pin: no broadcasting needed
+            d = delta if delta.shape == A.shape else np.full(A.shape, delta.reshape(()))
+            b_all, ab_all, dl = B_pins, A_over_B, d_lim_pins
         else:
             shape = np.broadcast(delta, A).shape
             d = np.broadcast_to(delta, shape)
