@@ -344,19 +344,19 @@ def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | 
     return np.where(same, f * (d @ d.T), 0.0)
 
 
-def _cached_coupling(stage: ReducerStage, systems, phases, sets, cache: dict | None) -> np.ndarray | None:
-    """:func:`coupling_matrix`, kept in ``cache`` (a solve's ``g_cache``) for the same contact sets
-    (by identity) of the same stage: the load steps of a hysteresis loop solve one crank angle's
-    contacts again and again."""
-    if cache is None or stage.influence is None:
-        return coupling_matrix(stage, systems, phases, sets)
-    key = ("coupling", id(stage)) + tuple(id(c) for c, _ in sets)
-    entry = cache.get(key)
+def _pair_contacts(stage: ReducerStage, systems, phases, sets, cache: dict | None) -> tuple:
+    """The contact names of a pair solve and its crankshaft coupling (:func:`coupling_matrix`),
+    kept in ``cache`` (a solve's ``g_cache``) for the same contact sets (by identity) of the same
+    stage: the load steps of a hysteresis loop solve one crank angle's contacts again and again."""
+    key = ("pair contacts", id(stage)) + tuple(id(c) for c, _ in sets)
+    entry = None if cache is None else cache.get(key)
     if entry is not None and entry[0] is stage and all(a is c for a, (c, _) in zip(entry[1], sets)):
-        return entry[2]
+        return entry[2], entry[3]
+    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
     H = coupling_matrix(stage, systems, phases, sets)
-    cache[key] = (stage, [c for c, _ in sets], H)
-    return H
+    if cache is not None:
+        cache[key] = (stage, [c for c, _ in sets], names, H)
+    return names, H
 
 
 def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None, *,
@@ -375,8 +375,7 @@ def _solve_pair(stage: ReducerStage, theta: float, start: PairResult | None, op:
     op = OperatingPoint.of(stage.first.case) if op is None else op
     systems, thetas, phases, sets = _bodies(stage, theta, op)
     case = stage.first.case
-    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
-    H = _cached_coupling(stage, systems, phases, sets, g_cache)
+    names, H = _pair_contacts(stage, systems, phases, sets, g_cache)
     sols = contact.solve_bodies(
         [contact.Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.carrier_torque_Nmm(op),
         coupling=H, start=None if start is None else [r.solution for r in start.results],
