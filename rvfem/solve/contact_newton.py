@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -88,11 +89,35 @@ class ContactProblem:
                 g_cache[self._parts_key(csets, rigid_dofs)] = (list(csets), [b.interface for b in bodies],
                                                                None if coupling is None else np.array(coupling),
                                                                fixed)
-        self.__dict__.update(fixed)
+        self.offs: np.ndarray = fixed["offs"]
+        self.nc: int = fixed["nc"]
+        self.nr: int = fixed["nr"]                   # rigid-motion unknowns, 3 per body
+        self.n: int = fixed["n"]
+        self.eq: slice = fixed["eq"]
+        self.dropped: list[int] = fixed["dropped"]
+        self.Rc: np.ndarray = fixed["Rc"]            # rigid motion → approach, per contact
+        self.RL: np.ndarray = fixed["RL"]            # Fx, Fy, Mz on its body per unit λ
+        self.Rfull: np.ndarray = fixed["Rfull"]
+        self.subs: list = fixed["subs"]
+        self.moment: np.ndarray = fixed["moment"]
+        self.sig: np.ndarray = fixed["sig"]
+        self.spring: np.ndarray = fixed["spring"]
+        self.si: np.ndarray = fixed["si"]
+        self.gap0: np.ndarray = fixed["gap0"]
+        self.offset: np.ndarray = fixed["offset"]
+        self.lever: np.ndarray = fixed["lever"]
+        self.laws: list = fixed["laws"]
+        self.Rc_springs: np.ndarray = fixed["Rc_springs"]
+        self.lever_springs: np.ndarray = fixed["lever_springs"]
+        self.r_typ: float = fixed["r_typ"]
+        self.row_scale: np.ndarray = fixed["row_scale"]
+        self.newton_template: np.ndarray = fixed["newton_template"]
+        self.G: np.ndarray = fixed["G"]
+        self.filled: np.ndarray = fixed["filled"]
         self.scale_f = max(abs(self.torque) / self.r_typ, 1.0)
         self._open_tangent: np.ndarray | None = None
 
-    def _parts(self, csets: list, coupling, rigid_dofs: tuple) -> dict:
+    def _parts(self, csets: list, coupling, rigid_dofs: tuple) -> dict[str, Any]:
         """Everything of the problem that does not depend on the torque: the contacts' rigid-motion
         and load rows, their weights, data and laws, the sizes and scales, the constant rows of the
         Newton matrix and an empty G (with its filled columns)."""
@@ -130,7 +155,7 @@ class ContactProblem:
             "offset": np.concatenate([c.offset for c in csets]), "lever": lever, "laws": laws,
             "spring": spring, "si": si, "Rc_springs": Rc[si], "lever_springs": lever[si],
             "r_typ": r_typ, "n": n, "eq": slice(nc, nc + nr), "row_scale": row_scale,
-            "RLT_scaled": RL.T * row_scale[:, None], "newton_template": template,
+            "newton_template": template,
             "G": np.zeros((nc, nc)) if coupling is None else np.array(coupling, dtype=float, order="C"),
             "filled": np.zeros(nc, dtype=bool),
         }
@@ -139,7 +164,7 @@ class ContactProblem:
         return (("parts", self.carrier, rigid_dofs) + tuple(id(c) for c in csets)
                 + tuple(id(b.interface) for b in self.bodies) + tuple(id(b.compliance) for b in self.bodies))
 
-    def _cached_parts(self, cache: dict, csets: list, coupling, rigid_dofs: tuple) -> dict | None:
+    def _cached_parts(self, cache: dict, csets: list, coupling, rigid_dofs: tuple) -> dict[str, Any] | None:
         """The torque-independent parts (:meth:`_parts`) of a problem of the same contact sets and
         interfaces (by identity), compliances, coupling, rigid motions and carrier solved before
         with ``cache``, or None. Its G is the shared one (:meth:`_share_G`)."""
