@@ -86,9 +86,9 @@ class ContactProblem:
             fixed = self._parts(csets, coupling, rigid_dofs)
             if g_cache is not None:
                 fixed["G"], fixed["filled"] = self._share_G(g_cache, csets, coupling, fixed["G"], fixed["filled"])
-                g_cache[self._parts_key(csets, rigid_dofs)] = (list(csets), [b.interface for b in bodies],
-                                                               None if coupling is None else np.array(coupling),
-                                                               fixed)
+                g_cache[self._parts_key(csets, rigid_dofs)] = (
+                    list(csets), [(b.interface, b.compliance) for b in bodies],
+                    None if coupling is None else np.array(coupling), fixed)
         self.offs: np.ndarray = fixed["offs"]
         self.nc: int = fixed["nc"]
         self.nr: int = fixed["nr"]                   # rigid-motion unknowns, 3 per body
@@ -171,9 +171,9 @@ class ContactProblem:
         entry = cache.get(self._parts_key(csets, rigid_dofs))
         if entry is None:
             return None
-        sets, interfaces, coupled, fixed = entry
+        sets, models, coupled, fixed = entry
         if not (all(a is b for a, b in zip(sets, csets))
-                and all(a is b.interface for a, b in zip(interfaces, self.bodies))
+                and all(i is b.interface and c is b.compliance for (i, c), b in zip(models, self.bodies))
                 and _same_coupling(coupled, coupling)):
             return None
         return fixed
