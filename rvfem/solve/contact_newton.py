@@ -393,7 +393,8 @@ def linearised_start_laws(problem: ContactProblem, it: NewtonIterate, engaged: n
 
 def newton_step(problem: ContactProblem, it: NewtonIterate, kappa: float, colscale: np.ndarray,
                 label: str = "") -> np.ndarray:
-    """The Newton step at an iterate (:func:`newton_matrix`, :func:`_reduced_step`).
+    """The Newton step at an iterate (:func:`reduced_newton_step`: :func:`newton_matrix` reduced by
+    :func:`known_rows`, :func:`_reduced_step`).
 
     If the linearised system is a mechanism (every spring that could hold a rigid motion of a
     body or of the carrier is open: zero tangent, Palmgren's law at δ ≤ 0, e.g. a radial clearance
@@ -520,7 +521,7 @@ def reduced_newton_step(problem: ContactProblem, it: NewtonIterate, q: np.ndarra
     flat[pa[:, None] * n + J] = kappa * G.take(ai[:, None] * nc + J)
     Jf[pa, nc:nc + nr] = kappa * p.Rc[ai]
     r = np.empty(n)
-    r[:nc] = lam - q                             # springs, and the known rigid rows (q = 0 there)
+    r[:nc] = lam - q                             # the springs' rows (the rigid contacts' set below)
     r[ai] = kappa * (p.gap0[ai] + it.v[ai])
     inactive = p.sig & ~active
     r[:nc][inactive] = lam[inactive]
