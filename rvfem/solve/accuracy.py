@@ -44,6 +44,7 @@ from rvfem.solve.cycle import (
     solve_pair,
     symmetry_plan,
 )
+from rvfem.solve.cycle_stage import prefetch_columns
 from rvfem.solve.stage_parts import STIFFEN, component_names, stiffened_stage
 from rvfem.units import arcmin_from_rad, nm_from_nmm
 
@@ -336,6 +337,7 @@ def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float
     # the carrier rotation repeats where the stage does (a turn by 2π/N, the pair swapped at π)
     solve_at, source = symmetry_plan(thetas, min(s.symmetry for s in systems),
                                      stage.discs == 2 and stage.mirrored_pairs)
+    prefetch_columns(stage, thetas[solve_at], OperatingPoint(T, float(friction), 0))
     no_load, loaded = {}, {}
     start = None
     for i in solve_at:

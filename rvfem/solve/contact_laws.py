@@ -14,7 +14,10 @@ import numpy as np
 from scipy.special import lambertw
 
 ForceLaw = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
-"""A force law of spring contacts, vectorised: approach δ (mm) → (force q (N), slope dq/dδ (N/mm))."""
+"""A force law of spring contacts, vectorised: approach δ (mm) → (force q (N), slope dq/dδ (N/mm)).
+A law whose ``elementwise`` attribute is True gives each contact's force from its own approach
+alone, for an array of any shape (no per-contact data): the contact problem evaluates the contacts
+of every body that share it in one call (:class:`rvfem.solve.contact_newton.ContactProblem`)."""
 
 
 PALMGREN_COEFFICIENT = 3.84e-5
@@ -42,6 +45,7 @@ def palmgren_law(length: float, contacts: int = 2):
         dq = np.where(d > 0, p / c * (d / c) ** (p - 1.0), 0.0)
         return q, dq
 
+    law.elementwise = True  # type: ignore[attr-defined]
     return law
 
 
@@ -61,6 +65,7 @@ def linear_law(stiffness: float, bilateral: bool = False, open_fraction: float =
             return k * delta, k
         return stiffness * np.maximum(delta, 0.0), np.where(delta > 0, stiffness, 0.0)
 
+    law.elementwise = True  # type: ignore[attr-defined]
     return law
 
 
@@ -173,14 +178,17 @@ def hertz_pin_law(**params):
 
     def law(delta):
         delta = np.asarray(delta, dtype=float)
-        shape = np.broadcast(delta, curvature).shape
-        d = np.broadcast_to(delta, shape)
-        a_, b_ = np.broadcast_to(alpha, shape), np.broadcast_to(P_lim, shape)
-        dl = np.broadcast_to(d_lim, shape)
-        q = np.zeros(shape)
-        dq = np.zeros(shape)
+        if curvature.ndim and delta.shape == curvature.shape:    # one approach per pin: no broadcasting
+            d, a_, b_, dl = delta, alpha, P_lim, d_lim
+        else:
+            shape = np.broadcast(delta, curvature).shape
+            d = np.broadcast_to(delta, shape)
+            a_, b_ = np.broadcast_to(alpha, shape), np.broadcast_to(P_lim, shape)
+            dl = np.broadcast_to(d_lim, shape)
+        q = np.zeros(d.shape)
+        dq = np.zeros(d.shape)
         pos = d > 0
-        if not np.any(pos):
+        if not pos.any():
             return q, dq
         dp, ap, Pl, dlp = d[pos], a_[pos], b_[pos], dl[pos]
         linear = dp > dlp
@@ -257,24 +265,38 @@ def roller_bore_approach(Q, *, length: float, reduced_radius_bore: float, disc_m
     bearings, far beyond any roller load, but a trial approach of the solver may get there) δ is
     continued linearly with its tangent (dδ/dQ > 0 there for s ≥ 1).
     """
-    Q = np.maximum(np.asarray(Q, dtype=float), 0.0)
+    return _roller_bore_approach_of(length, reduced_radius_bore, disc_modulus, disc_poisson,
+                                    footprint_half_width, disc_stiffness_scale)(Q)
+
+
+def _roller_bore_approach_of(length: float, reduced_radius_bore: float, disc_modulus: float, disc_poisson: float,
+                             footprint_half_width: float, disc_stiffness_scale: float = 1.0):
+    """:func:`roller_bore_approach` of one bearing as a function of Q alone (N → (δ mm, dδ/dQ
+    mm/N)), its constants computed once: the roller law evaluates it at every Newton iterate."""
     c1 = PALMGREN_COEFFICIENT / length**0.8
     k = 2.0 * (1.0 - disc_poisson**2) / (np.pi * disc_modulus * length)
     e_star = disc_modulus / (2.0 * (1.0 - disc_poisson**2))             # two bodies of the disc's steel
     w, s = float(footprint_half_width), float(disc_stiffness_scale)
     q_lim = np.pi * e_star * length * w * w / (4.0 * reduced_radius_bore)   # a = w
+    ln_w = np.log(w)
+    a_denominator = np.pi * e_star * length                          # a² = 4QR'/(πE*L)
 
-    def parts(q):
-        q = np.maximum(q, 1e-300)
-        ln_wa = np.log(w) - 0.5 * np.log(4.0 * q * reduced_radius_bore / (np.pi * e_star * length))
-        d = 2.0 * c1 * q**0.9 - (0.5 * c1 * q**0.9 - k * q * ln_wa) / s
-        dd = 1.8 * c1 * q**-0.1 - (0.45 * c1 * q**-0.1 - k * (ln_wa - 0.5)) / s
-        return d, dd
+    def approach(Q, slope_only: bool = False):
+        Q = np.maximum(np.asarray(Q, dtype=float), 0.0)
+        beyond = Q > q_lim
+        q = np.maximum(np.where(beyond, q_lim, Q), 1e-300)
+        ln_wa = ln_w - 0.5 * np.log(4.0 * q * reduced_radius_bore / a_denominator)
+        q01 = q**-0.1
+        dd = 1.8 * c1 * q01 - (0.45 * c1 * q01 - k * (ln_wa - 0.5)) / s
+        if slope_only:
+            return None, dd
+        q09 = q**0.9
+        d = 2.0 * c1 * q09 - (0.5 * c1 * q09 - k * q * ln_wa) / s
+        if beyond.any():
+            d = np.where(beyond, d + dd * (Q - q_lim), d)
+        return np.where(Q > 0.0, d, 0.0), dd
 
-    beyond = Q > q_lim
-    d, dd = parts(np.where(beyond, q_lim, Q))
-    delta = np.where(beyond, d + dd * (Q - q_lim), d)
-    return np.where(Q > 0.0, delta, 0.0), dd
+    return approach
 
 
 def roller_bore_law(*, length: float, reduced_radius_bore: float, disc_modulus: float, disc_poisson: float,
@@ -288,36 +310,42 @@ def roller_bore_law(*, length: float, reduced_radius_bore: float, disc_modulus: 
     on ln Q (to about 10⁻¹⁰ relative); beyond the tangent continuation of
     :func:`roller_bore_approach` it is linear.
     """
-    params = dict(length=length, reduced_radius_bore=reduced_radius_bore, disc_modulus=disc_modulus,
-                  disc_poisson=disc_poisson, footprint_half_width=footprint_half_width,
-                  disc_stiffness_scale=disc_stiffness_scale)
+    approach = _roller_bore_approach_of(length, reduced_radius_bore, disc_modulus, disc_poisson,
+                                        footprint_half_width, disc_stiffness_scale)
     e_star = disc_modulus / (2.0 * (1.0 - disc_poisson**2))
     w = float(footprint_half_width)
     q_lim = np.pi * e_star * length * w * w / (4.0 * reduced_radius_bore)
-    d_lim, slope_lim = (float(v) for v in roller_bore_approach(q_lim, **params))
+    d_lim, slope_lim = (float(v) for v in approach(q_lim))
     table_q = np.geomspace(1e-6, q_lim, 400)
-    table_ln_d = np.log(roller_bore_approach(table_q, **params)[0])
+    table_ln_d = np.log(approach(table_q)[0])
     table_ln_q = np.log(table_q)
+    ln_d0, ln_q0 = table_ln_d[0], table_ln_q[0]
 
     def law(delta):
         d = np.asarray(delta, dtype=float)
         q = np.zeros(d.shape)
         dq = np.zeros(d.shape)
         pos = d > 0.0
-        if not np.any(pos):
+        if not pos.any():
             return q, dq
         dp = d[pos]
         lin = dp > d_lim
         target = np.log(np.minimum(dp, d_lim))
         # below the table: δ ∝ Q^0.9 to within the ln term's change, extrapolated so
-        ln_q = np.where(target < table_ln_d[0], table_ln_q[0] + (target - table_ln_d[0]) / 0.9,
-                        np.interp(target, table_ln_d, table_ln_q))
-        d_, dd_ = roller_bore_approach(np.exp(ln_q), **params)
-        ln_q = ln_q - (np.log(d_) - target) * d_ / (np.exp(ln_q) * dd_)     # f = ln δ(Q) − ln δ*
-        qp = np.where(lin, q_lim + (dp - d_lim) / slope_lim, np.exp(ln_q))
-        _, slope = roller_bore_approach(qp, **params)
+        ln_q = np.interp(target, table_ln_d, table_ln_q)
+        below = target < ln_d0
+        if below.any():
+            ln_q = np.where(below, ln_q0 + (target - ln_d0) / 0.9, ln_q)
+        q_ = np.exp(ln_q)
+        d_, dd_ = approach(q_)
+        ln_q = ln_q - (np.log(d_) - target) * d_ / (q_ * dd_)     # f = ln δ(Q) − ln δ*
+        qp = np.exp(ln_q)
+        if lin.any():
+            qp = np.where(lin, q_lim + (dp - d_lim) / slope_lim, qp)
+        _, slope = approach(qp, slope_only=True)
         q[pos] = qp
         dq[pos] = 1.0 / slope
         return q, dq
 
+    law.elementwise = True  # type: ignore[attr-defined]
     return law

@@ -9,7 +9,9 @@ primal–dual active set for the rigid pins) on this small dense system (:class:
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -74,71 +76,119 @@ class ContactProblem:
     def __init__(self, bodies: list, torque: float | None, coupling: np.ndarray | None = None,
                  rigid_dofs: tuple = (0, 1, 2), g_cache: dict | None = None):
         self.bodies = bodies
-        self.nb = nb = len(bodies)
-        csets = [b.cset for b in bodies]
-        self.offs = offs = np.concatenate([[0], np.cumsum([c.W.shape[1] for c in csets])]).astype(int)
-        self.nc = nc = int(offs[-1])
-        self.nr = nr = 3 * nb                        # rigid-motion unknowns, 3 per body
-        self.dropped = [k for k in range(3) if k not in rigid_dofs]
-        self.Rc = np.zeros((nc, nr))                 # rigid motion → approach, per contact
-        self.RL = np.zeros((nc, nr))                 # Fx, Fy, Mz on its body per unit λ
-        self.Rfull = np.zeros((nc, 3))
-        self.subs = [self._weights(k, b) for k, b in enumerate(bodies)]
-        self.moment = self.RL[:, 2::3].sum(axis=1)  # Mz of each contact on its own body
+        self.nb = len(bodies)
         self.carrier = torque is not None            # without a carrier: no φ unknown
         self.torque = 0.0 if torque is None else torque
-        self.sig = np.concatenate([c.signorini for c in csets])
-        self.gap0 = np.concatenate([c.gap0 for c in csets])
-        self.offset = np.concatenate([c.offset for c in csets])
-        self.lever = np.concatenate([c.lever for c in csets])
-        self.laws = [(offs[k] + np.asarray(idx, dtype=int), law) for k, c in enumerate(csets) for idx, law in c.laws]
-        self.spring = ~self.sig
-        self.si = np.flatnonzero(self.spring)
-        self.r_typ = max(float(np.abs(self.lever).max()), 1.0)
-        self.n = nc + nr + 1 if self.carrier else nc + nr
-        self.eq = slice(nc, nc + nr)
-        self.row_scale = np.tile([1.0, 1.0, 1.0 / self.r_typ], nb)
+        csets = [b.cset for b in bodies]
+        rigid_dofs = tuple(rigid_dofs)
+        fixed = None if g_cache is None else self._cached_parts(g_cache, csets, coupling, rigid_dofs)
+        if fixed is None:
+            fixed = self._parts(csets, coupling, rigid_dofs)
+            if g_cache is not None:
+                fixed["G"], fixed["filled"] = self._share_G(g_cache, csets, coupling, fixed["G"], fixed["filled"])
+                g_cache[self._parts_key(csets, rigid_dofs)] = (
+                    list(csets), [(b.interface, b.compliance) for b in bodies],
+                    None if coupling is None else np.array(coupling), fixed)
+        self.offs: np.ndarray = fixed["offs"]
+        self.nc: int = fixed["nc"]
+        self.nr: int = fixed["nr"]                   # rigid-motion unknowns, 3 per body
+        self.n: int = fixed["n"]
+        self.eq: slice = fixed["eq"]
+        self.dropped: list[int] = fixed["dropped"]
+        self.Rc: np.ndarray = fixed["Rc"]            # rigid motion → approach, per contact
+        self.RL: np.ndarray = fixed["RL"]            # Fx, Fy, Mz on its body per unit λ
+        self.Rfull: np.ndarray = fixed["Rfull"]
+        self.subs: list = fixed["subs"]
+        self.moment: np.ndarray = fixed["moment"]
+        self.sig: np.ndarray = fixed["sig"]
+        self.spring: np.ndarray = fixed["spring"]
+        self.si: np.ndarray = fixed["si"]
+        self.gap0: np.ndarray = fixed["gap0"]
+        self.offset: np.ndarray = fixed["offset"]
+        self.lever: np.ndarray = fixed["lever"]
+        self.laws: list = fixed["laws"]
+        self.Rc_springs: np.ndarray = fixed["Rc_springs"]
+        self.lever_springs: np.ndarray = fixed["lever_springs"]
+        self.r_typ: float = fixed["r_typ"]
+        self.row_scale: np.ndarray = fixed["row_scale"]
+        self.newton_template: np.ndarray = fixed["newton_template"]
+        self.G: np.ndarray = fixed["G"]
+        self.filled: np.ndarray = fixed["filled"]
         self.scale_f = max(abs(self.torque) / self.r_typ, 1.0)
-        self.G = np.zeros((nc, nc)) if coupling is None else np.array(coupling, dtype=float)
-        self.filled = np.zeros(nc, dtype=bool)
         self._open_tangent: np.ndarray | None = None
-        if g_cache is not None:
-            self._share_G(g_cache, csets, coupling)
 
-    def _share_G(self, cache: dict, csets: list, coupling) -> None:
-        """Take G and its filled columns from ``cache`` if the same contact sets (by identity), the
-        same compliances and the same coupling filled them before, else put this problem's there.
-        G depends on the contacts' weights, the compliance and the coupling only, and its columns
-        never change once computed, so the arrays are shared and filled further in place."""
+    def _parts(self, csets: list, coupling, rigid_dofs: tuple) -> dict[str, Any]:
+        """Everything of the problem that does not depend on the torque: the contacts' rigid-motion
+        and load rows, their weights, data and laws, the sizes and scales, the constant rows of the
+        Newton matrix and an empty G (with its filled columns)."""
+        bodies, nb = self.bodies, self.nb
+        offs = np.concatenate([[0], np.cumsum([c.W.shape[1] for c in csets])]).astype(int)
+        nc = int(offs[-1])
+        nr = 3 * nb                                  # rigid-motion unknowns, 3 per body
+        dropped = [k for k in range(3) if k not in rigid_dofs]
+        Rc = np.zeros((nc, nr))                      # rigid motion → approach, per contact
+        RL = np.zeros((nc, nr))                      # Fx, Fy, Mz on its body per unit λ
+        Rfull = np.zeros((nc, 3))
+        subs = [_weights(k, b, offs, dropped, Rc, RL, Rfull) for k, b in enumerate(bodies)]
+        sig = np.concatenate([c.signorini for c in csets])
+        lever = np.concatenate([c.lever for c in csets])
+        laws = _grouped_laws([(offs[k] + np.asarray(idx, dtype=int), law)
+                              for k, c in enumerate(csets) for idx, law in c.laws])
+        spring = ~sig
+        si = np.flatnonzero(spring)
+        r_typ = max(float(np.abs(lever).max()), 1.0)
+        n = nc + nr + 1 if self.carrier else nc + nr
+        row_scale = np.tile([1.0, 1.0, 1.0 / r_typ], nb)
+        # the rows of the Newton matrix that do not change (:func:`newton_matrix`): each body's
+        # equilibrium, the carrier's, and the identity rows of the rigid motions left out
+        template = np.zeros((n, n))
+        template[nc:nc + nr, :nc] = RL.T * row_scale[:, None]
+        if self.carrier:
+            template[nc + nr, :nc] = lever / r_typ
+        for k in range(nb):
+            for d in dropped:
+                template[nc + 3 * k + d, nc + 3 * k + d] = 1.0
+        return {
+            "offs": offs, "nc": nc, "nr": nr, "dropped": dropped, "Rc": Rc, "RL": RL, "Rfull": Rfull,
+            "subs": subs, "moment": RL[:, 2::3].sum(axis=1),      # Mz of each contact on its own body
+            "sig": sig, "gap0": np.concatenate([c.gap0 for c in csets]),
+            "offset": np.concatenate([c.offset for c in csets]), "lever": lever, "laws": laws,
+            "spring": spring, "si": si, "Rc_springs": Rc[si], "lever_springs": lever[si],
+            "r_typ": r_typ, "n": n, "eq": slice(nc, nc + nr), "row_scale": row_scale,
+            "newton_template": template,
+            "G": np.zeros((nc, nc)) if coupling is None else np.array(coupling, dtype=float, order="C"),
+            "filled": np.zeros(nc, dtype=bool),
+        }
+
+    def _parts_key(self, csets: list, rigid_dofs: tuple) -> tuple:
+        return (("parts", self.carrier, rigid_dofs) + tuple(id(c) for c in csets)
+                + tuple(id(b.interface) for b in self.bodies) + tuple(id(b.compliance) for b in self.bodies))
+
+    def _cached_parts(self, cache: dict, csets: list, coupling, rigid_dofs: tuple) -> dict[str, Any] | None:
+        """The torque-independent parts (:meth:`_parts`) of a problem of the same contact sets and
+        interfaces (by identity), compliances, coupling, rigid motions and carrier solved before
+        with ``cache``, or None. Its G is the shared one (:meth:`_share_G`)."""
+        entry = cache.get(self._parts_key(csets, rigid_dofs))
+        if entry is None:
+            return None
+        sets, models, coupled, fixed = entry
+        if not (all(a is b for a, b in zip(sets, csets))
+                and all(i is b.interface and c is b.compliance for (i, c), b in zip(models, self.bodies))
+                and _same_coupling(coupled, coupling)):
+            return None
+        return fixed
+
+    def _share_G(self, cache: dict, csets: list, coupling, G: np.ndarray, filled: np.ndarray) -> tuple:
+        """G and its filled columns from ``cache`` if the same contact sets (by identity), the
+        same compliances and the same coupling filled them before, else ``G``, ``filled``, put
+        there. G depends on the contacts' weights, the compliance and the coupling only, and its
+        columns never change once computed, so the arrays are shared and filled further in place."""
         key = tuple(id(c) for c in csets) + tuple(id(b.compliance) for b in self.bodies)
         entry = cache.get(key)
-        same = (entry is not None and all(a is b for a, b in zip(entry[0], csets))
-                and ((entry[1] is None and coupling is None)
-                     or (entry[1] is not None and coupling is not None and np.array_equal(entry[1], coupling))))
-        if same and entry is not None:
-            self.G, self.filled = entry[2], entry[3]
-        else:
-            cache[key] = (list(csets), None if coupling is None else np.array(coupling), self.G, self.filled)
-
-    def _weights(self, k: int, body) -> tuple:
-        """Fill body k's rows of R_c and R_L; its weights on the interface columns it touches."""
-        c, rows = body.cset, slice(self.offs[k], self.offs[k + 1])
-        W = c.W.tocsc()                              # gaps/approaches are measured along W
-        WL = c.load_weights.tocsc()                  # loads act along W_load
-        self.Rc[rows, 3 * k:3 * k + 3] = np.asarray(W.T @ body.interface.resultants)
-        self.RL[rows, 3 * k:3 * k + 3] = np.asarray(WL.T @ body.interface.resultants)
-        self.Rfull[rows] = self.RL[rows, 3 * k:3 * k + 3]
-        for d in self.dropped:
-            self.Rc[rows, 3 * k + d] = 0.0
-            self.RL[rows, 3 * k + d] = 0.0
-        # the weights on the touched columns alone: the same CSC arrays with the column indices
-        # renumbered (W's arrays read as CSR are Wᵀ)
-        touched = np.unique(np.concatenate([W.indices, WL.indices]))
-        Wsub_T = sp.csr_matrix((W.data, np.searchsorted(touched, W.indices), W.indptr),
-                               shape=(W.shape[1], len(touched)))
-        WL_dense = sp.csc_matrix((WL.data, np.searchsorted(touched, WL.indices), WL.indptr),
-                                 shape=(len(touched), WL.shape[1])).toarray()
-        return touched, Wsub_T, WL_dense, WL_dense != 0
+        if entry is not None and all(a is b for a, b in zip(entry[0], csets)) and _same_coupling(entry[1], coupling):
+            return entry[2], entry[3]
+        cache[key] = (list(csets), None if coupling is None else np.array(coupling), G, filled)
+        return G, filled
 
     def G_full(self, idx: np.ndarray) -> np.ndarray:
         """G with the columns of contacts ``idx`` valid (the others are not read with weight)."""
@@ -296,30 +346,27 @@ def newton_matrix(problem: ContactProblem, it: NewtonIterate, q: np.ndarray, dq:
     nc, nr, n, eq, si = p.nc, p.nr, p.n, p.eq, p.si
     lam, active = it.lam, it.active
     J = np.flatnonzero(active | (p.spring & (dq > 0)) | (lam != 0))   # the forces that move the approaches
-    Gj = p.G_cols(J)
-    Jm = np.zeros((n, n))
+    G = p.G_full(J).reshape(-1)                  # G[i, j] at i·nc + j (a C-ordered view)
+    Jm = p.newton_template.copy()                # the equilibrium and carrier rows, the dropped motions
+    flat = Jm.reshape(-1)                        # Jm[i, j] at i·n + j
     r = np.zeros(n)
+    dqs = dq[si]
     r[si] = lam[si] - q[si]
-    Jm[si, si] = 1.0
-    Jm[np.ix_(si, J)] += dq[si, None] * Gj[si]
-    Jm[si, eq] = dq[si, None] * p.Rc[si]
+    flat[si * (n + 1)] = 1.0
+    flat[si[:, None] * n + J] += dqs[:, None] * G.take(si[:, None] * nc + J)
+    Jm[si, eq] = dqs[:, None] * p.Rc_springs
     if p.carrier:
-        Jm[si, nc + nr] = -dq[si] * p.lever[si]
+        Jm[si, nc + nr] = -dqs * p.lever_springs
     ai = np.flatnonzero(active)
     r[ai] = kappa * (p.gap0[ai] + it.v[ai])
-    Jm[np.ix_(ai, J)] = kappa * Gj[ai]
+    flat[ai[:, None] * n + J] = kappa * G.take(ai[:, None] * nc + J)
     Jm[ai, eq] = kappa * p.Rc[ai]
     ii = np.flatnonzero(p.sig & ~active)
     r[ii] = lam[ii]
-    Jm[ii, ii] = 1.0
+    flat[ii * (n + 1)] = 1.0
     r[eq] = (p.RL.T @ lam) * p.row_scale
-    Jm[eq, :nc] = p.RL.T * p.row_scale[:, None]
     if p.carrier:
         r[nc + nr] = (p.lever @ lam - p.torque) / p.r_typ
-        Jm[nc + nr, :nc] = p.lever / p.r_typ
-    for k in range(p.nb):
-        for d in p.dropped:
-            Jm[nc + 3 * k + d, nc + 3 * k + d] = 1.0
     return Jm, r
 
 
@@ -346,7 +393,8 @@ def linearised_start_laws(problem: ContactProblem, it: NewtonIterate, engaged: n
 
 def newton_step(problem: ContactProblem, it: NewtonIterate, kappa: float, colscale: np.ndarray,
                 label: str = "") -> np.ndarray:
-    """The Newton step at an iterate (:func:`newton_matrix`, :func:`_reduced_step`).
+    """The Newton step at an iterate (:func:`reduced_newton_step`: :func:`newton_matrix` reduced by
+    :func:`known_rows`, :func:`_reduced_step`).
 
     If the linearised system is a mechanism (every spring that could hold a rigid motion of a
     body or of the carrier is open: zero tangent, Palmgren's law at δ ≤ 0, e.g. a radial clearance
@@ -360,8 +408,7 @@ def newton_step(problem: ContactProblem, it: NewtonIterate, kappa: float, colsca
     ContactError
         If even that system is a mechanism (no contact at all can hold the body).
     """
-    Jm, r = newton_matrix(problem, it, it.q, it.dq, kappa)
-    step = _reduced_step(Jm, r, colscale, known_rows(problem, it.active, it.dq))
+    step = reduced_newton_step(problem, it, it.q, it.dq, kappa, colscale)
     if step is not None:
         return step
     opened = problem.spring & (it.dq == 0)
@@ -369,8 +416,7 @@ def newton_step(problem: ContactProblem, it: NewtonIterate, kappa: float, colsca
     q = it.q.copy()
     q[opened] = k_open[opened] * np.minimum(it.delta[opened], 0.0)
     dq = np.where(opened, k_open, it.dq)
-    Jm, r = newton_matrix(problem, it, q, dq, kappa)
-    step = _reduced_step(Jm, r, colscale, known_rows(problem, it.active, dq))
+    step = reduced_newton_step(problem, it, q, dq, kappa, colscale)
     if step is None:
         raise ContactError(
             f"the contact problem {label}is a mechanism: no contact holds the disc or the carrier "
@@ -445,6 +491,52 @@ def _newton(bodies, torque, coupling, start, options: NewtonOptions, engaged=Non
     raise _not_settled(problem, it, history, spring_history, options)
 
 
+def reduced_newton_step(problem: ContactProblem, it: NewtonIterate, q: np.ndarray, dq: np.ndarray, kappa: float,
+                        colscale: np.ndarray) -> np.ndarray | None:
+    """:func:`_reduced_step` of :func:`newton_matrix` with :func:`known_rows`, the same numbers,
+    without the rows of the known steps: only the rows of the unknown steps (loaded springs,
+    active rigid contacts, the equilibrium and carrier rows) are built, those of the open springs
+    and inactive rigid contacts (identity rows, about half the contacts) are not."""
+    p = problem
+    nc, nr, n = p.nc, p.nr, p.n
+    lam, active = it.lam, it.active
+    known = known_rows(p, active, dq)
+    fixed, free = np.flatnonzero(known), np.flatnonzero(~known)
+    J = np.flatnonzero(active | (p.spring & (dq > 0)) | (lam != 0))   # the forces that move the approaches
+    G = p.G_full(J).reshape(-1)                  # G[i, j] at i·nc + j (a C-ordered view)
+    m = int(np.searchsorted(free, nc))           # free[:m]: the contacts' rows, then eq and carrier
+    rows = free[:m]
+    is_spring = p.spring[rows]
+    ps, pa = np.flatnonzero(is_spring), np.flatnonzero(~is_spring)   # loaded springs, active rigid
+    si, ai = rows[ps], rows[pa]
+    Jf = np.zeros((free.size, n))                # the rows `free` of newton_matrix's Jm
+    flat = Jf.reshape(-1)
+    Jf[m:] = p.newton_template[nc:]
+    dqs = dq[si]
+    flat[ps * n + si] = 1.0
+    flat[ps[:, None] * n + J] += dqs[:, None] * G.take(si[:, None] * nc + J)
+    Jf[ps, nc:nc + nr] = dqs[:, None] * p.Rc[si]
+    if p.carrier:
+        Jf[ps, nc + nr] = -dqs * p.lever[si]
+    flat[pa[:, None] * n + J] = kappa * G.take(ai[:, None] * nc + J)
+    Jf[pa, nc:nc + nr] = kappa * p.Rc[ai]
+    r = np.empty(n)
+    r[:nc] = lam - q                             # the springs' rows (the rigid contacts' set below)
+    r[ai] = kappa * (p.gap0[ai] + it.v[ai])
+    inactive = p.sig & ~active
+    r[:nc][inactive] = lam[inactive]
+    r[nc:nc + nr] = (p.RL.T @ lam) * p.row_scale
+    if p.carrier:
+        r[nc + nr] = (p.lever @ lam - p.torque) / p.r_typ
+    step = np.zeros(n)
+    step[fixed] = -r[fixed]
+    cscale = colscale[free]
+    at = np.arange(free.size)[:, None] * n
+    A = flat.take(at + free) * cscale[None, :]
+    rhs = -r[free] - flat.take(at + fixed) @ step[fixed]
+    return _solved_step(A, rhs, cscale, step, free)
+
+
 def _reduced_step(Jm: np.ndarray, r: np.ndarray, colscale: np.ndarray, known: np.ndarray) -> np.ndarray | None:
     """The Newton step of the system ``Jm·step = −r``: the ``known`` rows' steps are −r (their
     rows are identity rows), the rest solved with the columns scaled by ``colscale``. None if that
@@ -453,8 +545,17 @@ def _reduced_step(Jm: np.ndarray, r: np.ndarray, colscale: np.ndarray, known: np
     step = np.zeros(r.size)
     step[fixed] = -r[fixed]
     cscale = colscale[free]
-    A = Jm[np.ix_(free, free)] * cscale[None, :]
-    rhs = -r[free] - Jm[np.ix_(free, fixed)] @ step[fixed]
+    rows = free[:, None] * r.size                # Jm[free][:, cols] gathered through the flat view
+    flat = Jm.reshape(-1)
+    A = flat.take(rows + free) * cscale[None, :]
+    rhs = -r[free] - flat.take(rows + fixed) @ step[fixed]
+    return _solved_step(A, rhs, cscale, step, free)
+
+
+def _solved_step(A: np.ndarray, rhs: np.ndarray, cscale: np.ndarray, step: np.ndarray,
+                 free: np.ndarray) -> np.ndarray | None:
+    """``step`` with its ``free`` entries from A·y = rhs (y scaled by ``cscale``), or None if that
+    system is singular and inconsistent (:func:`_reduced_step`)."""
     try:
         y = np.linalg.solve(A, rhs)
     except np.linalg.LinAlgError:
@@ -463,6 +564,59 @@ def _reduced_step(Jm: np.ndarray, r: np.ndarray, colscale: np.ndarray, known: np
             return None
     step[free] = y * cscale
     return step
+
+
+def _weights(k: int, body, offs: np.ndarray, dropped: list, Rc: np.ndarray, RL: np.ndarray,
+             Rfull: np.ndarray) -> tuple:
+    """Fill body k's rows of R_c, R_L and R_full; its weights on the interface columns it touches
+    (:class:`ContactProblem`)."""
+    c, rows = body.cset, slice(offs[k], offs[k + 1])
+    W = c.W.tocsc()                              # gaps/approaches are measured along W
+    WL = c.load_weights.tocsc()                  # loads act along W_load
+    Rc[rows, 3 * k:3 * k + 3] = np.asarray(W.T @ body.interface.resultants)
+    RL[rows, 3 * k:3 * k + 3] = np.asarray(WL.T @ body.interface.resultants)
+    Rfull[rows] = RL[rows, 3 * k:3 * k + 3]
+    for d in dropped:
+        Rc[rows, 3 * k + d] = 0.0
+        RL[rows, 3 * k + d] = 0.0
+    # the weights on the touched columns alone: the same CSC arrays with the column indices
+    # renumbered (W's arrays read as CSR are Wᵀ)
+    touched = np.unique(np.concatenate([W.indices, WL.indices]))
+    Wsub_T = sp.csr_matrix((W.data, np.searchsorted(touched, W.indices), W.indptr),
+                           shape=(W.shape[1], len(touched)))
+    WL_dense = sp.csc_matrix((WL.data, np.searchsorted(touched, WL.indices), WL.indptr),
+                             shape=(len(touched), WL.shape[1])).toarray()
+    return touched, Wsub_T, WL_dense, WL_dense != 0
+
+
+def _grouped_laws(laws: list) -> list:
+    """The (contacts, law) groups of a problem, those of one elementwise law
+    (:data:`rvfem.solve.contact_laws.ForceLaw`: a bearing's, shared by every crank angle and disc)
+    joined, so that it is evaluated once for all of them; a group's contacts as a slice where they
+    are consecutive (a view instead of a gather)."""
+    joined: dict = {}
+    out: list = []
+    for idx, law in laws:
+        if getattr(law, "elementwise", False) and id(law) in joined:
+            k = joined[id(law)]
+            out[k] = (np.concatenate([out[k][0], idx]), law)
+            continue
+        if getattr(law, "elementwise", False):
+            joined[id(law)] = len(out)
+        out.append((idx, law))
+    return [(_as_slice(idx), law) for idx, law in out]
+
+
+def _as_slice(idx: np.ndarray) -> slice | np.ndarray:
+    """``idx`` as a slice if it is a run of consecutive indices, else itself."""
+    if idx.size and idx[-1] - idx[0] == idx.size - 1 and np.all(np.diff(idx) == 1):
+        return slice(int(idx[0]), int(idx[-1]) + 1)
+    return idx
+
+
+def _same_coupling(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    """Both None, or equal arrays."""
+    return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
 
 
 def _submatrix(C: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -514,12 +668,52 @@ def _carries_tension(law, delta: float) -> bool:
     return bool(np.all(law(np.array([-delta]))[0] < 0))
 
 
+_SECANTS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+"""The secant stiffnesses found so far, per force law (while it lives) and force: a bearing's law
+is one object for every crank angle, and each cold start of a hysteresis loop or TE asks again."""
+
+
 def _secant(law, q_ref: float) -> float:
-    """Secant stiffness q_ref/δ of a force law at the force q_ref (bisection for δ in (0, 1] mm)."""
+    """Secant stiffness q_ref/δ of a force law at the force q_ref (bisection for δ in (0, 1] mm);
+    remembered per law and force (:data:`_SECANTS`)."""
+    try:
+        known = _SECANTS.setdefault(law, {})
+    except TypeError:                            # a law that cannot be weakly referenced
+        return _bisected_secant(law, q_ref)
+    if q_ref not in known:
+        known[q_ref] = _bisected_secant(law, q_ref)
+    return known[q_ref]
+
+
+SECANT_PROBE = 2.0 ** -6
+"""A bisection point of :func:`_bisected_secant` (15.6 µm, above the approach of a pin or roller
+at its expected force), evaluated first."""
+
+
+def _bisected_secant(law, q_ref: float) -> float:
+    """:func:`_secant` by bisection, 80 halvings of (0, 1] mm.
+
+    A force law does not decrease with the approach, so the force at :data:`SECANT_PROBE`, found
+    first, settles the comparison at every larger bisection point when it reaches q_ref already
+    (the first halvings, where a pin's law is continued beyond its closed form, are not evaluated),
+    and at every smaller one when it does not; and the halving stops once the midpoint is one of
+    the ends (the interval is one ulp wide: every further halving leaves it as it is). The result
+    is that of the 80 halvings."""
+    def below(x: float) -> bool:
+        return bool(law(np.array([x]))[0][0] < q_ref)
+
+    probe = SECANT_PROBE
+    probe_below = below(probe)
     lo, hi = 0.0, 1.0
     for _ in range(80):
         mid = 0.5 * (lo + hi)
-        if law(np.array([mid]))[0][0] < q_ref:
+        if mid == lo or mid == hi:
+            break
+        if mid == probe or (mid > probe and not probe_below) or (mid < probe and probe_below):
+            is_below = probe_below
+        else:
+            is_below = below(mid)
+        if is_below:
             lo = mid
         else:
             hi = mid

@@ -344,6 +344,21 @@ def coupling_matrix(stage: ReducerStage, systems, phases, sets) -> np.ndarray | 
     return np.where(same, f * (d @ d.T), 0.0)
 
 
+def _pair_contacts(stage: ReducerStage, systems, phases, sets, cache: dict | None) -> tuple:
+    """The contact names of a pair solve and its crankshaft coupling (:func:`coupling_matrix`),
+    kept in ``cache`` (a solve's ``g_cache``) for the same contact sets (by identity) of the same
+    stage: the load steps of a hysteresis loop solve one crank angle's contacts again and again."""
+    key = ("pair contacts", id(stage)) + tuple(id(c) for c, _ in sets)
+    entry = None if cache is None else cache.get(key)
+    if entry is not None and entry[0] is stage and all(a is c for a, (c, _) in zip(entry[1], sets)):
+        return entry[2], entry[3]
+    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
+    H = coupling_matrix(stage, systems, phases, sets)
+    if cache is not None:
+        cache[key] = (stage, [c for c, _ in sets], names, H)
+    return names, H
+
+
 def solve_pair(stage: ReducerStage, theta: float, start: PairResult | None = None, *,
                op: OperatingPoint | None = None, g_cache: dict | None = None) -> PairResult:
     """Solve the stage at crank angle θ (rad) and the operating point ``op`` (default the case's):
@@ -360,8 +375,7 @@ def _solve_pair(stage: ReducerStage, theta: float, start: PairResult | None, op:
     op = OperatingPoint.of(stage.first.case) if op is None else op
     systems, thetas, phases, sets = _bodies(stage, theta, op)
     case = stage.first.case
-    names = [f"disc {'AB'[k]} {n}" if len(sets) > 1 else n for k, (_, ns) in enumerate(sets) for n in ns]
-    H = coupling_matrix(stage, systems, phases, sets)
+    names, H = _pair_contacts(stage, systems, phases, sets, g_cache)
     sols = contact.solve_bodies(
         [contact.Body(c, s.interface, s.compliance) for s, (c, _) in zip(systems, sets)], stage.carrier_torque_Nmm(op),
         coupling=H, start=None if start is None else [r.solution for r in start.results],
@@ -430,6 +444,24 @@ def _prefetch_stage(stage: ReducerStage, systems: list, thetas: np.ndarray, solv
         sets = [contact_set(systems[k], _disc_angles(stage, float(thetas[i]))[k], op)[0]
                 for i in solve_at for k in ks]
         s.compliance.ensure(likely_columns(s, sets, stage.carrier_torque_Nmm(op)))
+
+
+def prefetch_columns(stage: ReducerStage, thetas, op: OperatingPoint, torques_Nmm=None) -> None:
+    """Build the contacts of both discs at the stage's crank angles ``thetas`` (rad) in one sweep
+    per disc model, and compute the compliance columns solves there will likely need
+    (:func:`likely_columns`, for each carrier torque in ``torques_Nmm``, N·mm; default the
+    operating point's) in one parallel sweep per model, instead of a few at a time as each solve
+    first needs them. For solves outside a load cycle at many crank angles (the transmission
+    error over a revolution); columns missed here are still computed when first needed."""
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    angles = [_disc_angles(stage, float(t)) for t in np.atleast_1d(thetas)]
+    torques = [stage.carrier_torque_Nmm(op)] if torques_Nmm is None else list(torques_Nmm)
+    for d, s in enumerate(systems):
+        contact_sets(s, [a[d] for a in angles], op)
+    for s in {id(s): s for s in systems}.values():
+        ks = [k for k, t in enumerate(systems) if t is s]
+        sets = [stage_contact_set(stage, systems[k], a[k], op)[0] for a in angles for k in ks]
+        s.compliance.ensure(np.unique(np.concatenate([likely_columns(s, sets, T) for T in torques])))
 
 
 def _stage_angle(stage: ReducerStage, pair: PairResult, swap: int, k: int, theta: float, order: int,

@@ -346,25 +346,35 @@ def _closed_form_law(params: dict[str, Any], seat_form: tuple[float, float, floa
     q_lim = np.minimum(q_lim_f, q_lim_s)
     d_lim = q_lim * (A - B * np.log(q_lim))
 
+    A_over_B = A / B
+    B_pins = np.broadcast_to(B, np.shape(A))     # B is one value for every pin, A one per pin
+    d_lim_pins = np.broadcast_to(d_lim, np.shape(A))
+
     def law(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         delta = np.asarray(delta, dtype=float)
-        shape = np.broadcast(delta, A).shape
-        d = np.broadcast_to(delta, shape)
-        if np.any(d > np.broadcast_to(d_lim, shape)):
+        if isinstance(A, np.ndarray) and (delta.shape == A.shape or (delta.size == 1 and delta.ndim <= A.ndim)):
+            # one approach per pin, or one for every pin: no broadcasting needed
+            d = delta if delta.shape == A.shape else np.full(A.shape, delta.reshape(()))
+            b_all, ab_all, dl = B_pins, A_over_B, d_lim_pins
+        else:
+            shape = np.broadcast(delta, A).shape
+            d = np.broadcast_to(delta, shape)
+            b_all, ab_all, dl = (np.broadcast_to(v, shape) for v in (B, A_over_B, d_lim))
+        if (d > dl).any():
             return fallback(delta)
-        q = np.zeros(shape)
-        dq = np.zeros(shape)
+        q = np.zeros(d.shape)
+        dq = np.zeros(d.shape)
         pos = d > 0
-        if not np.any(pos):
+        if not pos.any():
             return q, dq
-        a_, b_ = np.broadcast_to(A, shape)[pos], np.broadcast_to(B, shape)[pos]
-        t = -np.real(lambertw(-d[pos] / b_ * np.exp(-a_ / b_), k=-1))
-        lnq = a_ / b_ - t
+        b_, ab, dp = b_all[pos], ab_all[pos], d[pos]
+        t = -np.real(lambertw(-dp / b_ * np.exp(-ab), k=-1))
+        lnq = ab - t
         # one Newton step on ln Q polishes the root: f = ln(Q(A − B ln Q)) − ln δ, f' = 1 − 1/t
-        t1 = a_ / b_ - lnq
-        lnq = lnq - (np.log(b_ * t1) + lnq - np.log(d[pos])) / (1.0 - 1.0 / t1)
+        t1 = ab - lnq
+        lnq = lnq - (np.log(b_ * t1) + lnq - np.log(dp)) / (1.0 - 1.0 / t1)
         q[pos] = np.exp(lnq)
-        dq[pos] = 1.0 / (b_ * (a_ / b_ - lnq - 1.0))
+        dq[pos] = 1.0 / (b_ * (ab - lnq - 1.0))
         return q, dq
 
     return law

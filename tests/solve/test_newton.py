@@ -129,3 +129,98 @@ def test_a_mechanism_is_stepped_onto_its_springs_and_an_empty_one_is_an_error():
     it = contact.initial_iterate(problem, None, 1e-9)
     with pytest.raises(contact.ContactError, match="mechanism"):
         contact.newton_step(problem, it, 1e6, np.ones(problem.n))
+
+
+class _Elastic:
+    """A column compliance of a toy body: a fixed symmetric positive definite C (mm/N)."""
+
+    C = np.asfortranarray(np.array([[4.0, 1.0, 0.5, 0.2], [1.0, 3.0, 0.3, 0.1],
+                                    [0.5, 0.3, 5.0, 0.7], [0.2, 0.1, 0.7, 2.0]]) * 1e-6)
+
+    def ensure(self, columns):
+        pass
+
+
+def _two_elastic_bodies(law):
+    """Two elastic toy bodies on one carrier, each with a loaded and an open spring of one shared
+    (elementwise) law, a closed rigid contact and an open one, and bilateral ground springs in x
+    and y (no moments: solved with the rotations left out)."""
+    bodies = []
+    for sign in (1.0, -1.0):
+        b = _body([0, 0, 2, 3, 1, 3], [False, False, True, True, False, False], [0.0, 0.0, -1e-4, 0.05, 0.0, 0.0],
+                  [0.004, -0.01, 0.0, 0.0, 0.0, 0.0], [30.0 * sign, 10.0 * sign, 0.0, 0.0, 0.0, 0.0],
+                  [(np.array([0, 1]), law), (np.array([4, 5]), contact.linear_law(1e7, bilateral=True))])
+        bodies.append(contact.Body(b.cset, b.interface, _Elastic()))
+    return bodies
+
+
+def test_reduced_newton_step_solves_the_whole_newton_system():
+    """The step built from the unknown steps' rows alone (:func:`rvfem.solve.contact_newton.reduced_newton_step`)
+    solves the whole Newton system Jm·step = −r of :func:`rvfem.solve.contact.newton_matrix`, and is
+    the very step of its reduction by the known rows, on two elastic bodies with a loaded and an
+    open spring, an active and an inactive rigid contact each."""
+    from rvfem.solve.contact_newton import reduced_newton_step
+    problem = contact.ContactProblem(_two_elastic_bodies(contact.palmgren_law(9.0, contacts=2)), 5.0e4,
+                                     rigid_dofs=(0, 1))
+    lam = np.array([800.0, 0.0, 50.0, 0.0, 800.0, 50.0, 600.0, 0.0, 40.0, 0.0, 600.0, 40.0])
+    it = contact.NewtonIterate(lam, np.zeros(6), 2e-5, problem.sig & (problem.gap0 < 0)).update(problem)
+    assert (it.dq[problem.spring] == 0).any() and (it.dq[problem.spring] > 0).any()
+    kappa = 1.0e5
+    colscale = np.concatenate([np.ones(problem.nc), np.full(problem.n - problem.nc, 1e-5)])
+    Jm, r = contact.newton_matrix(problem, it, it.q, it.dq, kappa)
+    step = reduced_newton_step(problem, it, it.q, it.dq, kappa, colscale)
+    assert np.allclose(Jm @ step, -r, rtol=0, atol=1e-9 * np.abs(r).max())
+    known = contact.known_rows(problem, it.active, it.dq)
+    assert np.array_equal(step, contact._reduced_step(Jm, r, colscale, known))
+
+
+def test_a_shared_elementwise_law_is_evaluated_once_for_both_bodies():
+    """The springs of two bodies with one elementwise law are one group of the problem, and their
+    forces are the law's at each spring's own approach."""
+    law = contact.palmgren_law(9.0, contacts=2)
+    problem = contact.ContactProblem(_two_elastic_bodies(law), 5.0e4)
+    assert sum(1 for _, g in problem.laws if g is law) == 1
+    it = contact.NewtonIterate(np.zeros(problem.nc), np.zeros(6), 1e-4, np.zeros(problem.nc, dtype=bool)).update(problem)
+    springs = np.array([0, 1, 6, 7])
+    q, dq = law(it.delta[springs])
+    assert np.array_equal(it.q[springs], q) and np.array_equal(it.dq[springs], dq)
+
+
+def test_a_kept_contact_problem_solves_as_a_fresh_one():
+    """Solves of the same contacts at several torques with one ``g_cache`` (the torque-independent
+    parts of the problem and G kept between them) give the solutions of solves without it."""
+    bodies = [_body([0, 1, 0], [False, False, False], [0, 0, 0], [0.002, 0, -0.001], [40.0, 0.0, 20.0],
+                    [(np.array([0, 2]), contact.palmgren_law(9.0, contacts=2)),
+                     (np.array([1]), contact.linear_law(1.0e9, bilateral=True))])]
+    cache: dict = {}
+    for T in (5.0e4, 2.0e4, 5.0e4, 1.0e3):
+        kept = contact.solve_bodies(bodies, T, g_cache=cache, rigid_dofs=(0,))
+        fresh = contact.solve_bodies(bodies, T, rigid_dofs=(0,))
+        for a, b in zip(kept, fresh):
+            assert np.array_equal(a.force, b.force) and np.array_equal(a.rigid, b.rigid)
+            assert a.carrier_rotation == b.carrier_rotation
+    assert any(isinstance(k, tuple) and k and k[0] == "parts" for k in cache)
+
+
+@pytest.mark.parametrize("q_ref", [1e-3, 3.0, 850.0, 2.0e4, 1.0e6])
+def test_the_secant_bisection_is_eighty_halvings(q_ref):
+    """The secant stiffness of a cold start (:func:`rvfem.solve.contact_newton._bisected_secant`,
+    which skips the halvings a monotone law's probe force decides) is that of 80 plain halvings of
+    (0, 1] mm, for Palmgren's law and the Hertz pin law."""
+    from rvfem.solve.contact_newton import _bisected_secant
+
+    def halvings(law):
+        lo, hi = 0.0, 1.0
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if law(np.array([mid]))[0][0] < q_ref:
+                lo = mid
+            else:
+                hi = mid
+        return q_ref / max(hi, 1e-15)
+
+    pin = contact.hertz_pin_law(length=15.0, pin_radius=3.0, flank_curvature=np.array([0.02, -0.01]),
+                                pin_modulus=2.06e5, pin_poisson=0.3, disc_modulus=2.06e5, disc_poisson=0.3,
+                                footprint_half_width=0.5)
+    for law in (contact.palmgren_law(9.0, contacts=2), pin, contact.linear_law(3.0e5)):
+        assert _bisected_secant(law, q_ref) == halvings(law)
