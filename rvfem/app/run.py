@@ -54,6 +54,7 @@ from rvfem.app.analysis import (
 from rvfem.app import screen
 from rvfem.case.definition import Case
 from rvfem.outputs import summary as outputs
+from rvfem.outputs.plot_worker import PendingPlots, PlotWorker
 from rvfem.outputs.render import RenderWorker
 from rvfem.outputs.summary import IMAGE_SIZE, SCHEMA_VERSION
 
@@ -87,7 +88,10 @@ the plots are drawn by a child process (:class:`rvfem.outputs.render.RenderWorke
 writers on (the mesh picture from the end of the ``model`` stage on, during the load cycle), while
 this process writes the tables and the VTK files and then computes the attribution (it enters only
 the summary and the report; stage ``attribution``, reported after ``vtk``); the ``plots`` and
-``images`` stages are then the waits for the child process."""
+``images`` stages are then the waits for the child process. Without images the plots are drawn by a
+child process of their own (:class:`rvfem.outputs.plot_worker.PlotWorker`, started in the ``check``
+stage: it imports matplotlib during the analysis) while this process writes the tables and the VTK
+files; the ``plots`` stage is then the wait for it."""
 
 
 def summary_text(summary: dict) -> str:
@@ -223,19 +227,22 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
     checked = _checked_run(case, out_dir, stages, overrides=overrides, angle_step_deg=angle_step_deg,
                            bearing_model=bearing_model, order=order, field_step_deg=field_step_deg,
                            overwrite=overwrite, images=images)
-    worker = checked.worker
+    worker, plot_worker = checked.worker, checked.plot_worker
     try:
         with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
             try:
                 result, mesh_call = _analyse_for_run(checked, tmp, stages, progress=progress, cache_dir=cache_dir,
                                                      field_step_deg=field_step_deg)
-                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, mesh_call)
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, mesh_call,
+                                                        plot_worker=plot_worker)
             finally:
-                if worker is not None:
-                    worker.close()   # before the folder is moved or removed: nothing writes into it
+                for child in (worker, plot_worker):
+                    if child is not None:
+                        child.close()   # before the folder is moved or removed: nothing writes into it
     finally:
-        if worker is not None:
-            worker.close()
+        for child in (worker, plot_worker):
+            if child is not None:
+                child.close()
 
     return RunSummary(out_dir=out_dir, summary=summary, analysis=result, files=files)
 
@@ -251,11 +258,14 @@ class _CheckedRun:
     provenance : CaseProvenance
     worker : rvfem.outputs.render.RenderWorker or None
         The render worker checking off-screen rendering (None without images).
+    plot_worker : rvfem.outputs.plot_worker.PlotWorker or None
+        Without images, the child process that draws the plots (importing matplotlib meanwhile).
     """
 
     case: Case
     provenance: CaseProvenance
     worker: RenderWorker | None
+    plot_worker: PlotWorker | None = None
 
 
 def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, *, overrides: tuple[str, ...],
@@ -263,19 +273,22 @@ def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, 
                  field_step_deg: float | None, overwrite: bool, images: bool) -> _CheckedRun:
     """The ``check`` stage of :func:`run_case`: the case resolved with its options, its angles and
     the output folder checked, and with images the render worker started (its rendering check
-    runs meanwhile; one this process knows to fail raises at once)."""
+    runs meanwhile; one this process knows to fail raises at once), without them the plot worker
+    (:class:`rvfem.outputs.plot_worker.PlotWorker`)."""
     t = stages.start("check")
     case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
                                     bearing_model=bearing_model, order=order)
     _analysis.cycle_angles(case)
     _analysis.kept_field_angles(case, field_step_deg)
     outputs.check_output_folder(out_dir, overwrite)
-    worker = None
+    worker, plot_worker = None, None
     if images:
         worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
         worker.check(wait=False)            # raises at once if this process knows it fails
+    else:
+        plot_worker = PlotWorker()          # imports matplotlib while the analysis runs
     stages.end("check", t)
-    return _CheckedRun(case=case, provenance=provenance, worker=worker)
+    return _CheckedRun(case=case, provenance=provenance, worker=worker, plot_worker=plot_worker)
 
 
 def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progress: ProgressCallback | None,
@@ -324,7 +337,8 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
     return report
 
 
-def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None):
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None, *,
+                   plot_worker: PlotWorker | None = None):
     """Write every file of the result folder ``tmp``; returns the summary, the files and the
     analysis (with its attribution).
 
@@ -335,7 +349,8 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
     first (its child process draws them meanwhile); this process writes the tables and the VTK
     files, then computes the attribution (if the analysis left it: it enters only the summary and
     the report; after the VTK files, which a thread of pure Python beside them would slow down),
-    then waits for the plots and the images. Without a worker the plots are drawn here.
+    then waits for the plots and the images. Without a render worker the plots are drawn by
+    ``plot_worker`` while this process writes the tables and the VTK files, or here without one.
     """
     computed = []
 
@@ -346,7 +361,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
 
     registered = outputs.writers(images=worker is not None)
     written = _write_files(result, tmp, stages, worker, [w for w in registered if not w.needs_summary], mesh_call,
-                           meanwhile=attribute if result.attribution is None else None)
+                           meanwhile=attribute if result.attribution is None else None, plot_worker=plot_worker)
     if computed:
         (value, seconds), = computed
         result = dataclasses.replace(result, attribution=value,
@@ -384,17 +399,19 @@ def outside_stages(timings: dict) -> float:
 
 
 def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[outputs.Writer], mesh_call: int | None = None,
-                 meanwhile: Callable[[], None] | None = None) -> list[Path]:
+                 meanwhile: Callable[[], None] | None = None, plot_worker: PlotWorker | None = None) -> list[Path]:
     """Call the ``registered`` writers (the tables, the VTK files, the plots and the images), each
     run of writers sharing a stage reported as that stage. With ``worker`` the plots and the images
-    are handed to it first (the mesh picture is its call ``mesh_call`` if it was started already)
-    and the writers taking ``pending`` wait for them; ``meanwhile()`` is called before the first
-    of those."""
+    are handed to it first (the mesh picture is its call ``mesh_call`` if it was started already),
+    else the plots to ``plot_worker`` if given, and the writers taking ``pending`` wait for them;
+    ``meanwhile()`` is called before the first of those."""
     t_submit = time.perf_counter()
-    pending = None
+    pending: outputs.PendingImages | PendingPlots | None = None
     if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
         pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
                                         mesh_call=mesh_call)
+    elif plot_worker is not None:   # its child draws the plots while this process writes the rest
+        pending = plot_worker.submit(outputs.plot_calls(result, tmp))
     submitted = time.perf_counter() - t_submit
 
     written: list[Path] = []
@@ -415,8 +432,10 @@ def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[out
             drawn = time.perf_counter()
     if meanwhile is not None:   # no writer waited for the worker
         meanwhile()
-    if pending is not None:
+    if worker is not None:
         stages.seconds["images"] += submitted   # handing the drawings over counts as drawing
         # the child process draws while this one writes: the stages above are only the waits for it
         stages.seconds["drawing_background"] = drawn - t_submit
+    elif pending is not None and "plots" in stages.seconds:
+        stages.seconds["plots"] += submitted   # handing the plots over counts as plotting
     return written
