@@ -36,6 +36,7 @@ import dataclasses
 import itertools
 import logging
 import os
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -91,7 +92,8 @@ the summary and the report; stage ``attribution``, reported after ``vtk``); the 
 ``images`` stages are then the waits for the child process. Without images the plots are drawn by a
 child process of their own (:class:`rvfem.outputs.plot_worker.PlotWorker`, started in the ``check``
 stage: it imports matplotlib during the analysis) while this process writes the tables and the VTK
-files; the ``plots`` stage is then the wait for it."""
+files, and the ``plots`` stage is the wait for it; a process that has matplotlib loaded already
+(e.g. a study's worker after its first variant) draws them itself."""
 
 
 def summary_text(summary: dict) -> str:
@@ -274,7 +276,7 @@ def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, 
     """The ``check`` stage of :func:`run_case`: the case resolved with its options, its angles and
     the output folder checked, and with images the render worker started (its rendering check
     runs meanwhile; one this process knows to fail raises at once), without them the plot worker
-    (:class:`rvfem.outputs.plot_worker.PlotWorker`)."""
+    (:class:`rvfem.outputs.plot_worker.PlotWorker`) unless matplotlib is loaded here already."""
     t = stages.start("check")
     case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
                                     bearing_model=bearing_model, order=order)
@@ -285,8 +287,11 @@ def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, 
     if images:
         worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
         worker.check(wait=False)            # raises at once if this process knows it fails
-    else:
-        plot_worker = PlotWorker()          # imports matplotlib while the analysis runs
+    elif "matplotlib" not in sys.modules:
+        # a child imports matplotlib while the analysis runs, then draws the plots beside the other
+        # writers; a process that has matplotlib loaded already (a study's worker after its first
+        # variant) draws them itself, with nothing to hide and no process to start
+        plot_worker = PlotWorker()
     stages.end("check", t)
     return _CheckedRun(case=case, provenance=provenance, worker=worker, plot_worker=plot_worker)
 
