@@ -36,7 +36,6 @@ import dataclasses
 import itertools
 import logging
 import os
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -55,7 +54,6 @@ from rvfem.app.analysis import (
 from rvfem.app import screen
 from rvfem.case.definition import Case
 from rvfem.outputs import summary as outputs
-from rvfem.outputs.plot_worker import PendingPlots, PlotWorker
 from rvfem.outputs.render import RenderWorker
 from rvfem.outputs.summary import IMAGE_SIZE, SCHEMA_VERSION
 
@@ -89,11 +87,7 @@ the plots are drawn by a child process (:class:`rvfem.outputs.render.RenderWorke
 writers on (the mesh picture from the end of the ``model`` stage on, during the load cycle), while
 this process writes the tables and the VTK files and then computes the attribution (it enters only
 the summary and the report; stage ``attribution``, reported after ``vtk``); the ``plots`` and
-``images`` stages are then the waits for the child process. Without images the plots are drawn by a
-child process of their own (:class:`rvfem.outputs.plot_worker.PlotWorker`, started in the ``check``
-stage: it imports matplotlib during the analysis) while this process writes the tables and the VTK
-files, and the ``plots`` stage is the wait for it; a process that has matplotlib loaded already
-(e.g. a study's worker after its first variant) draws them itself."""
+``images`` stages are then the waits for the child process."""
 
 
 def summary_text(summary: dict) -> str:
@@ -229,22 +223,19 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
     checked = _checked_run(case, out_dir, stages, overrides=overrides, angle_step_deg=angle_step_deg,
                            bearing_model=bearing_model, order=order, field_step_deg=field_step_deg,
                            overwrite=overwrite, images=images)
-    worker, plot_worker = checked.worker, checked.plot_worker
+    worker = checked.worker
     try:
         with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
             try:
                 result, mesh_call = _analyse_for_run(checked, tmp, stages, progress=progress, cache_dir=cache_dir,
                                                      field_step_deg=field_step_deg)
-                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, mesh_call,
-                                                        plot_worker=plot_worker)
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, mesh_call)
             finally:
-                for child in (worker, plot_worker):
-                    if child is not None:
-                        child.close()   # before the folder is moved or removed: nothing writes into it
+                if worker is not None:
+                    worker.close()   # before the folder is moved or removed: nothing writes into it
     finally:
-        for child in (worker, plot_worker):
-            if child is not None:
-                child.close()
+        if worker is not None:
+            worker.close()
 
     return RunSummary(out_dir=out_dir, summary=summary, analysis=result, files=files)
 
@@ -260,14 +251,11 @@ class _CheckedRun:
     provenance : CaseProvenance
     worker : rvfem.outputs.render.RenderWorker or None
         The render worker checking off-screen rendering (None without images).
-    plot_worker : rvfem.outputs.plot_worker.PlotWorker or None
-        Without images, the child process that draws the plots (importing matplotlib meanwhile).
     """
 
     case: Case
     provenance: CaseProvenance
     worker: RenderWorker | None
-    plot_worker: PlotWorker | None = None
 
 
 def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, *, overrides: tuple[str, ...],
@@ -275,25 +263,19 @@ def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, 
                  field_step_deg: float | None, overwrite: bool, images: bool) -> _CheckedRun:
     """The ``check`` stage of :func:`run_case`: the case resolved with its options, its angles and
     the output folder checked, and with images the render worker started (its rendering check
-    runs meanwhile; one this process knows to fail raises at once), without them the plot worker
-    (:class:`rvfem.outputs.plot_worker.PlotWorker`) unless matplotlib is loaded here already."""
+    runs meanwhile; one this process knows to fail raises at once)."""
     t = stages.start("check")
     case, provenance = resolve_case(case, overrides=overrides, angle_step_deg=angle_step_deg,
                                     bearing_model=bearing_model, order=order)
     _analysis.cycle_angles(case)
     _analysis.kept_field_angles(case, field_step_deg)
     outputs.check_output_folder(out_dir, overwrite)
-    worker, plot_worker = None, None
+    worker = None
     if images:
         worker = RenderWorker(IMAGE_SIZE)   # checks off-screen rendering meanwhile
         worker.check(wait=False)            # raises at once if this process knows it fails
-    elif "matplotlib" not in sys.modules:
-        # a child imports matplotlib while the analysis runs, then draws the plots beside the other
-        # writers; a process that has matplotlib loaded already (a study's worker after its first
-        # variant) draws them itself, with nothing to hide and no process to start
-        plot_worker = PlotWorker()
     stages.end("check", t)
-    return _CheckedRun(case=case, provenance=provenance, worker=worker, plot_worker=plot_worker)
+    return _CheckedRun(case=case, provenance=provenance, worker=worker)
 
 
 def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progress: ProgressCallback | None,
@@ -342,8 +324,7 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
     return report
 
 
-def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None, *,
-                   plot_worker: PlotWorker | None = None):
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None):
     """Write every file of the result folder ``tmp``; returns the summary, the files and the
     analysis (with its attribution).
 
@@ -354,8 +335,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
     first (its child process draws them meanwhile); this process writes the tables and the VTK
     files, then computes the attribution (if the analysis left it: it enters only the summary and
     the report; after the VTK files, which a thread of pure Python beside them would slow down),
-    then waits for the plots and the images. Without a render worker the plots are drawn by
-    ``plot_worker`` while this process writes the tables and the VTK files, or here without one.
+    then waits for the plots and the images. Without a worker the plots are drawn here.
     """
     computed = []
 
@@ -366,7 +346,7 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
 
     registered = outputs.writers(images=worker is not None)
     written = _write_files(result, tmp, stages, worker, [w for w in registered if not w.needs_summary], mesh_call,
-                           meanwhile=attribute if result.attribution is None else None, plot_worker=plot_worker)
+                           meanwhile=attribute if result.attribution is None else None)
     if computed:
         (value, seconds), = computed
         result = dataclasses.replace(result, attribution=value,
@@ -404,19 +384,17 @@ def outside_stages(timings: dict) -> float:
 
 
 def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[outputs.Writer], mesh_call: int | None = None,
-                 meanwhile: Callable[[], None] | None = None, plot_worker: PlotWorker | None = None) -> list[Path]:
+                 meanwhile: Callable[[], None] | None = None) -> list[Path]:
     """Call the ``registered`` writers (the tables, the VTK files, the plots and the images), each
     run of writers sharing a stage reported as that stage. With ``worker`` the plots and the images
-    are handed to it first (the mesh picture is its call ``mesh_call`` if it was started already),
-    else the plots to ``plot_worker`` if given, and the writers taking ``pending`` wait for them;
-    ``meanwhile()`` is called before the first of those."""
+    are handed to it first (the mesh picture is its call ``mesh_call`` if it was started already)
+    and the writers taking ``pending`` wait for them; ``meanwhile()`` is called before the first
+    of those."""
     t_submit = time.perf_counter()
-    pending: outputs.PendingImages | PendingPlots | None = None
+    pending = None
     if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
         pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
                                         mesh_call=mesh_call)
-    elif plot_worker is not None:   # its child draws the plots while this process writes the rest
-        pending = plot_worker.submit(outputs.plot_calls(result, tmp))
     submitted = time.perf_counter() - t_submit
 
     written: list[Path] = []
@@ -437,10 +415,8 @@ def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[out
             drawn = time.perf_counter()
     if meanwhile is not None:   # no writer waited for the worker
         meanwhile()
-    if worker is not None:
+    if pending is not None:
         stages.seconds["images"] += submitted   # handing the drawings over counts as drawing
         # the child process draws while this one writes: the stages above are only the waits for it
         stages.seconds["drawing_background"] = drawn - t_submit
-    elif pending is not None and "plots" in stages.seconds:
-        stages.seconds["plots"] += submitted   # handing the plots over counts as plotting
     return written

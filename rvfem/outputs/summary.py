@@ -50,7 +50,6 @@ from rvfem.evaluate.hertz import RIGID_ROLLER_MODEL
 from rvfem.evaluate.rigid import references
 from rvfem.geometry import crank_centres
 from rvfem.outputs import plots, render, tables, vtkio
-from rvfem.outputs.plot_worker import PendingPlots
 from rvfem.outputs.plots import mesh_plot, rim_closeup
 from rvfem.outputs.registry import Writer, register_writer, writers
 from rvfem.outputs.report import write_report as _write_html
@@ -697,14 +696,12 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
                  files=tuple(f"plots/{name}.png" for name in ("bearing_loads", "roller_loads", "pin_forces",
                                                             "pins_in_contact", "roller_pressure",
                                                             "roller_damage")))
-def write_plots(analysis, folder: str | os.PathLike, *,
-                pending: PendingImages | PendingPlots | None = None) -> list[Path]:
+def write_plots(analysis, folder: str | os.PathLike, *, pending: PendingImages | None = None) -> list[Path]:
     """Draw ``plots/``: bearing loads over θ (flexible vs the bearing-load reference: the handbook, or
     the equal share where it is not defined), roller loads and pin forces at the angle of the
     largest bearing load, pins in contact over θ (matplotlib, :mod:`rvfem.outputs.plots`). With
-    ``pending`` (:func:`submit_images` given :func:`plot_calls`, or
-    :meth:`rvfem.outputs.plot_worker.PlotWorker.submit`) the plots a child process is drawing are
-    waited for instead."""
+    ``pending`` (:func:`submit_images` given :func:`plot_calls`) the plots a render worker is
+    drawing are waited for instead."""
     if pending is not None:
         return pending.calls_result()
     return [function(**kwargs) for function, kwargs in plot_calls(analysis, folder)]
