@@ -2,7 +2,10 @@
 
 Every CSV file rvfem writes (the run's tables, ``roller_pressure.csv``, ``hysteresis.csv``,
 ``te.csv``, a study's ``study.csv`` and an optimisation's ``trials.csv``) goes through
-:func:`write_csv` or :func:`csv_text`, so they all read back the same way.
+:func:`write_csv`, :func:`write_csv_columns` or :func:`csv_text`, so they all read back the same way.
+:func:`write_csv_columns` writes a table given by its columns (the long tables of a run: one row per
+crank angle and roller or pin) with the same text as :func:`write_csv`, formatting a NumPy column
+in one pass (:func:`format_column`) instead of cell by cell.
 
 The policy (documented for users in ``docs/outputs.md``, section "CSV tables"):
 
@@ -31,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["csv_text", "format_cell", "write_csv"]
+__all__ = ["csv_text", "format_cell", "format_column", "write_csv", "write_csv_columns"]
 
 
 def format_cell(value: Any, *, nan_as_empty: bool = False) -> str:
@@ -61,6 +64,38 @@ def format_cell(value: Any, *, nan_as_empty: bool = False) -> str:
             return "" if nan_as_empty else "nan"
         return repr(x)
     return str(value)
+
+
+def format_column(values: np.ndarray | Sequence[Any], *, nan_as_empty: bool = False) -> list[str]:
+    """The cells of one column of a CSV file, each exactly as :func:`format_cell` writes it.
+
+    A one-dimensional NumPy array of floats, integers or bools is formatted in one pass (its
+    values as Python numbers, ``repr`` or ``str`` mapped over them: a tenth of the time of a call
+    of :func:`format_cell` per cell); anything else cell by cell.
+
+    Parameters
+    ----------
+    values : ndarray (n,) or sequence
+        The column's values.
+    nan_as_empty : bool
+        Write NaN as an empty cell instead of ``nan``.
+
+    Returns
+    -------
+    list of str
+    """
+    if isinstance(values, np.ndarray) and values.ndim == 1:
+        kind = values.dtype.kind
+        if kind == "f":
+            cells = list(map(repr, values.astype(float, copy=False).tolist()))   # NaN gives "nan"
+            if nan_as_empty and bool(np.isnan(values).any()):
+                cells = ["" if cell == "nan" else cell for cell in cells]
+            return cells
+        if kind in "iu":
+            return list(map(str, values.tolist()))
+        if kind == "b":
+            return ["yes" if v else "no" for v in values.tolist()]
+    return [format_cell(v, nan_as_empty=nan_as_empty) for v in values]
 
 
 def _write_rows(fh, header: Sequence[str], rows: Iterable[Sequence[Any]], nan_as_empty: bool) -> None:
@@ -115,4 +150,43 @@ def write_csv(path: str | os.PathLike, header: Sequence[str], rows: Iterable[Seq
     path = Path(path)
     with path.open("w", newline="", encoding="utf-8") as fh:
         _write_rows(fh, header, rows, nan_as_empty)
+    return path
+
+
+def write_csv_columns(path: str | os.PathLike, header: Sequence[str],
+                      columns: Sequence[np.ndarray | Sequence[Any]], *, nan_as_empty: bool = False) -> Path:
+    """Write a CSV file given by its columns: the same file as :func:`write_csv` with the rows
+    ``zip(*columns)``, each column formatted in one pass (:func:`format_column`).
+
+    Parameters
+    ----------
+    path : path-like
+        The file to write (replaced if it exists).
+    header : sequence of str
+        Column names (with their units).
+    columns : sequence of ndarray (n,) or sequences
+        One per name of ``header``, all of the same length (the rows).
+    nan_as_empty : bool
+        Write NaN as an empty cell instead of ``nan``.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        The columns are not one per name, or not all of the same length.
+    """
+    if len(columns) != len(header):
+        raise ValueError(f"{len(columns)} columns for {len(header)} names in the header of {Path(path).name}")
+    cells = [format_column(c, nan_as_empty=nan_as_empty) for c in columns]
+    if len({len(c) for c in cells}) > 1:
+        raise ValueError(f"the columns of {Path(path).name} differ in length: {sorted({len(c) for c in cells})}")
+    path = Path(path)
+    with path.open("w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(header)
+        writer.writerows(zip(*cells))
     return path

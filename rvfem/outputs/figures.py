@@ -20,10 +20,16 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["DPI", "new_figure", "save_figure"]
+__all__ = ["DPI", "PNG_COMPRESS_LEVEL", "new_figure", "save_figure"]
 
 DPI = 120
 """Resolution of every plot's PNG, dots per inch."""
+
+PNG_COMPRESS_LEVEL = 3
+"""zlib level of the plots' PNG files (0-9). The plots are large white areas with thin lines and
+text: level 3 encodes them in about two thirds of the time of zlib's default (6, what matplotlib
+asks for otherwise), with the same pixels; the files of a run come out about 10 % smaller together
+(the mesh picture a quarter smaller, the line plots up to a fifth larger)."""
 
 
 def new_figure(size: tuple[float, float]) -> Figure:
@@ -51,6 +57,23 @@ def new_figure(size: tuple[float, float]) -> Figure:
     return fig
 
 
+def _drop_layout_placeholder(fig: Figure) -> None:
+    """Forget the do-nothing layout engine ``fig.tight_layout()`` leaves behind.
+
+    ``tight_layout`` lays the figure out once and then sets a placeholder layout engine that does
+    nothing; but ``savefig`` sees *a* layout engine and draws the whole figure once more (with
+    rendering switched off) before the real drawing, for a layout that is already done (a tenth
+    to a fifth of a plot's time). Without the placeholder the PNG is the same, drawn once. A
+    layout engine that lays out (constrained, or the rcParams' automatic layouts) is kept.
+    """
+    import matplotlib as mpl  # drawing only: matplotlib is a heavy import the solver never needs
+    from matplotlib.layout_engine import PlaceHolderLayoutEngine
+
+    automatic = mpl.rcParams["figure.autolayout"] or mpl.rcParams["figure.constrained_layout.use"]
+    if isinstance(fig.get_layout_engine(), PlaceHolderLayoutEngine) and not automatic:
+        fig.set_layout_engine(None)
+
+
 def save_figure(fig: Figure, path: str | os.PathLike[str], *, dpi: int = DPI) -> Path:
     """Write ``fig`` as a PNG at ``path`` (its folder is created if missing) and close it.
 
@@ -73,6 +96,7 @@ def save_figure(fig: Figure, path: str | os.PathLike[str], *, dpi: int = DPI) ->
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi, bbox_inches=None)
+    _drop_layout_placeholder(fig)
+    fig.savefig(path, dpi=dpi, bbox_inches=None, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
     fig.clear()
     return path

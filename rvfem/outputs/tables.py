@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from rvfem.evaluate import strength
-from rvfem.outputs.csvfile import write_csv
+from rvfem.outputs.csvfile import write_csv, write_csv_columns
 from rvfem.units import arcmin_from_rad, crank_angle_deg
 
 __all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "write_cycle_table",
@@ -39,6 +39,11 @@ __all__ = ["write_bearing_loads", "write_roller_loads", "write_pin_forces", "wri
 
 def _write(path: str | os.PathLike, header: list[str], rows) -> Path:
     return write_csv(path, header, rows)
+
+
+def _degrees(theta: np.ndarray) -> np.ndarray:
+    """:func:`rvfem.units.crank_angle_deg` of every angle (the same numbers, one call per angle)."""
+    return np.array([crank_angle_deg(t) for t in np.asarray(theta, dtype=float).ravel().tolist()], dtype=float)
 
 
 def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np.ndarray,
@@ -68,17 +73,12 @@ def write_bearing_loads(path: str | os.PathLike, theta: np.ndarray, flexible: np
         for name, _ in models[2:]:
             header += [f"bearing{i}_{name}_Fx_N", f"bearing{i}_{name}_Fy_N", f"bearing{i}_{name}_F_N"]
     mags = {name: np.linalg.norm(f, axis=2) for name, f in models}
-
-    def rows():
-        for k, th in enumerate(theta):
-            row = [crank_angle_deg(th)]
-            for group in (models[:2], models[2:]):
-                for i in range(n_b):
-                    for name, f in group:
-                        row += [f[k, i, 0], f[k, i, 1], mags[name][k, i]]
-            yield row
-
-    return _write(path, header, rows())
+    columns = [_degrees(theta)]
+    for group in (models[:2], models[2:]):
+        for i in range(n_b):
+            for name, f in group:
+                columns += [f[:, i, 0], f[:, i, 1], mags[name][:, i]]
+    return write_csv_columns(path, header, columns)
 
 
 def write_roller_loads(path: str | os.PathLike, theta: np.ndarray, roller_angles: np.ndarray,
@@ -96,15 +96,10 @@ def write_roller_loads(path: str | os.PathLike, theta: np.ndarray, roller_angles
         N.
     """
     n, n_b, z = roller_loads.shape
-
-    def rows():
-        for k in range(n):
-            deg = crank_angle_deg(theta[k])
-            for i in range(n_b):
-                for j in range(z):
-                    yield [deg, i + 1, j + 1, crank_angle_deg(roller_angles[k, i, j]) % 360.0, roller_loads[k, i, j]]
-
-    return _write(path, ["theta_deg", "bearing", "roller", "roller_angle_deg", "load_N"], rows())
+    angles = np.array([crank_angle_deg(a) % 360.0 for a in np.asarray(roller_angles, dtype=float).ravel().tolist()])
+    columns = [np.repeat(_degrees(theta), n_b * z), np.tile(np.repeat(np.arange(1, n_b + 1), z), n),
+               np.tile(np.arange(1, z + 1), n * n_b), angles, np.asarray(roller_loads).reshape(-1)]
+    return write_csv_columns(path, ["theta_deg", "bearing", "roller", "roller_angle_deg", "load_N"], columns)
 
 
 def write_pin_forces(path: str | os.PathLike, theta: np.ndarray, pin_xy: np.ndarray, flexible: np.ndarray,
@@ -124,14 +119,10 @@ def write_pin_forces(path: str | os.PathLike, theta: np.ndarray, pin_xy: np.ndar
         Classical rigid pin forces, N.
     """
     n, zp = flexible.shape
-
-    def rows():
-        for k in range(n):
-            deg = crank_angle_deg(theta[k])
-            for j in range(zp):
-                yield [deg, j + 1, pin_xy[k, j, 0], pin_xy[k, j, 1], flexible[k, j], classical[k, j]]
-
-    return _write(path, ["theta_deg", "pin", "x_mm", "y_mm", "flexible_N", "classical_N"], rows())
+    pin_xy = np.asarray(pin_xy)
+    columns = [np.repeat(_degrees(theta), zp), np.tile(np.arange(1, zp + 1), n), pin_xy[:, :, 0].reshape(-1),
+               pin_xy[:, :, 1].reshape(-1), np.asarray(flexible).reshape(-1), np.asarray(classical).reshape(-1)]
+    return write_csv_columns(path, ["theta_deg", "pin", "x_mm", "y_mm", "flexible_N", "classical_N"], columns)
 
 
 def write_cycle_table(path: str | os.PathLike, theta: np.ndarray, pins_in_contact: np.ndarray,

@@ -43,3 +43,30 @@ print("ok")
 """
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+def _laid_out_figure():
+    fig = new_figure((5.0, 3.0))
+    axes = fig.subplots(1, 2)
+    axes[0].plot([0.0, 1.0, 2.0], [1.0, 3.0, 2.0], label="a line")
+    axes[1].bar([1, 2, 3], [3.0, 1.0, 2.0])
+    axes[0].set_title("a title that tight_layout makes room for")
+    axes[0].legend()
+    fig.tight_layout()
+    return fig
+
+
+def test_a_laid_out_plot_is_drawn_once_with_the_pixels_matplotlib_draws(tmp_path):
+    import numpy as np
+
+    reference = _laid_out_figure()
+    reference.savefig(tmp_path / "reference.png", dpi=DPI)   # matplotlib's own savefig: drawn twice
+
+    fig = _laid_out_figure()
+    draws = []
+    draw = fig.draw
+    fig.draw = lambda renderer: (draws.append(renderer), draw(renderer))[1]
+    path = save_figure(fig, tmp_path / "once.png")
+    assert len(draws) == 1
+    with Image.open(path) as once, Image.open(tmp_path / "reference.png") as ref:
+        assert np.array_equal(np.asarray(once), np.asarray(ref))
