@@ -69,6 +69,15 @@ sys.exit(cli.main(sys.argv[1:]))
 """
 
 
+def _as_terminal_job() -> None:
+    """In a child before it runs the command: SIGINT unblocked and at its default action, as in a
+    job started from a terminal. A child inherits its parent's blocked signals and ignored ones,
+    and a test process that ran clusters and child processes before may hold SIGINT so (seen with
+    parallel test workers): the command would then never see the Ctrl-C these tests send."""
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _env() -> dict:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT), *filter(None, [env.get("PYTHONPATH")])])
@@ -257,7 +266,8 @@ values = [250.0, 300.0, 350.0, 450.0, 500.0, 550.0]
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-c", RUNNER, "study", str(study_file), "-o", str(out),
                              "--scheduler", scheduler, "--cache-dir", str(meshes)],
-                            env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_as_terminal_job)
     try:
         end = time.monotonic() + 90
         while not list((out / "variants").glob("*/summary.json")):
@@ -617,7 +627,8 @@ values = [250.0, 300.0, 350.0, 450.0, 500.0]
     proc = subprocess.Popen([sys.executable, "-c", RUNNER, "study", str(study_file), "-o", str(out),
                              "--workers", "2", "--cache-dir", str(meshes)],
                             env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)   # its own process group, as a terminal's job
+                            start_new_session=True,   # its own process group, as a terminal's job
+                            preexec_fn=_as_terminal_job)
     try:
         end = time.monotonic() + 240
         while not list((out / "variants").glob("*/summary.json")):
