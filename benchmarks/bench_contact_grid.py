@@ -30,23 +30,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from rvfem.case.definition import case_from_dict, case_to_dict, load_case  # noqa: E402
+from bench_convergence import scaled  # noqa: E402  (the scripts' own folder is on the path)
+from rvfem.case.definition import load_case  # noqa: E402
 from rvfem.geometry import disc_geometry  # noqa: E402
 from rvfem.mesh import mesh_case  # noqa: E402
 from rvfem.solve import cycle  # noqa: E402
-
-
-def variant(case, factor: float, grid: float | None):
-    """The case with every element size × ``factor`` and, with ``grid``, the contact grid fixed at
-    the case's own flank and bore sizes × ``grid``."""
-    data = case_to_dict(case)
-    own = dict(data["mesh"])
-    for key in ("size_flank", "size_bore", "size_interior", "size_hole", "size_fillet"):
-        if data["mesh"].get(key) is not None:
-            data["mesh"][key] *= factor
-    if grid is not None:
-        data["mesh"].update(contact_grid_flank=own["size_flank"] * grid, contact_grid_bore=own["size_bore"] * grid)
-    return case_from_dict(data, source=f"{case.source} × {factor:g}")
 
 
 def measure(case, mesh_dir: str) -> dict:
@@ -77,7 +65,7 @@ def main(argv=None) -> None:
     rows = []
     for label, grid in (("vertex", None), (f"fixed × {args.grid:g}", args.grid)):
         for factor in args.factors:
-            row = {"grid": label, "factor": factor, **measure(variant(base, factor, grid), args.mesh_dir)}
+            row = {"grid": label, "factor": factor, **measure(scaled(base, factor, grid), args.mesh_dir)}
             rows.append(row)
             print(json.dumps(row), flush=True)
     ref = next(r for r in rows if r["grid"] == "vertex" and r["factor"] == 1.0) if 1.0 in args.factors else rows[0]

@@ -19,8 +19,11 @@ Richardson extrapolation f∞ = f₃ + (f₃ − f₂)/(2^p − 1) with the obse
 p = log2((f₂ − f₁)/(f₃ − f₂)); each mesh's error against the finest three's f∞ is printed beside
 the run's own estimate. docs/outputs.md quotes ``--hole-factors 1 0.5 0.25 0.125``.
 
+With ``--fixed-contact-grid`` the contact grid stays that of the case's own mesh
+(``mesh.contact_grid_*``): the loads' change is then the FE discretisation's alone.
+
 Run: ``python benchmarks/bench_convergence.py [CASE] [--factors 2 1.4 1 0.7 0.5] [--step 1]
-[--bearing-model rollers]``; ``python benchmarks/bench_convergence.py --stress [CASE]
+[--bearing-model rollers] [--fixed-contact-grid]``; ``python benchmarks/bench_convergence.py --stress [CASE]
 [--hole-factors 1 0.5 0.25] [--step 1] [--window 10]`` (about 2 minutes on two cores, 4 with the
 factor 0.125 added).
 """
@@ -43,13 +46,19 @@ from rvfem.case.definition import case_from_dict, case_to_dict, load_case  # noq
 from rvfem.mesh import mesh_case  # noqa: E402
 
 
-def scaled(case, factor: float):
+def scaled(case, factor: float, grid: float | None = None):
     """The case with every element size of its ``[mesh]`` table multiplied by ``factor``
-    (``size_hole`` too when the case sets it; otherwise its default follows ``size_bore``)."""
+    (``size_hole`` and ``size_fillet`` too when the case sets them; otherwise their defaults follow
+    ``size_bore``). With ``grid``, the contact grid is fixed at the case's own flank and bore sizes
+    × ``grid`` (``mesh.contact_grid_flank`` / ``contact_grid_bore``, docs/theory.md § 5): only the
+    FE mesh is refined, not the contact model."""
     data = case_to_dict(case)
-    for key in ("size_flank", "size_bore", "size_interior", "size_hole"):
+    own = dict(data["mesh"])
+    for key in ("size_flank", "size_bore", "size_interior", "size_hole", "size_fillet"):
         if data["mesh"].get(key) is not None:
             data["mesh"][key] *= factor
+    if grid is not None:
+        data["mesh"].update(contact_grid_flank=own["size_flank"] * grid, contact_grid_bore=own["size_bore"] * grid)
     return case_from_dict(data, source=case.source)
 
 
@@ -140,6 +149,8 @@ def main(argv=None) -> int:
     ap.add_argument("--factors", type=float, nargs="+", default=[2.0, 1.4, 1.0, 0.7, 0.5])
     ap.add_argument("--step", type=float, default=1.0)
     ap.add_argument("--bearing-model", default=None)
+    ap.add_argument("--fixed-contact-grid", action="store_true",
+                    help="keep the contact grid of the case's own mesh while the mesh is refined")
     ap.add_argument("--mesh-dir", default="meshes")
     ap.add_argument("--stress", action="store_true",
                     help="convergence of the structural stress peak under refinement of mesh.size_hole")
@@ -157,7 +168,7 @@ def main(argv=None) -> int:
     prev = None
     rows = [(f, 1) for f in sorted(args.factors, reverse=True)] + [(1.0, 2)]
     for factor, order in rows:
-        case = scaled(base, factor)
+        case = scaled(base, factor, 1.0 if args.fixed_contact_grid else None)
         mesh, system, b, wall = run(case, order, args.step, args.bearing_model, args.mesh_dir)
         f = b.flexible
         if prev is not None and order == 1:
