@@ -251,26 +251,36 @@ class _SingleThreadedBlasSetup:
     """Worker plugin: one worker, one core.
 
     Limits the BLAS/OpenMP thread pools of the worker to one thread (also in workers started by
-    hand, without the nanny's environment). With ``pin_core=True`` (the workers of
-    :func:`local_cluster`) it also pins the worker process to one core of the machine, worker
-    ``i`` to the ``i``-th allowed core, so that the few threads an analysis starts itself (the
-    parallel back-substitutions of the contact columns) share that core instead of competing with
-    the other workers (Linux; elsewhere a no-op).
+    hand, without the nanny's environment). With ``local=True`` (the workers of
+    :func:`local_cluster`, which share this process's terminal) it also
+
+    - pins the worker process to one core of the machine, worker ``i`` to the ``i``-th allowed
+      core, so that the few threads an analysis starts itself (the parallel back-substitutions of
+      the contact columns) share that core instead of competing with the other workers (Linux;
+      elsewhere a no-op);
+    - keeps Dask's own log messages in the worker to critical ones. A local worker writes to the
+      user's terminal, and what it would say there is either reported by the study itself (a
+      variant that fails is a record with its error; a worker that dies is a ``KilledWorker``) or
+      noise of a shutdown: after Ctrl-C the scheduler may close while a worker's heartbeat is in
+      flight, and the worker would print "Failed to communicate with scheduler during heartbeat"
+      with its traceback under the command's one line "interrupted".
     """
 
     name = "rvfem-single-threaded-blas"
     idempotent = True
 
-    def __init__(self, pin_core: bool = False):
-        self.pin_core = pin_core
+    def __init__(self, local: bool = False):
+        self.local = local
 
     def setup(self, worker) -> None:
         try:
-
             self._limits = threadpool_limits(limits=1)
         except Exception:  # a library threadpoolctl cannot control: leave it
             log.debug("threadpoolctl could not limit the thread pools", exc_info=True)
-        if self.pin_core and isinstance(worker.name, int) and hasattr(os, "sched_setaffinity"):
+        if self.local:
+            for name in ("distributed", "tornado"):
+                logging.getLogger(name).setLevel(logging.CRITICAL)
+        if self.local and isinstance(worker.name, int) and hasattr(os, "sched_setaffinity"):
             try:
                 cores = sorted(os.sched_getaffinity(0))
                 core = {cores[worker.name % len(cores)]}
@@ -298,9 +308,9 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def _single_threaded_blas_plugin(pin_core: bool = False):
+def _single_threaded_blas_plugin(local: bool = False):
     """A ``SingleThreadedBlas`` plugin (:func:`_plugin_class`)."""
-    return _plugin_class()(pin_core=pin_core)
+    return _plugin_class()(local=local)
 
 
 def local_cluster(workers: int | None = None):
@@ -328,7 +338,7 @@ def local_cluster(workers: int | None = None):
             return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                 scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                                 env=env, silence_logs=logging.ERROR, host="127.0.0.1",
-                                plugins=(_single_threaded_blas_plugin(pin_core=True),))
+                                plugins=(_single_threaded_blas_plugin(local=True),))
     except Exception as exc:
         raise ClusterError(f"cannot start a local Dask cluster of {n} workers: {_one_line(exc)}") from None
 
