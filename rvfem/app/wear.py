@@ -129,10 +129,7 @@ def worn_stage(system, worn: Case, deviation: FlankDeviation | None):
     """The stage of ``worn`` on the factorised disc of ``system`` (same mesh, model and column
     compliance): the gaps of its profile plus ``deviation``
     (:attr:`rvfem.solve.cycle.DiscSystem.flank_deviation`), the bearing laws of its clearances."""
-    bearing_class = models.bearing_model(system.bearing_model)
-    bearings = (bearing_class(worn, system.bearing_stiffness_scale, disc_stiffness_scale=system.stiffness_scale)
-                if getattr(bearing_class, "takes_disc_stiffness_scale", False)
-                else bearing_class(worn, system.bearing_stiffness_scale))
+    bearings = models.bearing_laws(system.bearing_model, worn, system.bearing_stiffness_scale, system.stiffness_scale)
     geometry = system.geometry if worn is system.case else disc_geometry(worn)
     worn_system = dataclasses.replace(system, case=worn, geometry=geometry, bearings=bearings,
                                       contact_sets={}, flank_deviation=deviation)

@@ -99,6 +99,34 @@ class Compliance:
         self._orbits = None if rotation is None else column_orbits(sp.csr_matrix(rotation), self.order)
         self._lock = threading.Lock()
 
+    def scaled(self, factor: float) -> "Compliance":
+        """The compliance of the same disc with its stiffness × ``factor`` (its Young's modulus;
+        linear elasticity: every displacement ÷ ``factor``): the columns known so far carried over
+        divided by ``factor``, the rest back-substituted on the same factorisation when first
+        needed, scaled alike. A new cache; this one is left as it is."""
+        factor = float(factor)
+        new = object.__new__(Compliance)
+        new.__dict__.update(self.__dict__)
+
+        def solve(rhs, _solve=self._solve):
+            return _solve(rhs) / factor
+
+        new._solve = solve
+        with self._lock:
+            new.C = np.asfortranarray(self.C / factor)
+            new.known = self.known.copy()
+        new.solve_seconds, new.columns_solved, new.columns_mapped = 0.0, 0, 0
+        if self._free is not None:
+            solve_free, B_f, B_fT, BtZ, HRvtZ = self._free
+
+            def free_solve(rhs, _solve=solve_free):
+                return _solve(rhs) / factor
+
+            new._free = (free_solve, B_f, B_fT, BtZ / factor, HRvtZ / factor)
+            new._rhs = threading.local()
+        new._lock = threading.Lock()
+        return new
+
     @property
     def symmetric(self) -> bool:
         """True when columns are mapped by the disc's rotation symmetry."""

@@ -65,7 +65,7 @@ from rvfem.solve.cycle_symmetry import (
     turn_result,
     turned_nodes,
 )
-from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, build_system
+from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, build_system, scaled_system
 from rvfem.solve.models import roller_angles
 from rvfem.solve.stage_parts import case_stage
 from rvfem.units import arcmin_from_rad, nm_from_nmm
@@ -86,6 +86,7 @@ __all__ = [
     "AngleResult",
     "CycleResult",
     "build_system",
+    "scaled_system",
     "contact_set",
     "solve_angle",
     "load_cycle",

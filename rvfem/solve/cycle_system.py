@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -178,11 +178,7 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
     pin_model = pin_model or case.pins.model
     try:
         pins = models.pin_model(pin_model)(case, pin_stiffness_N_per_mm)
-        bearing_class = models.bearing_model(bearing_model)
-        # a model whose law complements the FE bore's own compliance is told the disc's stiffness scale
-        bearings = (bearing_class(case, bearing_stiffness_scale, disc_stiffness_scale=stiffness_scale)
-                    if getattr(bearing_class, "takes_disc_stiffness_scale", False)
-                    else bearing_class(case, bearing_stiffness_scale))
+        bearings = models.bearing_laws(bearing_model, case, bearing_stiffness_scale, stiffness_scale)
     except KeyError as exc:
         raise CaseError(exc.args[0]) from None
     times = {}
@@ -211,6 +207,45 @@ def build_system(case: Case, mesh, *, order: int | None = None, bearing_model: s
                       pin_model=pin_model, geometry=geometry, bearing_stiffness_scale=bearing_stiffness_scale,
                       pin_stiffness_N_per_mm=pin_stiffness_N_per_mm, setup_seconds=times, bearings=bearings,
                       pins=pins, symmetry=symmetry, node_rotation=node_rotation)
+
+
+def scaled_system(system: DiscSystem, factor: float) -> DiscSystem:
+    """The disc of ``system`` with its Young's modulus × ``factor``, without a new assembly,
+    factorisation or back-substitution.
+
+    Linear plane-stress elasticity is homogeneous in E: the stiffness is K·factor, every
+    displacement of the same loads, the floating compliance C = Bᵀ K⁺ B included, is divided by
+    ``factor``, and the stresses of the same loads are unchanged. The columns already
+    back-substituted are carried over (divided by ``factor``); the laws that depend on the disc's
+    stiffness (the roller law that complements the FE bore, :func:`rvfem.solve.models.bearing_laws`)
+    are built for the new modulus; the contact-set cache starts empty. Equal to
+    :func:`build_system` with ``stiffness_scale`` × ``factor`` to round-off
+    (tests/solve/test_scaled_system.py), at none of its cost: the disc-body share of the compliance
+    (:class:`rvfem.solve.stage_parts.DiscBody`) stiffens the disc 1000× this way.
+
+    Parameters
+    ----------
+    system : DiscSystem
+    factor : float
+        > 0, dimensionless.
+
+    Returns
+    -------
+    DiscSystem
+    """
+    factor = float(factor)
+    if not factor > 0.0:
+        raise ValueError(f"the factor on the disc's Young's modulus must be positive, got {factor!r}")
+    model = replace(system.model, youngs_modulus=system.model.youngs_modulus * factor,
+                     stiffness=system.model.stiffness * factor)
+    scale = system.stiffness_scale * factor
+    bearings = models.bearing_laws(system.bearing_model, system.case, system.bearing_stiffness_scale, scale)
+
+    def solve(rhs, _solve=system.solve):
+        return _solve(rhs) / factor
+
+    return replace(system, model=model, compliance=system.compliance.scaled(factor), solve=solve,
+                   stiffness_scale=scale, bearings=bearings, setup_seconds={}, contact_sets={})
 
 
 def _footprint_interface(case: Case, mesh, model, rigid: np.ndarray, column_stride: int) -> Interface:

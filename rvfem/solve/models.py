@@ -51,6 +51,7 @@ __all__ = [
     "hertz_pin_parameters",
     "roller_angles",
     "bearing_contacts_many",
+    "bearing_laws",
     "contact_columns",
     "contact_columns_many",
 ]
@@ -485,3 +486,20 @@ def pin_model(name: str) -> type:
     """The class of the pin model ``name`` (built in or registered,
     :func:`rvfem.case.registry.register_pin_model`)."""
     return _model("pin", name)
+
+
+def bearing_laws(name: str, case: Case, stiffness_scale: float = 1.0, disc_stiffness_scale: float = 1.0):
+    """The crank-bearing model ``name`` of ``case`` (:func:`bearing_model`), built with its stiffness
+    scale and, for a model whose law complements the FE bore's own compliance
+    (:attr:`RollerBearing.takes_disc_stiffness_scale`), the factor on the disc's Young's modulus of the
+    FE model it loads.
+
+    Raises
+    ------
+    KeyError
+        ``name`` is not a known bearing model.
+    """
+    model = bearing_model(name)
+    if getattr(model, "takes_disc_stiffness_scale", False):
+        return model(case, stiffness_scale, disc_stiffness_scale=disc_stiffness_scale)
+    return model(case, stiffness_scale)

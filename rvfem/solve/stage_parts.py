@@ -53,7 +53,7 @@ from rvfem.errors import CaseError
 from rvfem.fem.crankshaft import crankshaft_influence
 from rvfem.solve import models
 from rvfem.solve.cycle_stage import ReducerStage, build_stage, solve_pair
-from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, build_system
+from rvfem.solve.cycle_system import DiscSystem, OperatingPoint, scaled_system
 from rvfem.solve.stage_carrier import Carrier
 from rvfem.solve.stage_component import STIFFEN, StageComponent
 from rvfem.solve.stage_main_bearings import MainBearings
@@ -118,13 +118,9 @@ class DiscBody(StageComponent):
     body = True
 
     def stiffen(self, stage: ReducerStage) -> ReducerStage:
-        """The disc's E × STIFFEN: a new factorisation of the same mesh and models."""
-        s = stage.first
-        system = build_system(s.case, s.mesh, bearing_model=s.bearing_model, pin_model=s.pin_model,
-                              stiffness_scale=STIFFEN * s.stiffness_scale,
-                              bearing_stiffness_scale=s.bearing_stiffness_scale,
-                              pin_stiffness_N_per_mm=s.pin_stiffness_N_per_mm, geometry=s.geometry)
-        return _with_disc_system(stage, system)
+        """The disc's E × STIFFEN: the same factorisation and compliance columns divided by STIFFEN
+        (:func:`rvfem.solve.cycle_system.scaled_system`, exact for linear elasticity)."""
+        return _with_disc_system(stage, scaled_system(stage.first, STIFFEN))
 
 
 class CrankBearingRollers(StageComponent):
