@@ -365,7 +365,6 @@ def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_cou
                    "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in duty_rows(case)],
                    "te_peak_to_peak_initial_arcsec": records[0]["te_peak_to_peak_arcsec"],
                    "te_peak_to_peak_final_arcsec": records[-1]["te_peak_to_peak_arcsec"],
-                   "wear": dataclasses.asdict(case.wear), "duty": [list(r) for r in duty_rows(case)],
                    "running_in": RUNNING_IN, "warnings": wear_warnings(state, case, records, hours)}
         pin_at = kin.pin_angle * case.pins.radius
         pin_gap = np.array([np.interp(pin_at, pin_nodes(case), state.pin[s]) for s in range(2)])

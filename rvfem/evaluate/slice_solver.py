@@ -219,7 +219,6 @@ class SliceSolver:
 
     def _set_masks(self, ids: np.ndarray) -> np.ndarray:
         """The active sets of the given set numbers, (len(ids), n) bool."""
-        n = self.modes.shape[0]
         return self._masks[ids]
 
     def _set_ids(self, act: np.ndarray) -> np.ndarray:
@@ -244,7 +243,6 @@ class SliceSolver:
         the heaviest contact) of the surface, for some contact of the call. A slice beyond it is out
         of contact in every set met so far; its gap is checked like any other, so that a set
         reaching past R is still solved, through all of C⁻¹ (:meth:`_solve_sets`)."""
-        n = self.modes.shape[0]
         g = coef @ self.modes[:, 1:].T
         reach = g.max(axis=0, initial=-np.inf) + 2.0 * max(float(np.max(delta, initial=0.0)), 0.0) > 0.0
         self._reach = reach

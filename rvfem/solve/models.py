@@ -488,7 +488,7 @@ def pin_model(name: str) -> type:
     return _model("pin", name)
 
 
-def bearing_laws(name: str, case: Case, stiffness_scale: float = 1.0, disc_stiffness_scale: float = 1.0):
+def bearing_laws(name: str, case: Case, stiffness_scale: float = 1.0, disc_stiffness_scale: float = 1.0) -> BearingModel:
     """The crank-bearing model ``name`` of ``case`` (:func:`bearing_model`), built with its stiffness
     scale and, for a model whose law complements the FE bore's own compliance
     (:attr:`RollerBearing.takes_disc_stiffness_scale`), the factor on the disc's Young's modulus of the
