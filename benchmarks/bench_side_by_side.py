@@ -1,5 +1,5 @@
-"""`rvfem run` of two source trees side by side: whole-process wall time, alternating A and B, the
-median of each and B/A.
+"""`rvfem run` (or another command writing a result folder) of two source trees side by side:
+whole-process wall time, alternating A and B, the median of each and B/A.
 
 Each run is a fresh ``python -m rvfem run CASE`` process with ``PYTHONPATH`` set to the tree, so the
 two versions run under the same load; the mesh cache is shared (both read the same meshes). Prints
@@ -7,7 +7,7 @@ every run, the medians and the ratio, and each stage's median from ``summary.jso
 ``timings_s``::
 
     python benchmarks/bench_side_by_side.py OLD_TREE NEW_TREE [--case cases/rv40e_fanholes.toml]
-        [--repeat 5] [--no-images]
+        [--repeat 5] [--no-images] [--command hysteresis --extra "--te"]
 
 A tree is a checkout of rvfem (e.g. ``git worktree add /path/old COMMIT``).
 """
@@ -25,15 +25,18 @@ import time
 from pathlib import Path
 
 
-def _run(tree: Path, case: Path, out: Path, cache: Path, images: bool) -> tuple[float, dict]:
+def _run(tree: Path, case: Path, out: Path, cache: Path, images: bool, command: str = "run",
+         extra: tuple[str, ...] = ()) -> tuple[float, dict]:
     env = {**os.environ, "PYTHONPATH": str(tree)}
-    argv = [sys.executable, "-m", "rvfem", "run", str(case), "-o", str(out), "--overwrite", "--cache-dir", str(cache)]
+    argv = [sys.executable, "-m", "rvfem", command, str(case), "-o", str(out), "--overwrite", "--cache-dir", str(cache),
+            *extra]
     if not images:
         argv.append("--no-images")
     t0 = time.perf_counter()
     subprocess.run(argv, env=env, cwd=tree, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.perf_counter() - t0
-    return wall, json.loads((out / "summary.json").read_text(encoding="utf-8"))["timings_s"]
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    return wall, summary.get("timings_s") or summary.get("timings") or {}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -42,18 +45,22 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("new", type=Path)
     parser.add_argument("--case", type=Path, default=Path("cases/rv40e_fanholes.toml"))
     parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--no-images", action="store_true")
+    parser.add_argument("--no-images", action="store_true", help="rvfem run only")
+    parser.add_argument("--command", default="run", help="the rvfem command (default run)")
+    parser.add_argument("--extra", default="", help="further arguments of the command, in one string")
     args = parser.parse_args(argv)
+    extra = tuple(args.extra.split())
     case = args.case.resolve()
     walls: dict[str, list[float]] = {"old": [], "new": []}
     stages: dict[str, dict[str, list[float]]] = {"old": {}, "new": {}}
     with tempfile.TemporaryDirectory() as tmp:
         cache = Path(tmp) / "meshes"
         for name, tree in (("old", args.old), ("new", args.new)):      # warm the mesh cache, not timed
-            _run(tree.resolve(), case, Path(tmp) / name, cache, not args.no_images)
+            _run(tree.resolve(), case, Path(tmp) / name, cache, not args.no_images, args.command, extra)
         for i in range(args.repeat):
             for name, tree in (("old", args.old), ("new", args.new)):
-                wall, timings = _run(tree.resolve(), case, Path(tmp) / name, cache, not args.no_images)
+                wall, timings = _run(tree.resolve(), case, Path(tmp) / name, cache, not args.no_images, args.command,
+                                     extra)
                 walls[name].append(wall)
                 for k, v in timings.items():
                     stages[name].setdefault(k, []).append(float(v))

@@ -110,6 +110,12 @@ class ChildProcessEnded(RuntimeError):
         return type(self), (str(self), self.returncode, self.stderr)
 
 
+def call_with_keywords(function: Callable, args: tuple, kwargs: dict):
+    """``function(*args, **kwargs)``: a call with keyword arguments through :meth:`ChildProcess.call`,
+    which passes positional arguments only."""
+    return function(*args, **kwargs)
+
+
 class ChildProcess:
     """A Python child process that runs module-level functions for this one, one call after the
     other, each returning a :class:`concurrent.futures.Future`.

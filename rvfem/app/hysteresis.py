@@ -25,6 +25,7 @@ from rvfem.evaluate.accuracy import accuracy_figures, mean_loop
 from rvfem.geometry import disc_geometry
 from rvfem.mesh import mesh_case
 from rvfem.outputs import accuracy as files
+from rvfem.outputs.plot_worker import PlotWorker
 from rvfem.outputs.summary import result_folder
 from rvfem.solve import accuracy
 from rvfem.solve.cycle import build_system, case_stage
@@ -151,7 +152,8 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
     warnings = loop_warnings(case, T)
     for w in warnings:   # in the summary; the command line prints them as rvfem run does
         log.debug("loop torque %g N·m: %s", T, w.message)
-    with result_folder(out_dir, overwrite=overwrite, what="hysteresis") as out:
+    with result_folder(out_dir, overwrite=overwrite, what="hysteresis") as out, \
+            PlotWorker("hysteresis plots") as plots:      # Matplotlib imported while the loops are solved
         (out / "plots").mkdir()
         timings = {}
         t0 = time.perf_counter()
@@ -171,8 +173,8 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
                    "per_angle": per_angle, "stage": stage.describe(), "left_out": left_out(),
                    "warnings": [w.as_dict() for w in warnings]}
         files.write_loop_csv(out / "hysteresis.csv", torque, branch, mean, np.degrees(thetas), rotations)
-        files.hysteresis_plot(out / "plots" / "hysteresis.png", torque, branch, mean, fig, T,
-                              title=f"{case.name}: hysteresis loop, input locked (mean of {len(thetas)} crank angles)")
+        plots.submit(files.hysteresis_plot, out / "plots" / "hysteresis.png", torque, branch, mean, fig, T,
+                     title=f"{case.name}: hysteresis loop, input locked (mean of {len(thetas)} crank angles)")
         if shares:
             t0 = time.perf_counter()
             cs = accuracy.compliance_shares(stage, float(thetas[0]), T, mu)
@@ -180,12 +182,13 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
             summary["compliance_shares"] = {"crank_angle_deg": math.degrees(thetas[0]),
                                             "rotation_arcmin": cs.rotation_arcmin, "shares": cs.shares,
                                             "total": cs.total}
-            files.shares_plot(out / "plots" / "compliance_shares.png", cs.shares,
-                              title=f"{case.name}: where the compliance sits")
+            plots.submit(files.shares_plot, out / "plots" / "compliance_shares.png", cs.shares,
+                         title=f"{case.name}: where the compliance sits")
         if te:
             t0 = time.perf_counter()
-            summary["transmission_error"] = _te(case, stage, T, mu, out)
+            summary["transmission_error"] = _te(case, stage, T, mu, out, plots)
             timings["te_s"] = time.perf_counter() - t0
+        plots.wait()
         timings["total_s"] = time.perf_counter() - t_start
         summary["timings"] = timings
         (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")
@@ -193,13 +196,13 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
     return summary
 
 
-def _te(case: Case, stage, torque: float, friction: float, out: Path) -> dict:
+def _te(case: Case, stage, torque: float, friction: float, out: Path, plots: PlotWorker) -> dict:
     """The TE over one crank revolution at the case's angle step: te.csv, the plot, the summary part."""
     thetas = np.radians(np.arange(0.0, 360.0, case.analysis.angle_step_deg))
     no_load, loaded = accuracy.transmission_error(stage, thetas, torque, friction)
     files.write_te_csv(out / "te.csv", np.degrees(thetas), no_load, loaded)
-    files.te_plot(out / "plots" / "transmission_error.png", np.degrees(thetas), no_load, loaded, torque,
-                  title=f"{case.name}: transmission error over one crank revolution")
+    plots.submit(files.te_plot, out / "plots" / "transmission_error.png", np.degrees(thetas), no_load, loaded, torque,
+                 title=f"{case.name}: transmission error over one crank revolution")
     arcsec = ARCSEC_PER_RAD
 
     def orders(te):

@@ -5,7 +5,7 @@ while the calling process does other work, and other drawings (the mesh picture)
 The child's work is a sequence of calls of the module-level functions below: the check
 (:func:`rvfem.outputs.render_check._probe_in_child`), :func:`_open_renderer`, one :func:`_draw`
 per image and :func:`_close_renderer`, one after the other in the child's main thread; the other
-drawings (:func:`_call`) in its second thread.
+drawings (:func:`rvfem._child.call_with_keywords`) in its second thread.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from pathlib import Path
 
-from rvfem._child import ChildProcess, ChildProcessEnded
+from rvfem._child import ChildProcess, ChildProcessEnded, call_with_keywords
 from rvfem.errors import RenderError
 from rvfem.outputs import render_check
 from rvfem.outputs.render_check import RENDER_WINDOW_VARIABLE, _probe_error, _probe_in_child, _vtk_messages
@@ -65,11 +65,6 @@ def _close_renderer() -> tuple[int, str]:
         raise RenderError("the render process has no renderer")
     renderer.close()
     return renderer.frames, renderer.anti_aliasing
-
-
-def _call(function: Callable, kwargs: dict):
-    """``function(**kwargs)`` (:class:`ChildProcess` passes positional arguments only)."""
-    return function(**kwargs)
 
 
 # --------------------------------------------------------------------------------------------
@@ -254,7 +249,7 @@ class RenderWorker:
     def _start(self, calls: Sequence[Call]) -> list[int]:
         first = len(self._calls)
         for function, kwargs in calls:
-            self._calls.append(self._send(_call, function, dict(kwargs), background=True))
+            self._calls.append(self._send(call_with_keywords, function, (), dict(kwargs), background=True))
         return list(range(first, len(self._calls)))
 
     def submit(self, jobs: Sequence[ImageJob], *, calls: Sequence[Call] = ()) -> list[int]:
