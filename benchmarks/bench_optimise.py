@@ -16,6 +16,7 @@ fresh folder for a timing. Run from the repository root::
     python benchmarks/bench_optimise.py studies/other.toml -o DIR --trials 10 --json DIR/bench.json
     python benchmarks/bench_optimise.py -o DIR --trials 8 --full-designs   # every design a full rvfem run (before)
     python benchmarks/bench_optimise.py -o DIR --trials 8 --screen 2       # screening, coarse mesh sizes x 2
+    python benchmarks/bench_optimise.py -o DIR --screen 2 --confirm best   # the fine mesh confirms the best only
 
 The machine should be otherwise idle: the load average before and after is printed.
 """
@@ -49,11 +50,13 @@ def main() -> int:
                         help="run every design as a full rvfem run (the optimiser before design-only analyses)")
     parser.add_argument("--screen", type=float, metavar="SCALE",
                         help="screen on a coarse mesh (sizes x SCALE), confirming the front on the case's mesh")
+    parser.add_argument("--confirm", choices=("front", "best"), default="front",
+                        help="with --screen: what the case's mesh confirms (the front and the best, or the best only)")
     args = parser.parse_args()
     load_before = os.getloadavg()[0]
     problem = load_problem(args.problem, trials=args.trials)
     if args.screen:
-        problem = dataclasses.replace(problem, screening=Screening(mesh_scale=args.screen))
+        problem = dataclasses.replace(problem, screening=Screening(mesh_scale=args.screen, confirm=args.confirm))
     t0 = time.perf_counter()
     r = run_optimisation(problem, args.output, workers=args.workers, cache_dir=args.cache_dir,
                          design_only=not args.full_designs)

@@ -58,10 +58,16 @@ class Screening:
     band_factor : float
         The coarse–fine error band of a response is this times the largest coarse–fine difference
         of that response over every design evaluated on both meshes (≥ 1).
+    confirm : {"front", "best"}
+        What the fine mesh must get right (:func:`to_confirm`): ``"front"`` the best feasible
+        design and the Pareto front of the report, ``"best"`` the best feasible design only (the
+        front's other designs may stay coarse; for a problem whose designs nearly all lie on the
+        front, as mass against life ratio, this is what saves fine runs).
     """
 
     mesh_scale: float = 2.0
     band_factor: float = 2.0
+    confirm: str = "front"
 
 
 @dataclass(frozen=True)
@@ -127,12 +133,21 @@ _TOP_KEYS = {"name", "description", "problem", "base_case", "objective", "trials
              "parameter", "budget", "screening"}
 
 
+CONFIRM = ("front", "best")
+"""The values of ``screening.confirm`` (:class:`Screening`)."""
+
+
 def _read_screening(where: str, raw: Any) -> Screening | None:
     if raw is None:
         return None
-    if not isinstance(raw, dict) or set(raw) - {"mesh_scale", "band_factor"}:
-        raise _fail(where, "screening", "expected a table of mesh_scale (> 1) and band_factor (≥ 1)")
-    out = Screening(**{k: _number(where, f"screening.{k}", v) for k, v in raw.items()})
+    if not isinstance(raw, dict) or set(raw) - {"mesh_scale", "band_factor", "confirm"}:
+        raise _fail(where, "screening", "expected a table of mesh_scale (> 1), band_factor (≥ 1) and "
+                    f"confirm (one of {', '.join(CONFIRM)})")
+    confirm = raw.get("confirm", "front")
+    if confirm not in CONFIRM:
+        raise _fail(where, "screening.confirm", f"must be one of {', '.join(repr(c) for c in CONFIRM)}, got {confirm!r}")
+    out = Screening(**{k: _number(where, f"screening.{k}", v) for k, v in raw.items() if k != "confirm"},
+                    confirm=confirm)
     if not out.mesh_scale > 1.0:
         raise _fail(where, "screening.mesh_scale", f"must exceed 1 (the coarse mesh's sizes / the case's), got {out.mesh_scale:g}")
     if not out.band_factor >= 1.0:
@@ -256,7 +271,8 @@ def _interval(row: dict, key: str, bands: dict[str, float]) -> tuple[float, floa
 
 
 def to_confirm(problem: Problem, rows: Sequence[dict], bands: dict[str, float]) -> list[dict]:
-    """The coarse rows whose fine result could change the reported front or best design.
+    """The coarse rows whose fine result could change the reported front or best design (the
+    best design only with ``screening.confirm = "best"``).
 
     A coarse row is kept on the coarse mesh only if, wherever in its band the fine values lie,
     it is neither the best feasible design nor on the Pareto front: it is surely infeasible
@@ -305,6 +321,7 @@ def to_confirm(problem: Problem, rows: Sequence[dict], bands: dict[str, float]) 
                 return True
         return False
 
+    keep_front = problem.screening is None or problem.screening.confirm == "front"
     out = []
     for r in rows:
         if r.get("fidelity") != "coarse":
@@ -314,6 +331,6 @@ def to_confirm(problem: Problem, rows: Sequence[dict], bands: dict[str, float]) 
                 out.append(r)
             continue
         best = possibly_feasible(r) and _interval(r, problem.objective, bands)[0] <= bound
-        if best or not beaten_on_front(r):
+        if best or (keep_front and not beaten_on_front(r)):
             out.append(r)
     return out

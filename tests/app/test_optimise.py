@@ -237,6 +237,26 @@ def test_screened_front_equals_the_fine_only_optimisation_on_the_same_designs(cl
     assert (screened.best["id"], screened.best["objective"]) == (fine_only.best["id"], fine_only.best["objective"])
 
 
+def test_screening_for_the_best_alone_confirms_fewer_designs_and_the_same_best(client, tmp_path):
+    """``confirm = "best"``: the same designs (the sampler sees the coarse results either way),
+    the best feasible design that of every design evaluated on the fine fidelity, with its fine
+    value, from fewer fine runs than keeping the front needs; the front may keep coarse rows."""
+    runs = {}
+    for confirm in ("front", "best"):
+        path = tmp_path / f"{confirm}.toml"
+        path.write_text(SCREENED.format(trials=30, band_factor=2.0) + f'confirm = "{confirm}"\n', encoding="utf-8")
+        runs[confirm] = run_optimisation(load_problem(path), tmp_path / confirm, client=client)
+    front, best = runs["front"], runs["best"]
+    assert [(r["x"], r["y"]) for r in best.rows] == [(r["x"], r["y"]) for r in front.rows]
+    _, _, fine_best = _fine_front_and_best(best.rows)
+    assert best.best is not None and best.best["id"] == fine_best["id"] == front.best["id"]
+    assert best.best["fidelity"] == "fine" and best.best["objective"] == pytest.approx(fine_best["objective"], rel=1e-12)
+    count = {k: sum(1 for r in v.rows if r["fidelity"] == "fine") for k, v in runs.items()}
+    assert 1 <= count["best"] < count["front"]
+    doc = json.loads((tmp_path / "best" / "optimisation.json").read_text(encoding="utf-8"))
+    assert doc["screening"]["confirm"] == "best" and doc["screening"]["confirmed_on_fine_mesh"] == count["best"]
+
+
 def test_screening_table_is_checked(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text(SCREENED.format(trials=5, band_factor=0.5), encoding="utf-8")
@@ -246,6 +266,9 @@ def test_screening_table_is_checked(tmp_path):
     load_problem(path)
     path.write_text(SCREENED.format(trials=5, band_factor=2.0) + "extra = 1\n", encoding="utf-8")
     with pytest.raises(CaseError, match="screening: expected a table of mesh_scale"):
+        load_problem(path)
+    path.write_text(SCREENED.format(trials=5, band_factor=2.0) + 'confirm = "all"\n', encoding="utf-8")
+    with pytest.raises(CaseError, match="screening.confirm: must be one of 'front', 'best', got 'all'"):
         load_problem(path)
 
 
