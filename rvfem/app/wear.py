@@ -40,6 +40,7 @@ from rvfem.evaluate.hertz import composite_modulus
 from rvfem.geometry import FlankDeviation, disc_geometry, pin_phases
 from rvfem.mesh import mesh_case
 from rvfem.outputs import wear as files
+from rvfem.outputs.plot_worker import PlotWorker
 from rvfem.outputs.summary import result_folder
 from rvfem.solve import models
 from rvfem.solve.accuracy import loop_at_torques
@@ -352,7 +353,8 @@ def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_cou
         raise CaseError(" ".join(problem))
     if not case.loads.torque_Nm:
         raise CaseError("rvfem wear reads the lost motion at ±3 % of loads.torque_Nm, which is 0; give the rated torque")
-    with result_folder(out_dir, overwrite=overwrite, what="wear") as out:
+    with result_folder(out_dir, overwrite=overwrite, what="wear") as out, \
+            PlotWorker("wear plots") as plots:          # Matplotlib imported while the life is solved
         geometry = disc_geometry(case)
         mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
         system = build_system(case, mesh, geometry=geometry)
@@ -369,7 +371,8 @@ def wear_life(case: Case, out_dir: str | os.PathLike, *, hours: float, angle_cou
         pin_at = kin.pin_angle * case.pins.radius
         pin_gap = np.array([np.interp(pin_at, pin_nodes(case), state.pin[s]) for s in range(2)])
         profile = archard.worn_profile(geometry, kin.psi, state.flank[0], state.flank[1])
-        files.write_wear_files(out, records, state, kin, case, profile, pin_gap)
+        files.write_wear_files(out, records, state, kin, case, profile, pin_gap, draw=plots.submit)
+        plots.wait()
         summary["timings"] = {"total_s": time.perf_counter() - t0}
         files.write_wear_report(out, summary, records)
         (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")

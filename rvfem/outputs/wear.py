@@ -5,6 +5,7 @@ a short report (report.md)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +27,12 @@ WEAR_COLUMNS = (
 """wear.csv's columns: (header, record key)."""
 
 
-def write_wear_files(out: Path, records: list[dict], state, kin, case, profile, pin_gap) -> list[Path]:
+def _draw_here(function: Callable, *args) -> None:
+    function(*args)
+
+
+def write_wear_files(out: Path, records: list[dict], state, kin, case, profile, pin_gap,
+                     draw: Callable = _draw_here) -> list[Path]:
     """Write wear.csv (one row per geometry update), worn_flank.csv (one tooth space of the profile
     at each pin phase ψ: the profile parameter, the nominal and worn points, the flank's depth, the
     pin's depth at the same contact and their sum, the FE gap added there, and the sliding
@@ -34,7 +40,9 @@ def write_wear_files(out: Path, records: list[dict], state, kin, case, profile, 
     hours) and plots/wear_profile.png into ``out``.
 
     ``profile`` is the :class:`rvfem.evaluate.wear.WornProfile` of the final state, ``pin_gap``
-    (2, n) the pin's depth at the contact of each grid phase (rows: +ψ, −ψ), mm."""
+    (2, n) the pin's depth at the contact of each grid phase (rows: +ψ, −ψ), mm. ``draw(function,
+    *args)`` draws a plot (here by default; :meth:`rvfem.outputs.plot_worker.PlotWorker.submit` in a
+    child process)."""
     paths = [write_csv(out / "wear.csv", [h for h, _ in WEAR_COLUMNS],
                        ([r[k] for _, k in WEAR_COLUMNS] for r in records), nan_as_empty=True)]
     n = len(kin.psi)
@@ -56,9 +64,9 @@ def write_wear_files(out: Path, records: list[dict], state, kin, case, profile, 
     paths.append(write_csv(out / "worn_pin.csv", ["pin_angle_deg", "wear_um_positive_torque_side",
                                                   "wear_um_negative_torque_side"],
                            zip(pin_deg, 1e3 * state.pin[0], 1e3 * state.pin[1])))
-    paths.append(_history_plot(out / "plots" / "lost_motion.png", records, case))
-    paths.append(_profile_plot(out / "plots" / "wear_profile.png", kin, state, pin_gap, pin_deg, case))
-    return paths
+    draw(_history_plot, out / "plots" / "lost_motion.png", records, case)
+    draw(_profile_plot, out / "plots" / "wear_profile.png", kin, state, pin_gap, pin_deg, case)
+    return paths + [out / "plots" / "lost_motion.png", out / "plots" / "wear_profile.png"]
 
 
 def _history_plot(path: Path, records: list[dict], case) -> Path:

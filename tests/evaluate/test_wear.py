@@ -193,3 +193,30 @@ def test_a_duty_without_torque_is_refused():
     case = coarse_case("rv40e_solid")
     with pytest.raises(CaseError, match="torque"):
         wear_life(case.replace(loads=case.loads.__class__(torque_Nm=0.0, speed_rpm=15.0)), "/nonexistent/x", hours=1)
+
+
+def test_the_wear_command_writes_its_folder(tmp_path):
+    """``wear_life`` end to end on the coarse solid disc: every file of the folder, the tables'
+    hours rising with the lost motion (wear only removes material), the worn flank at least the
+    nominal one's depth, the plots drawn (by the plot worker's child process) and the summary's
+    life figures consistent with wear.csv."""
+    import csv
+    import json
+
+    from rvfem.app.wear import wear_life
+
+    case = coarse_case("rv40e_solid", analysis={"angle_step_deg": 10.0}, wear={"update_step_um": 10.0})
+    out = tmp_path / "wear"
+    summary = wear_life(case, out, hours=30.0, cache_dir=tmp_path / "mesh")
+    names = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()} - {".rvfem-results"}   # the folder mark
+    assert names == {"wear.csv", "worn_flank.csv", "worn_pin.csv", "plots/lost_motion.png", "plots/wear_profile.png",
+                     "report.md", "summary.json"}
+    assert all((out / "plots" / n).stat().st_size > 5000 for n in ("lost_motion.png", "wear_profile.png"))
+    rows = list(csv.DictReader((out / "wear.csv").open(encoding="utf-8")))
+    hours = [float(r["hours"]) for r in rows]
+    lost = [float(r["lost_motion_arcsec"]) for r in rows]
+    assert hours[0] == 0.0 and all(b > a for a, b in zip(hours, hours[1:])) and len(rows) == summary["updates"] + 1
+    assert all(b >= a - 1e-9 for a, b in zip(lost, lost[1:])) and lost[-1] > lost[0]
+    assert json.loads((out / "summary.json").read_text(encoding="utf-8"))["final_lost_motion_arcsec"] == pytest.approx(lost[-1])
+    flank = list(csv.DictReader((out / "worn_flank.csv").open(encoding="utf-8")))
+    assert all(float(r["flank_wear_um"]) >= 0.0 for r in flank) and max(float(r["flank_wear_um"]) for r in flank) > 0.0
