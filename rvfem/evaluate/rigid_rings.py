@@ -34,8 +34,9 @@ halved until it lowers the convex potential Σ K·s_j^(19/9)/(19/9) − F·d). W
     roller_angles : ndarray (..., Z)
         Angular positions of the rollers, rad, same frame.
     iterations : int
-        Newton iterations (converged to round-off in about ten; a light force within a wide
-        clearance may need the damped steps of more).
+        Most Newton iterations (they stop once every step is below round-off of the largest
+        approach, in about ten; a light force within a wide clearance may need the damped steps
+        of more).
     radial_clearance_mm : float
         c, mm (0: zero clearance; negative: preload).
     roller_length_mm : float, optional
@@ -73,6 +74,8 @@ halved until it lowers the convex potential Σ K·s_j^(19/9)/(19/9) − F·d). W
         jac = np.einsum("...z,...zc,...zd->...cd", k * (10.0 / 9.0) * s ** (1.0 / 9.0), e, e)
         jac = jac + 1e-12 * np.max(np.abs(jac), initial=1.0) * np.eye(2)
         step = -np.linalg.solve(jac, res[..., None])[..., 0]
+        if np.all(np.abs(step) <= 1e-15 * np.max(np.abs(d), initial=1e-300)):
+            break               # converged to round-off: the remaining iterations would not move d
         # Newton's step, halved until it lowers the potential (with a clearance, a light force
         # near the edge of the play would otherwise overshoot without bound)
         base = potential(d)
