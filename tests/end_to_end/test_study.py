@@ -615,6 +615,26 @@ def test_compute_time_counts_every_case_once():
     assert _compute_time(records) == 15.5
 
 
+def test_local_workers_keep_dask_log_messages_to_critical_ones():
+    """A local cluster's workers write to the user's terminal: Dask's own messages there (a
+    heartbeat cut short by a shutdown after Ctrl-C, with its traceback) are kept to critical
+    ones; a variant's failure reaches the study as its record instead."""
+    import logging
+
+    from distributed import Client
+
+    from rvfem.app.study_run import local_cluster
+
+    cluster = local_cluster(1)
+    try:
+        with Client(cluster, set_as_default=False) as client:
+            levels = client.run(lambda: tuple(logging.getLogger(n).getEffectiveLevel()
+                                              for n in ("distributed.worker", "distributed.core", "tornado")))
+    finally:
+        cluster.close()
+    assert list(levels.values()) == [(logging.CRITICAL,) * 3]
+
+
 def test_ctrl_c_on_a_local_cluster_prints_one_line(meshes, tmp_path):
     """Ctrl-C at a terminal signals the whole process group, the local cluster's workers too: the
     command still prints one line ("interrupted"), no worker traceback, no Dask warning."""
