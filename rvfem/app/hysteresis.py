@@ -8,16 +8,20 @@ The library part (:func:`accuracy_study`) computes and writes; the command line 
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import json
 import logging
 import math
 import os
 import time
+from concurrent.futures import Future
 from pathlib import Path
 
 import numpy as np
 
+from rvfem._child import ChildProcess, ChildProcessEnded
 from rvfem.app.analysis import analyse_rigid, default_cache_dir
+from rvfem.app.p2_model import models_in_package
 from rvfem.case.definition import MAX_FRICTION, Case
 from rvfem.errors import CaseError
 from rvfem.evaluate.validity import ResultWarning
@@ -153,12 +157,14 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
     for w in warnings:   # in the summary; the command line prints them as rvfem run does
         log.debug("loop torque %g N·m: %s", T, w.message)
     with result_folder(out_dir, overwrite=overwrite, what="hysteresis") as out, \
-            PlotWorker("hysteresis plots") as plots:      # Matplotlib imported while the loops are solved
+            PlotWorker("hysteresis plots") as plots, \
+            _TransmissionErrorChild(case if te else None) as te_child:   # imports while the model is built
         (out / "plots").mkdir()
         timings = {}
         t0 = time.perf_counter()
         geometry = disc_geometry(case)
         mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
+        te_child.start(mesh, geometry, T, mu)      # the TE solved there beside the loops and shares
         stage = case_stage(build_system(case, mesh, geometry=geometry))
         timings["model_s"] = time.perf_counter() - t0
         t0 = time.perf_counter()
@@ -186,7 +192,7 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
                          title=f"{case.name}: where the compliance sits")
         if te:
             t0 = time.perf_counter()
-            summary["transmission_error"] = _te(case, stage, T, mu, out, plots)
+            summary["transmission_error"] = _te(case, stage, T, mu, out, plots, te_child)
             timings["te_s"] = time.perf_counter() - t0
         plots.wait()
         timings["total_s"] = time.perf_counter() - t_start
@@ -196,10 +202,77 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
     return summary
 
 
-def _te(case: Case, stage, torque: float, friction: float, out: Path, plots: PlotWorker) -> dict:
+def te_angles(case: Case) -> np.ndarray:
+    """The crank angles of the TE over one revolution: the case's angle step, rad."""
+    return np.radians(np.arange(0.0, 360.0, case.analysis.angle_step_deg))
+
+
+def _te_in_child(case: Case, mesh, geometry, torque: float, friction: float) -> tuple[np.ndarray, np.ndarray]:
+    """In the child process of :class:`_TransmissionErrorChild`: the case's stage on its own
+    factorisation and :func:`rvfem.solve.accuracy.transmission_error` at :func:`te_angles`."""
+    stage = case_stage(build_system(case, mesh, geometry=geometry))
+    return accuracy.transmission_error(stage, te_angles(case), torque, friction)
+
+
+def _te_child_imports() -> None:
+    """In the child process of :class:`_TransmissionErrorChild`: import the solver."""
+    for name in ("rvfem.solve.cycle", "rvfem.solve.accuracy"):
+        importlib.import_module(name)
+
+
+class _TransmissionErrorChild:
+    """The TE over a revolution solved in a child process (:class:`rvfem._child.ChildProcess`)
+    while this one solves the loops and the compliance shares: the two would otherwise take turns
+    in this interpreter, on a two-core machine with the other core idle. The child builds the same
+    stage on its own factorisation (the TE's columns are mostly its own anyway: a revolution of
+    crank angles against the loops' mesh period), which costs about a second of the other core
+    and saves about as much of the command's wall time (benchmarks/README.md, "Hysteresis and
+    transmission error"). Without a child (``case`` None, a bearing or pin model registered in
+    this process only, no process could be started) or when the child ends before answering, the
+    TE is solved here: :meth:`result` returns None."""
+
+    def __init__(self, case: Case | None):
+        self._child: ChildProcess | None = None
+        self._future: Future | None = None
+        self._case = case
+        if case is None or not models_in_package(case):
+            return
+        try:
+            self._child = ChildProcess("transmission error", forward_logs=True)
+        except OSError as exc:  # pragma: no cover - the interpreter itself cannot be started
+            log.info("the transmission error is solved in this process: %s", exc)
+            return
+        self._child.call(_te_child_imports)
+
+    def start(self, mesh, geometry, torque: float, friction: float) -> None:
+        """Hand the child the case's mesh and geometry, the torque (N·m) and the friction."""
+        if self._child is not None:
+            self._future = self._child.call(_te_in_child, self._case, mesh, geometry, float(torque), float(friction))
+
+    def result(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(no load, loaded) TE from the child, rad; None where it is to be solved here."""
+        if self._future is None:
+            return None
+        try:
+            return self._future.result()
+        except ChildProcessEnded as exc:
+            log.info("the transmission error's process ended (%s): solved in this process", exc)
+            return None
+
+    def __enter__(self) -> "_TransmissionErrorChild":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._child is not None:
+            self._child.close()
+
+
+def _te(case: Case, stage, torque: float, friction: float, out: Path, plots: PlotWorker,
+        child: _TransmissionErrorChild | None = None) -> dict:
     """The TE over one crank revolution at the case's angle step: te.csv, the plot, the summary part."""
-    thetas = np.radians(np.arange(0.0, 360.0, case.analysis.angle_step_deg))
-    no_load, loaded = accuracy.transmission_error(stage, thetas, torque, friction)
+    thetas = te_angles(case)
+    solved = None if child is None else child.result()
+    no_load, loaded = solved if solved is not None else accuracy.transmission_error(stage, thetas, torque, friction)
     files.write_te_csv(out / "te.csv", np.degrees(thetas), no_load, loaded)
     plots.submit(files.te_plot, out / "plots" / "transmission_error.png", np.degrees(thetas), no_load, loaded, torque,
                  title=f"{case.name}: transmission error over one crank revolution")

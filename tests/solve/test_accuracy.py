@@ -281,6 +281,33 @@ def test_hysteresis_command_writes_the_folder(tmp_path, capsys):
     assert "torsional rigidity" in capsys.readouterr().out
 
 
+def test_the_te_of_the_child_process_is_the_te_solved_here(mesh_dir):
+    """``rvfem hysteresis --te`` solves the TE in a child process beside the loops: the same stage
+    built there on its own factorisation gives the TE of this process to round-off; a child
+    that has ended leaves the TE to this process (``result`` None)."""
+    from rvfem.app.hysteresis import _TransmissionErrorChild, te_angles
+    from rvfem.geometry import disc_geometry
+
+    case = coarse_case("rv40e", analysis={"angle_step_deg": 30.0})
+    geometry = disc_geometry(case)
+    mesh = mesh_case(case, mesh_dir, geometry=geometry)
+    here = transmission_error(cycle.case_stage(cycle.build_system(case, mesh, geometry=geometry)), te_angles(case),
+                              T_R, 0.05)
+    with _TransmissionErrorChild(case) as child:
+        child.start(mesh, geometry, T_R, 0.05)
+        there = child.result()
+    assert there is not None
+    for a, b in zip(there, here):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12 * np.max(np.abs(here[1])))
+    with _TransmissionErrorChild(case) as child:
+        child._child._proc.kill()
+        child.start(mesh, geometry, T_R, 0.05)
+        assert child.result() is None
+    with _TransmissionErrorChild(None) as child:             # no TE asked: no child
+        child.start(mesh, geometry, T_R, 0.05)
+        assert child.result() is None
+
+
 @pytest.mark.parametrize("options, cause", [
     (["--steps", "2"], "--steps must be a multiple of 4"), (["--steps", "42"], "--steps must be a multiple of 4"),
     (["--friction", "0.9"], "--friction must be in"), (["--torque", "-5"], "--torque must be positive"),
