@@ -220,25 +220,39 @@ def _te_child_imports() -> None:
         importlib.import_module(name)
 
 
+def _usable_cores() -> int:
+    """The cores this process may run on (its affinity where the system says, else the count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+TE_CHILD_NICENESS = 10
+"""Niceness added to the TE's child process (Unix ``nice``): where it competes for a core with
+this process (the model, the loops) or the plot worker, they go first."""
+
+
 class _TransmissionErrorChild:
     """The TE over a revolution solved in a child process (:class:`rvfem._child.ChildProcess`)
     while this one solves the loops and the compliance shares: the two would otherwise take turns
     in this interpreter, on a two-core machine with the other core idle. The child builds the same
     stage on its own factorisation (the TE's columns are mostly its own anyway: a revolution of
-    crank angles against the loops' mesh period), which costs about a second of the other core
-    and saves about as much of the command's wall time (benchmarks/README.md, "Hysteresis and
-    transmission error"). Without a child (``case`` None, a bearing or pin model registered in
+    crank angles against the loops' mesh period, but the child builds the model again): on two
+    cores the default case's ``--te`` spends about 1.5 s more processor time and ends about 0.35 s
+    sooner (benchmarks/README.md, "Hysteresis and transmission error"). Without a child (``case`` None, a bearing or pin model registered in
     this process only, no process could be started) or when the child ends before answering, the
-    TE is solved here: :meth:`result` returns None."""
+    TE is solved here: :meth:`result` returns None. On a single core the child would only take
+    turns with this process, so it is not started there either."""
 
     def __init__(self, case: Case | None):
         self._child: ChildProcess | None = None
         self._future: Future | None = None
         self._case = case
-        if case is None or not models_in_package(case):
+        if case is None or not models_in_package(case) or _usable_cores() < 2:
             return
         try:
-            self._child = ChildProcess("transmission error", forward_logs=True)
+            self._child = ChildProcess("transmission error", niceness=TE_CHILD_NICENESS, forward_logs=True)
         except OSError as exc:  # pragma: no cover - the interpreter itself cannot be started
             log.info("the transmission error is solved in this process: %s", exc)
             return
