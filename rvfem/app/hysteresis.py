@@ -183,13 +183,8 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
                      title=f"{case.name}: hysteresis loop, input locked (mean of {len(thetas)} crank angles)")
         if shares:
             t0 = time.perf_counter()
-            cs = accuracy.compliance_shares(stage, float(thetas[0]), T, mu)
+            summary["compliance_shares"] = _shares(case, stage, float(thetas[0]), T, mu, out, plots)
             timings["shares_s"] = time.perf_counter() - t0
-            summary["compliance_shares"] = {"crank_angle_deg": math.degrees(thetas[0]),
-                                            "rotation_arcmin": cs.rotation_arcmin, "shares": cs.shares,
-                                            "total": cs.total}
-            plots.submit(files.shares_plot, out / "plots" / "compliance_shares.png", cs.shares,
-                         title=f"{case.name}: where the compliance sits")
         if te:
             t0 = time.perf_counter()
             summary["transmission_error"] = _te(case, stage, T, mu, out, plots, te_child)
@@ -200,6 +195,15 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
         (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False), encoding="utf-8")
         (out / "accuracy.md").write_text(files.accuracy_report(summary), encoding="utf-8")
     return summary
+
+
+def _shares(case: Case, stage, theta: float, torque: float, friction: float, out: Path, plots: PlotWorker) -> dict:
+    """The compliance shares at crank angle θ (rad): the plot and the summary part."""
+    cs = accuracy.compliance_shares(stage, theta, torque, friction)
+    plots.submit(files.shares_plot, out / "plots" / "compliance_shares.png", cs.shares,
+                 title=f"{case.name}: where the compliance sits")
+    return {"crank_angle_deg": math.degrees(theta), "rotation_arcmin": cs.rotation_arcmin, "shares": cs.shares,
+            "total": cs.total}
 
 
 def te_angles(case: Case) -> np.ndarray:
