@@ -239,15 +239,17 @@ this process (the model, the loops) or the plot worker, they go first."""
 
 class _TransmissionErrorChild:
     """The TE over a revolution solved in a child process (:class:`rvfem._child.ChildProcess`)
-    while this one solves the loops and the compliance shares: the two would otherwise take turns
-    in this interpreter, on a two-core machine with the other core idle. The child builds the same
-    stage on its own factorisation (the TE's columns are mostly its own anyway: a revolution of
-    crank angles against the loops' mesh period, but the child builds the model again): on two
-    cores the default case's ``--te`` spends about 1.5 s more processor time and ends about 0.35 s
-    sooner (benchmarks/README.md, "Hysteresis and transmission error"). Without a child (``case`` None, a bearing or pin model registered in
-    this process only, no process could be started) or when the child ends before answering, the
-    TE is solved here: :meth:`result` returns None. On a single core the child would only take
-    turns with this process, so it is not started there either."""
+    while this one solves the loops and the compliance shares, which would otherwise take turns
+    with it in this interpreter while the other core idles.
+
+    The child builds the same stage on its own factorisation: most of the TE's compliance columns
+    are its own anyway (a revolution of crank angles against the loops' mesh period), but the
+    model is built twice. On two cores the default case's ``--te`` spends about 1.5 s more
+    processor time and ends about 0.35 s sooner (benchmarks/README.md, "Hysteresis and
+    transmission error"). Without a child (``case`` None, a bearing or pin model registered in
+    this process only, one usable core, no process could be started) or when the child ends
+    before answering, the TE is solved here: :meth:`result` returns None.
+    """
 
     def __init__(self, case: Case | None):
         self._child: ChildProcess | None = None
