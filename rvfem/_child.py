@@ -28,6 +28,14 @@ HEADER = struct.Struct("<Q")
 """Length prefix of a message (little-endian unsigned 64-bit)."""
 
 
+def usable_cores() -> int:
+    """The cores this process may run on (its affinity where the system says, else the count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def frame(message) -> bytes:
     """One message pickled and prefixed with its length (what :func:`receive` reads)."""
     data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
@@ -242,6 +250,95 @@ class ChildProcess:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+class SharedWork:
+    """Items worked on from both ends: a child process from the front, as soon as they are given,
+    and this process from the back once it comes to them (:meth:`finish`), until the two meet.
+
+    For work that a child can start on while this process is busy with something else and that
+    this process can help finish: whichever is faster does more, and neither waits for the other
+    longer than one item.
+
+    Parameters
+    ----------
+    items : sequence
+        The work, each item independent of the others.
+    submit : callable
+        ``submit(item)`` → a :class:`concurrent.futures.Future` of its result, computed by the
+        child (e.g. ``lambda item: child.call(function, item)``).
+    in_flight : int
+        Items handed to the child at a time (the next one waits in its pipe while it works).
+
+    Notes
+    -----
+    An item the child fails (or a child that has ended) is computed by :meth:`finish` in this
+    process, and the child is given no more; the reason is logged at INFO level.
+    """
+
+    def __init__(self, items, submit: Callable, in_flight: int = 2):
+        self._items = list(items)
+        self._submit = submit
+        self._results: list = [None] * len(self._items)
+        self._lock = threading.Lock()
+        self._front, self._back = 0, len(self._items)   # the child's next item; one past this process's next
+        self._in_flight = 0
+        self._idle = threading.Event()
+        self._failed: list[int] = []
+        self._broken = False
+        for _ in range(max(1, in_flight)):
+            self._send()
+
+    def _send(self) -> None:
+        with self._lock:
+            if self._front >= self._back or self._broken:
+                if self._in_flight == 0:
+                    self._idle.set()
+                return
+            i = self._front
+            self._front += 1
+            self._in_flight += 1
+        try:
+            future = self._submit(self._items[i])
+        except Exception as exc:   # noqa: BLE001 - e.g. an item that does not pickle: done here
+            future = Future()
+            future.set_exception(exc)
+        future.add_done_callback(lambda f, i=i: self._received(f, i))
+
+    def _received(self, future: Future, i: int) -> None:
+        try:
+            self._results[i] = future.result()
+        except Exception as exc:   # noqa: BLE001 - computed here instead, the reason logged
+            log.info("a child process did not compute its share (%s): this process does", exc)
+            with self._lock:
+                self._broken = True
+                self._failed.append(i)
+        with self._lock:
+            self._in_flight -= 1
+        self._send()
+
+    @property
+    def child_count(self) -> int:
+        """Items the child was given so far."""
+        return self._front
+
+    def finish(self, here: Callable) -> list:
+        """The results of every item, in their order: ``here(item)`` on the items the child has not
+        taken yet, from the last one backwards, then waiting for the child's last ones."""
+        while True:
+            with self._lock:
+                if self._back <= self._front:
+                    break
+                self._back -= 1
+                i = self._back
+            self._results[i] = here(self._items[i])
+        with self._lock:
+            if self._in_flight == 0:
+                self._idle.set()
+        self._idle.wait()
+        for i in self._failed:
+            self._results[i] = here(self._items[i])
+        return list(self._results)
 
 
 class _ForwardLog(logging.Handler):

@@ -14,12 +14,11 @@ import logging
 import math
 import os
 import time
-from concurrent.futures import Future
 from pathlib import Path
 
 import numpy as np
 
-from rvfem._child import ChildProcess, ChildProcessEnded
+from rvfem._child import ChildProcess, SharedWork, usable_cores
 from rvfem.app.analysis import analyse_rigid, default_cache_dir
 from rvfem.app.p2_model import models_in_package
 from rvfem.case.definition import MAX_FRICTION, Case
@@ -164,8 +163,9 @@ def accuracy_study(case: Case, out_dir: str | os.PathLike, *, torque_Nm: float |
         t0 = time.perf_counter()
         geometry = disc_geometry(case)
         mesh = mesh_case(case, default_cache_dir() if cache_dir is None else cache_dir, geometry=geometry)
-        te_child.start(mesh, geometry, T, mu)      # the TE solved there beside the loops and shares
+        te_child.start(mesh, geometry)      # its stage built there beside this one's
         stage = case_stage(build_system(case, mesh, geometry=geometry))
+        te_child.begin(stage, te_angles(case), T, mu)    # the child's share of the TE beside the loops and shares
         timings["model_s"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         loops, per_angle = _loops(stage, thetas, T, mu, steps)
@@ -211,11 +211,20 @@ def te_angles(case: Case) -> np.ndarray:
     return np.radians(np.arange(0.0, 360.0, case.analysis.angle_step_deg))
 
 
-def _te_in_child(case: Case, mesh, geometry, torque: float, friction: float) -> tuple[np.ndarray, np.ndarray]:
+_TE_STAGE: dict = {}
+"""In the TE's child process only: the stage it solves its share of the TE on (key ``"stage"``)."""
+
+
+def _te_child_stage(case: Case, mesh, geometry) -> None:
     """In the child process of :class:`_TransmissionErrorChild`: the case's stage on its own
-    factorisation and :func:`rvfem.solve.accuracy.transmission_error` at :func:`te_angles`."""
-    stage = case_stage(build_system(case, mesh, geometry=geometry))
-    return accuracy.transmission_error(stage, te_angles(case), torque, friction)
+    factorisation, kept for :func:`_te_child_angles`."""
+    _TE_STAGE["stage"] = case_stage(build_system(case, mesh, geometry=geometry))
+
+
+def _te_child_angles(thetas: np.ndarray, torque: float, friction: float) -> tuple[np.ndarray, np.ndarray]:
+    """In the child process of :class:`_TransmissionErrorChild`: :func:`rvfem.solve.accuracy.te_at_angles`
+    on its stage."""
+    return accuracy.te_at_angles(_TE_STAGE["stage"], thetas, torque, friction)
 
 
 def _te_child_imports() -> None:
@@ -224,38 +233,35 @@ def _te_child_imports() -> None:
         importlib.import_module(name)
 
 
-def _usable_cores() -> int:
-    """The cores this process may run on (its affinity where the system says, else the count)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        return os.cpu_count() or 1
-
-
 TE_CHILD_NICENESS = 10
 """Niceness added to the TE's child process (Unix ``nice``): where it competes for a core with
 this process (the model, the loops) or the plot worker, they go first."""
 
+TE_SHARE_ANGLES = 6
+"""Crank angles of one share of the TE (:class:`_TransmissionErrorChild`): each share starts from
+no contacts of its own, the angles within it each from the last one's."""
+
 
 class _TransmissionErrorChild:
-    """The TE over a revolution solved in a child process (:class:`rvfem._child.ChildProcess`)
-    while this one solves the loops and the compliance shares, which would otherwise take turns
-    with it in this interpreter while the other core idles.
+    """The TE over a revolution solved in shares of :data:`TE_SHARE_ANGLES` crank angles by a child
+    process (:class:`rvfem._child.ChildProcess`) and by this one (:class:`rvfem._child.SharedWork`):
+    the child takes shares from the first angle on as soon as its stage is built, while this
+    process solves the loops and the compliance shares; then this process takes the shares left
+    from the last angle backwards until the two meet.
 
-    The child builds the same stage on its own factorisation: most of the TE's compliance columns
-    are its own anyway (a revolution of crank angles against the loops' mesh period), but the
-    model is built twice. On two cores the default case's ``--te`` spends about 1.5 s more
-    processor time and ends about 0.35 s sooner (benchmarks/README.md, "Hysteresis and
-    transmission error"). Without a child (``case`` None, a bearing or pin model registered in
-    this process only, one usable core, no process could be started) or when the child ends
-    before answering, the TE is solved here: :meth:`result` returns None.
+    The child builds the same stage on its own factorisation (the model is built twice; most of
+    the TE's compliance columns are its own anyway: a revolution of crank angles against the
+    loops' mesh period). Measurements: benchmarks/README.md, "Hysteresis and transmission
+    error". Without a child (``case`` None, a bearing or pin model registered in this process
+    only, one usable core, no process could be started) the TE is solved here alone; a share the
+    child does not deliver (it ended) is solved here.
     """
 
     def __init__(self, case: Case | None):
         self._child: ChildProcess | None = None
-        self._future: Future | None = None
+        self._work: SharedWork | None = None
         self._case = case
-        if case is None or not models_in_package(case) or _usable_cores() < 2:
+        if case is None or not models_in_package(case) or usable_cores() < 2:
             return
         try:
             self._child = ChildProcess("transmission error", niceness=TE_CHILD_NICENESS, forward_logs=True)
@@ -264,20 +270,44 @@ class _TransmissionErrorChild:
             return
         self._child.call(_te_child_imports)
 
-    def start(self, mesh, geometry, torque: float, friction: float) -> None:
-        """Hand the child the case's mesh and geometry, the torque (N·m) and the friction."""
+    def start(self, mesh, geometry) -> None:
+        """Hand the child the case's mesh and geometry: it builds its stage."""
         if self._child is not None:
-            self._future = self._child.call(_te_in_child, self._case, mesh, geometry, float(torque), float(friction))
+            self._child.call(_te_child_stage, self._case, mesh, geometry)
 
-    def result(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """(no load, loaded) TE from the child, rad; None where it is to be solved here."""
-        if self._future is None:
-            return None
-        try:
-            return self._future.result()
-        except ChildProcessEnded as exc:
-            log.info("the transmission error's process ended (%s): solved in this process", exc)
-            return None
+    def begin(self, stage, thetas: np.ndarray, torque: float, friction: float) -> None:
+        """Let the child start on the TE at crank angles ``thetas`` (rad) of ``stage`` (this
+        process's, for the angles symmetry does not give: :func:`rvfem.solve.accuracy.te_plan`),
+        at the torque (N·m) and the friction."""
+        if self._child is None:
+            return
+        solve_at, _ = accuracy.te_plan(stage, thetas)
+        angles = np.asarray(thetas, dtype=float)[solve_at]
+        shares = [angles[i:i + TE_SHARE_ANGLES] for i in range(0, len(angles), TE_SHARE_ANGLES)]
+        child = self._child
+        self._work = SharedWork(shares, lambda share: child.call(_te_child_angles, share, float(torque),
+                                                                  float(friction)))
+
+    def solve(self, stage, torque: float, friction: float):
+        """The ``solve`` of :func:`rvfem.solve.accuracy.transmission_error`: the angles shared
+        with the child where :meth:`begin` gave it these, else solved here."""
+        def here(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return accuracy.te_at_angles(stage, angles, torque, friction)
+
+        def shared(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            if self._work is None:
+                return here(angles)
+            parts = self._work.finish(here)
+            log.info("transmission error: %d of %d shares of %d crank angles solved in the child process",
+                     self._work.child_count, len(parts), TE_SHARE_ANGLES)
+            return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+
+        return shared
+
+    @property
+    def shares_to_child(self) -> int:
+        """Shares of the TE the child was given (0 without a child)."""
+        return 0 if self._work is None else self._work.child_count
 
     def __enter__(self) -> "_TransmissionErrorChild":
         return self
@@ -291,8 +321,8 @@ def _te(case: Case, stage, torque: float, friction: float, out: Path, plots: Plo
         child: _TransmissionErrorChild | None = None) -> dict:
     """The TE over one crank revolution at the case's angle step: te.csv, the plot, the summary part."""
     thetas = te_angles(case)
-    solved = None if child is None else child.result()
-    no_load, loaded = solved if solved is not None else accuracy.transmission_error(stage, thetas, torque, friction)
+    no_load, loaded = accuracy.transmission_error(stage, thetas, torque, friction,
+                                                  solve=None if child is None else child.solve(stage, torque, friction))
     files.write_te_csv(out / "te.csv", np.degrees(thetas), no_load, loaded)
     plots.submit(files.te_plot, out / "plots" / "transmission_error.png", np.degrees(thetas), no_load, loaded, torque,
                  title=f"{case.name}: transmission error over one crank revolution")

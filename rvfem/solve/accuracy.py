@@ -31,7 +31,7 @@ import dataclasses
 import logging
 import math
 from dataclasses import dataclass
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -63,7 +63,9 @@ __all__ = [
     "loop_torques",
     "rigid_kinematic_te",
     "stiffened_stage",
+    "te_at_angles",
     "te_orders",
+    "te_plan",
     "transmission_error",
 ]
 
@@ -309,7 +311,8 @@ TE_LADDER = (1.0, 0.1, 0.01)
 ZERO_FRACTION (:func:`transmission_error`)."""
 
 
-def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float, friction: float = 0.0
+def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float, friction: float = 0.0, *,
+                       solve: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
                        ) -> tuple[np.ndarray, np.ndarray]:
     """The output's deviation from the ideal ratio at each crank angle (rad), at no load and at
     ``torque_Nm`` (N·m), rad.
@@ -317,35 +320,62 @@ def transmission_error(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float
     TE = θ_out − θ_in/i (Liu et al., *Degradation law analysis and life estimation of transmission
     accuracy of RV reducer based on tooth surface and bearing wear*, section 4): in the stage's frame
     the ideal output position at crank angle θ is the kinematic one of the nominal profile, so TE is
-    the carrier rotation φ(θ) of the solve at that crank angle. No load: the stage solved at
-    +ZERO_FRACTION·T (the profile's gaps, modification and pitch error, closed on the driving side:
-    the kinematic TE), reached from the loaded solve through :data:`TE_LADDER` (a nearly unloaded
-    stage is nearly a mechanism; from a loaded start its active set settles). The running stage's
-    pins slide as the crank turns (``slip`` 0). Only the crank angles symmetry does not give are
-    solved (:func:`rvfem.solve.cycle.symmetry_plan`: the carrier rotation is unchanged by the turn
-    and by the swap of the discs).
+    the carrier rotation φ(θ) of the solve at that crank angle (:func:`te_at_angles`). Only the
+    crank angles symmetry does not give are solved (:func:`te_plan`: the carrier rotation is
+    unchanged by the turn and by the swap of the discs).
+
+    Parameters
+    ----------
+    solve : callable, optional
+        ``solve(angles)`` → (no load, loaded) at those crank angles, rad: how the angles of
+        :func:`te_plan` are solved (default :func:`te_at_angles` on ``stage``; ``rvfem hysteresis
+        --te`` shares them with a child process).
 
     Returns
     -------
     no_load, loaded : ndarray (n,)
         rad.
     """
+    thetas = np.asarray(thetas, dtype=float)
+    solve_at, source = te_plan(stage, thetas)
+    if solve is None:
+        no_load, loaded = te_at_angles(stage, thetas[solve_at], torque_Nm, friction)
+    else:
+        no_load, loaded = solve(thetas[solve_at])
+    # the solved angles are the first len(solve_at) of thetas (symmetry_plan): index i is its own
+    return np.array([no_load[i] for i, _, _ in source]), np.array([loaded[i] for i, _, _ in source])
+
+
+def te_plan(stage: ReducerStage, thetas: np.ndarray) -> tuple[np.ndarray, list]:
+    """The crank angles (indices into ``thetas``, rad) whose TE :func:`transmission_error` solves,
+    and for every angle the solved one it repeats (:func:`rvfem.solve.cycle.symmetry_plan`: the
+    carrier rotation repeats where the stage does, a turn by 2π/N and the pair swapped at π)."""
+    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    return symmetry_plan(np.asarray(thetas, dtype=float), min(s.symmetry for s in systems),
+                         stage.discs == 2 and stage.mirrored_pairs)
+
+
+def te_at_angles(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float, friction: float = 0.0
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The carrier rotation at no load and at ``torque_Nm`` (N·m) at each crank angle (rad), rad:
+    the angles one after the other, each solve started from the last one's contacts.
+
+    No load: the stage solved at +ZERO_FRACTION·T (the profile's gaps, modification and pitch
+    error, closed on the driving side: the kinematic TE), reached from the loaded solve through
+    :data:`TE_LADDER` (a nearly unloaded stage is nearly a mechanism; from a loaded start its
+    active set settles). The running stage's pins slide as the crank turns (``slip`` 0)."""
     T = float(torque_Nm)
     ladder = [T * f for f in TE_LADDER] + [ZERO_FRACTION * T]
     thetas = np.asarray(thetas, dtype=float)
-    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
-    # the carrier rotation repeats where the stage does (a turn by 2π/N, the pair swapped at π)
-    solve_at, source = symmetry_plan(thetas, min(s.symmetry for s in systems),
-                                     stage.discs == 2 and stage.mirrored_pairs)
-    prefetch_columns(stage, thetas[solve_at], OperatingPoint(T, float(friction), 0))
-    no_load, loaded = {}, {}
+    prefetch_columns(stage, thetas, OperatingPoint(T, float(friction), 0))
+    no_load, loaded = np.zeros(len(thetas)), np.zeros(len(thetas))
     start = None
-    for i in solve_at:
-        r, _, pairs = loop_at_torques(stage, float(thetas[i]), ladder, friction, np.zeros(len(ladder), dtype=int),
+    for i, theta in enumerate(thetas):
+        r, _, pairs = loop_at_torques(stage, float(theta), ladder, friction, np.zeros(len(ladder), dtype=int),
                                       start=start, start_torque=None)
         loaded[i], no_load[i] = r[0], r[-1]
         start = pairs[0]
-    return np.array([no_load[i] for i, _, _ in source]), np.array([loaded[i] for i, _, _ in source])
+    return no_load, loaded
 
 
 def rigid_kinematic_te(geometry, thetas: np.ndarray) -> np.ndarray:

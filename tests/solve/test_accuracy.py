@@ -32,6 +32,7 @@ from rvfem.solve.accuracy import (
     hysteresis_loop,
     rigid_kinematic_te,
     stiffened_stage,
+    te_plan,
     transmission_error,
 )
 
@@ -281,34 +282,45 @@ def test_hysteresis_command_writes_the_folder(tmp_path, capsys):
     assert "torsional rigidity" in capsys.readouterr().out
 
 
-def test_the_te_of_the_child_process_is_the_te_solved_here(mesh_dir):
-    """``rvfem hysteresis --te`` solves the TE in a child process beside the loops: the same stage
-    built there on its own factorisation gives the TE of this process to round-off; a child
-    that has ended leaves the TE to this process (``result`` None)."""
-    from rvfem.app.hysteresis import _TransmissionErrorChild, _usable_cores, te_angles
+def test_the_te_shared_with_the_child_process_is_the_te_solved_here(mesh_dir):
+    """``rvfem hysteresis --te`` shares the TE's crank angles with a child process: the child
+    solves shares from the first angle on, on the same stage built there on its own
+    factorisation, this process the rest from the last angle back. Together they give the TE of
+    this process alone to round-off; the shares of a child that has ended are solved here; no TE
+    asked, no child."""
+    from rvfem._child import usable_cores
+    from rvfem.app.hysteresis import TE_SHARE_ANGLES, _TransmissionErrorChild, te_angles
     from rvfem.geometry import disc_geometry
 
-    if _usable_cores() < 2:
+    if usable_cores() < 2:
         pytest.skip("one core: the TE is solved in this process (no child)")
 
-    case = coarse_case("rv40e", analysis={"angle_step_deg": 30.0})
+    case = coarse_case("rv40e", analysis={"angle_step_deg": 3.0})
     geometry = disc_geometry(case)
     mesh = mesh_case(case, mesh_dir, geometry=geometry)
-    here = transmission_error(cycle.case_stage(cycle.build_system(case, mesh, geometry=geometry)), te_angles(case),
-                              T_R, 0.05)
-    with _TransmissionErrorChild(case) as child:
-        child.start(mesh, geometry, T_R, 0.05)
-        there = child.result()
-    assert there is not None
+    stage = cycle.case_stage(cycle.build_system(case, mesh, geometry=geometry))
+    thetas = te_angles(case)
+    here = transmission_error(stage, thetas, T_R, 0.05)
+    assert len(te_plan(stage, thetas)[0]) > 2 * TE_SHARE_ANGLES     # shares for both processes
+
+    def shared(kill: bool = False, te_case=case):
+        with _TransmissionErrorChild(te_case) as child:
+            if kill:
+                child._child._proc.kill()
+            child.start(mesh, geometry)
+            child.begin(stage, thetas, T_R, 0.05)
+            result = transmission_error(stage, thetas, T_R, 0.05, solve=child.solve(stage, T_R, 0.05))
+            return result, child.shares_to_child
+
+    for kill in (False, True):
+        there, given = shared(kill)
+        assert given >= 1
+        for a, b in zip(there, here):
+            np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12 * np.max(np.abs(here[1])))
+    there, given = shared(te_case=None)                     # no TE asked: no child, solved here
+    assert given == 0
     for a, b in zip(there, here):
-        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12 * np.max(np.abs(here[1])))
-    with _TransmissionErrorChild(case) as child:
-        child._child._proc.kill()
-        child.start(mesh, geometry, T_R, 0.05)
-        assert child.result() is None
-    with _TransmissionErrorChild(None) as child:             # no TE asked: no child
-        child.start(mesh, geometry, T_R, 0.05)
-        assert child.result() is None
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=0)
 
 
 @pytest.mark.parametrize("options, cause", [
