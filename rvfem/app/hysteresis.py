@@ -260,6 +260,7 @@ class _TransmissionErrorChild:
     def __init__(self, case: Case | None):
         self._child: ChildProcess | None = None
         self._work: SharedWork | None = None
+        self._angles = np.zeros(0)
         self._case = case
         if case is None or not models_in_package(case) or usable_cores() < 2:
             return
@@ -282,7 +283,7 @@ class _TransmissionErrorChild:
         if self._child is None:
             return
         solve_at, _ = accuracy.te_plan(stage, thetas)
-        angles = np.asarray(thetas, dtype=float)[solve_at]
+        angles = self._angles = np.asarray(thetas, dtype=float)[solve_at]
         shares = [angles[i:i + TE_SHARE_ANGLES] for i in range(0, len(angles), TE_SHARE_ANGLES)]
         child = self._child
         self._work = SharedWork(shares, lambda share: child.call(_te_child_angles, share, float(torque),
@@ -295,7 +296,7 @@ class _TransmissionErrorChild:
             return accuracy.te_at_angles(stage, angles, torque, friction)
 
         def shared(angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            if self._work is None:
+            if self._work is None or not np.array_equal(np.asarray(angles, dtype=float), self._angles):
                 return here(angles)
             parts = self._work.finish(here)
             log.info("transmission error: %d of %d shares of %d crank angles solved in the child process",
