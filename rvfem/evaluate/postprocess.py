@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 from rvfem import fem
 from rvfem._arrays import TIE_RTOL, first_max, max_load_index, near_max
 from rvfem.fem import StressState, nodal_stress_operator
-from rvfem.geometry.features import feature_text
+from rvfem.names import FEATURE_LABELS, feature_label, user_feature_label
 from rvfem.solve.cycle import displacement, displacements
 
 __all__ = [
@@ -120,34 +120,6 @@ class PeakStress:
     feature: str
     feature_label: str
     distance_to_feature_mm: float
-
-
-FEATURE_LABELS = {
-    "profile": "tooth profile",
-    "central_hole": "central hole",
-}
-"""Readable names of the mesh boundaries (bores and holes are numbered, see :func:`feature_label`)."""
-
-
-def feature_label(name: str) -> str:
-    """Readable name of a mesh boundary, numbered from 1 as everything rvfem prints names it (the
-    words of the check's messages, :func:`rvfem.geometry.features.feature_text`, without the
-    article): ``bore_0`` → ``bore 1`` (the bore of bearing 1), ``hole_2`` → ``hole 3`` (lightening
-    hole 3), ``profile`` → ``tooth profile``, ``central_hole`` → ``central hole``."""
-    if name in FEATURE_LABELS:
-        return FEATURE_LABELS[name]
-    return feature_text(name)
-
-
-def user_feature_label(name: str) -> str:
-    """:func:`feature_label` of a name numbered from 1 already (the ``feature`` of ``summary.json``,
-    :func:`user_feature_name`): ``bore_1`` → ``bore 1``, ``central_hole`` → ``central hole``."""
-    if name in FEATURE_LABELS:
-        return FEATURE_LABELS[name]
-    stem, _, number = name.rpartition("_")
-    if stem in ("bore", "hole") and number.isdigit():
-        return f"{stem} {number}"
-    return name
 
 
 def nearest_index(thetas: np.ndarray, theta: float) -> int:

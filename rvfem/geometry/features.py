@@ -38,6 +38,7 @@ from rvfem._arrays import points_in_polygon
 from rvfem.case.definition import Case
 from rvfem.errors import GeometryError
 from rvfem.geometry.kinematics import crank_centres
+from rvfem.names import feature_text
 from rvfem.geometry.profile import Profile, build_profile
 
 __all__ = [
@@ -64,20 +65,6 @@ WALL_SAMPLES = 20_000
 at sampling_length/WALL_SAMPLES instead of WALL_SPACING, so that checking a large disc stays cheap.
 The error of a wall measured on samples is about spacing²/(8·radius of curvature): 0.05 µm for a
 1 mm fillet at 0.02 mm spacing, 1.3 µm at 0.1 mm."""
-
-
-def feature_text(name: str) -> str:
-    """A feature's name as messages give it, numbered from 1 like bearings and pins: ``bore_0`` →
-    "bore 1" (the bore of bearing 1), ``hole_2`` → "hole 3", ``central_hole`` → "the central hole",
-    ``profile`` → "the tooth profile"; other names unchanged."""
-    if name == "central_hole":
-        return "the central hole"
-    if name == "profile":
-        return "the tooth profile"
-    stem, _, number = name.rpartition("_")
-    if stem in ("bore", "hole") and number.isdigit():
-        return f"{stem} {int(number) + 1}"
-    return name
 
 
 def length_text(x: float) -> str:

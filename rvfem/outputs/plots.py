@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rvfem.evaluate.postprocess import feature_label
+from rvfem.names import feature_label
 from rvfem.outputs.figures import new_figure, save_figure
 
 __all__ = ["mesh_plot", "mesh_preview", "rim_closeup", "bearing_loads_plot", "roller_loads_plot", "pin_forces_plot", "pins_in_contact_plot"]
