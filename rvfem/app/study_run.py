@@ -37,6 +37,7 @@ import os
 import shutil
 import signal
 import socket
+import sys
 import threading
 import time
 import uuid
@@ -263,7 +264,14 @@ class _SingleThreadedBlasSetup:
       variant that fails is a record with its error; a worker that dies is a ``KilledWorker``) or
       noise of a shutdown: after Ctrl-C the scheduler may close while a worker's heartbeat is in
       flight, and the worker would print "Failed to communicate with scheduler during heartbeat"
-      with its traceback under the command's one line "interrupted".
+      with its traceback under the command's one line "interrupted";
+    - ends a local worker's process at once when it is closed under a running variant (Ctrl-C:
+      this process cancels the variants and closes the cluster; the variant's temporary folder is
+      removed by the study afterwards). Its Python would otherwise finalise while the variant's
+      thread (a daemon thread of Dask's) is still inside a compiled library, and stop that
+      thread there: seen once as the C++ runtime's "terminate called without an active
+      exception" on the user's terminal (Dask reports the like as "Fatal Python error ... at
+      interpreter shutdown, possibly due to daemon threads").
     """
 
     name = "rvfem-single-threaded-blas"
@@ -288,6 +296,13 @@ class _SingleThreadedBlasSetup:
                     os.sched_setaffinity(int(tid), core)   # threads started later inherit it
             except OSError:
                 log.debug("could not pin worker %s to a core", worker.name, exc_info=True)
+
+    def teardown(self, worker) -> None:
+        if self.local and getattr(worker, "active_threads", None):   # closed under a running variant
+            for stream in (sys.stdout, sys.stderr):
+                with contextlib.suppress(Exception):
+                    stream.flush()
+            os._exit(0)
 
 
 @functools.cache

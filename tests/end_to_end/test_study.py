@@ -635,6 +635,24 @@ def test_local_workers_keep_dask_log_messages_to_critical_ones():
     assert list(levels.values()) == [(logging.CRITICAL,) * 3]
 
 
+def test_a_local_worker_closed_under_a_running_variant_ends_at_once(monkeypatch):
+    """Closing a local worker while a variant runs (Ctrl-C) ends its process at once, before its
+    Python finalises with the variant's thread still inside a compiled library; an idle local
+    worker, and any worker of a cluster the user started, closes as Dask closes it."""
+    from types import SimpleNamespace
+
+    from rvfem.app import study_run
+
+    ended = []
+    monkeypatch.setattr(study_run.os, "_exit", lambda code: ended.append(code))
+    busy, idle = SimpleNamespace(active_threads={1: "variant"}), SimpleNamespace(active_threads={})
+    study_run._SingleThreadedBlasSetup(local=True).teardown(busy)
+    assert ended == [0]
+    study_run._SingleThreadedBlasSetup(local=True).teardown(idle)
+    study_run._SingleThreadedBlasSetup(local=False).teardown(busy)
+    assert ended == [0]
+
+
 def test_ctrl_c_on_a_local_cluster_prints_one_line(meshes, tmp_path):
     """Ctrl-C at a terminal signals the whole process group, the local cluster's workers too: the
     command still prints one line ("interrupted"), no worker traceback, no Dask warning."""
