@@ -14,7 +14,7 @@ MAIN_JOB ?= run cases/rv40e_fanholes.toml -o results/rv40e_fanholes --overwrite
 # rvfem's modules compiled to bytecode (only those changed since): an editable install does not
 # compile them, and where PYTHONDONTWRITEBYTECODE is set (as in many containers) every Python
 # process of a run (the main one, the P2 model's, the render worker's) would compile them again,
-# about 0.15 s each (benchmarks/README.md, "Start-up").
+# about 0.2 s of processor time each (benchmarks/README.md, "Start-up").
 BYTECODE = $(BIN)/python -m compileall -q rvfem
 
 # Parallel pytest workers of `make test` (pytest-xdist's -n: a number, auto = one per core, 0 = none).
