@@ -66,9 +66,28 @@ _SHAPES_PER_SOLVER = 4
 
 def influence_inverse(influence: np.ndarray) -> np.ndarray:
     """C⁻¹ of an influence matrix (:func:`rvfem.evaluate.roller_slices.rectangle_influence`), for :func:`solve_slices`'s
-    ``inverse``, 1/(mm/MPa)."""
+    ``inverse``, 1/(mm/MPa).
+
+    The slices' C is centrosymmetric (C_(n−1−i)(n−1−j) = C_ij: the layout is symmetric about the
+    roller's middle). With n = 2m, P = diag(I, J) (J reverses m entries) turns it into
+    [[A, D], [D, A]] (A = C[:m, :m], D = C[:m, m:]·J), whose inverse is ½[[X + Y, X − Y], [X − Y,
+    X + Y]] with X = (A + D)⁻¹, Y = (A − D)⁻¹: two inverses of half the size, a quarter of the
+    work. Any other C is inverted as it is."""
+    c = np.asarray(influence, dtype=float)
+    n = c.shape[0]
     with single_threaded_blas():
-        return np.linalg.inv(np.asarray(influence, dtype=float))
+        if n < 2 or n % 2 or not np.array_equal(c, c[::-1, ::-1]):
+            return np.linalg.inv(c)
+        m = n // 2
+        a, d = c[:m, :m], c[:m, m:][:, ::-1]
+        x, y = np.linalg.inv(a + d), np.linalg.inv(a - d)
+    plus, minus = 0.5 * (x + y), 0.5 * (x - y)
+    h = np.empty_like(c)
+    h[:m, :m] = plus
+    h[:m, m:] = minus[:, ::-1]
+    h[m:, :m] = minus[::-1, :]
+    h[m:, m:] = plus[::-1, ::-1]
+    return h
 
 
 _BATCH_ELEMENTS = 1 << 21

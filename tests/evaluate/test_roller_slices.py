@@ -358,3 +358,25 @@ def test_influence_of_slices_on_one_line_equals_the_four_corner_sum():
         line = rs.rectangle_influence(x, dx, 0.07, E_STAR, half_heights_mm=hh)
         grid = rs.rectangle_influence(x, dx, 0.07, E_STAR, y_mm=np.zeros_like(x), half_heights_mm=hh)
         np.testing.assert_allclose(line, grid, rtol=1e-13, atol=1e-15 * np.abs(grid).max())
+
+
+@pytest.mark.parametrize("slices", [30, 31, 400])
+def test_the_influence_matrix_of_a_symmetric_layout_and_its_inverse_by_halves(slices):
+    """The slice layout is symmetric about the roller's middle, so C is centrosymmetric and only
+    half its rows are computed; C⁻¹ comes from two inverses of half the size. Both against the
+    whole computation (Love's corner function on every row, ``numpy.linalg.inv``); an odd count
+    and a matrix that is not centrosymmetric take the whole way."""
+    from rvfem.evaluate.slice_solver import influence_inverse
+
+    x, dx = rs.slice_layout(RollerProfile(kind="straight", slices=slices), 15.8)
+    b, e_star = 0.05, 2.3e5
+    c = rs.rectangle_influence(x, dx, b, e_star)
+    d = x[:, None] - x[None, :]
+    whole = sum(2.0 * s * rs._love(d + s * 0.5 * dx[None, :], np.full(d.shape, b)) for s in (-1.0, 1.0)) / (math.pi * e_star)
+    np.testing.assert_allclose(c, whole, rtol=1e-14, atol=0)
+    h = influence_inverse(c)
+    np.testing.assert_allclose(h, np.linalg.inv(whole), rtol=1e-11, atol=1e-13 * np.abs(h).max())
+    np.testing.assert_allclose(c @ h, np.eye(slices), atol=1e-12)
+    skew = c.copy()
+    skew[0, -1] *= 1.01                                       # not centrosymmetric: inverted as it is
+    np.testing.assert_allclose(influence_inverse(skew) @ skew, np.eye(slices), atol=1e-12)
