@@ -44,7 +44,7 @@ from rvfem.solve.cycle import (
     solve_pair,
     symmetry_plan,
 )
-from rvfem.solve.cycle_stage import prefetch_columns
+from rvfem.solve.cycle_stage import prefetch_columns, stage_symmetry
 from rvfem.solve.stage_parts import STIFFEN, component_names, stiffened_stage
 from rvfem.units import arcmin_from_rad, nm_from_nmm
 
@@ -350,9 +350,7 @@ def te_plan(stage: ReducerStage, thetas: np.ndarray) -> tuple[np.ndarray, list]:
     """The crank angles (indices into ``thetas``, rad) whose TE :func:`transmission_error` solves,
     and for every angle the solved one it repeats (:func:`rvfem.solve.cycle.symmetry_plan`: the
     carrier rotation repeats where the stage does, a turn by 2π/N and the pair swapped at π)."""
-    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
-    return symmetry_plan(np.asarray(thetas, dtype=float), min(s.symmetry for s in systems),
-                         stage.discs == 2 and stage.mirrored_pairs)
+    return symmetry_plan(np.asarray(thetas, dtype=float), *stage_symmetry(stage))
 
 
 def te_at_angles(stage: ReducerStage, thetas: np.ndarray, torque_Nm: float, friction: float = 0.0

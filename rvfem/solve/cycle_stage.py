@@ -137,6 +137,11 @@ class ReducerStage:
     def discs(self) -> int:
         return 1 if self.second is None else 2
 
+    @property
+    def systems(self) -> list[DiscSystem]:
+        """The disc models: disc A's, and disc B's (which may be disc A's itself)."""
+        return [self.first] if self.second is None else [self.first, self.second]
+
     def carrier_torque_Nmm(self, op: OperatingPoint) -> float:
         """Torque on the carrier from the discs modelled here at the operating point, a moment about
         the reducer axis, N·mm: T_out for two discs, T_out/discs for one disc (the handbook's equal
@@ -309,7 +314,7 @@ def stage_contact_set(stage: ReducerStage, system, theta: float, op: OperatingPo
 
 
 def _bodies(stage: ReducerStage, theta: float, op: OperatingPoint):
-    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    systems = stage.systems
     thetas = _disc_angles(stage, theta)
     phases = [0.0, stage.second_phase][:len(systems)]
     sets = [stage_contact_set(stage, s, th, op) for s, th in zip(systems, thetas)]
@@ -446,6 +451,13 @@ def _prefetch_stage(stage: ReducerStage, systems: list, thetas: np.ndarray, solv
         s.compliance.ensure(likely_columns(s, sets, stage.carrier_torque_Nmm(op)))
 
 
+def stage_symmetry(stage: ReducerStage) -> tuple[int, bool]:
+    """(N, mirrored) of a stage for :func:`rvfem.solve.cycle.symmetry_plan`: its results repeat,
+    turned, every 2π/N (N the smaller rotation symmetry of its discs) and, with two discs mirrored
+    at π, with the discs swapped every π."""
+    return min(s.symmetry for s in stage.systems), stage.discs == 2 and stage.mirrored_pairs
+
+
 def prefetch_columns(stage: ReducerStage, thetas, op: OperatingPoint, torques_Nmm=None) -> None:
     """Build the contacts of both discs at the stage's crank angles ``thetas`` (rad) in one sweep
     per disc model, and compute the compliance columns solves there will likely need
@@ -453,7 +465,7 @@ def prefetch_columns(stage: ReducerStage, thetas, op: OperatingPoint, torques_Nm
     operating point's) in one parallel sweep per model, instead of a few at a time as each solve
     first needs them. For solves outside a load cycle at many crank angles (the transmission
     error over a revolution); columns missed here are still computed when first needed."""
-    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
+    systems = stage.systems
     angles = [_disc_angles(stage, float(t)) for t in np.atleast_1d(thetas)]
     torques = [stage.carrier_torque_Nmm(op)] if torques_Nmm is None else list(torques_Nmm)
     for d, s in enumerate(systems):
@@ -512,14 +524,12 @@ def solve_stage_cycle(stage: ReducerStage, thetas: np.ndarray, op: OperatingPoin
     """
     thetas = np.asarray(thetas, dtype=float)
     n = len(thetas)
-    systems = [stage.first] if stage.second is None else [stage.first, stage.second]
-    order = min(s.symmetry for s in systems)
-    mirrored = stage.discs == 2 and stage.mirrored_pairs
+    order, mirrored = stage_symmetry(stage)
     solve_at, source = symmetry_plan(thetas, order, mirrored)
     step = 2.0 * math.pi / order
 
     t0 = time.perf_counter()
-    _prefetch_stage(stage, systems, thetas, solve_at, source, step, op)
+    _prefetch_stage(stage, stage.systems, thetas, solve_at, source, step, op)
     t_prefetch = time.perf_counter() - t0
     log.info("stage compliance prefetch %.2f s", t_prefetch)
     pairs: list[PairResult] = []
