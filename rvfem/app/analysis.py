@@ -280,7 +280,7 @@ def kept_field_angles(case: Case, field_step_deg: float | None) -> tuple[float, 
 def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None = None, *,
             overrides: tuple[str, ...] = (), cache_dir: str | os.PathLike[str] | None = None,
             progress: ProgressCallback | None = None, provenance: CaseProvenance | None = None,
-            on_model: Callable[[Any], None] | None = None, **choices: Any) -> Analysis:
+            after: Mapping[str, Callable[[Any], None]] = MappingProxyType({}), **choices: Any) -> Analysis:
     """Analyse a case completely, in memory.
 
     The choices of what to compute are an :class:`~rvfem.results.analysis.AnalysisOptions` (``options``),
@@ -317,13 +317,14 @@ def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None
         load cycle per torque, no new factorisation).
     attribute : bool
         Compute the attribution (:func:`rvfem.evaluate.attribution.attribution`, stage ``attribution``). False
-        leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`):
-        :func:`rvfem.app.run.run_case` computes it while the output files are drawn.
+        leaves ``Analysis.attribution`` None for the caller to fill (:func:`attribution_of`).
     sections : tuple of str, optional
         Only these result sections and those they require (:func:`selected_sections`; default all).
-    on_model : callable, optional
-        ``on_model(system)`` with the disc's :class:`rvfem.solve.cycle.DiscSystem` once it is built,
-        before the load cycle (:func:`rvfem.app.run.run_case` has the mesh picture drawn meanwhile).
+    after : mapping of str to callable, optional
+        ``after[name](result)`` once ``name`` is computed: ``"model"`` with the disc's
+        :class:`rvfem.solve.cycle.DiscSystem` (before the load cycle), a result section's name with
+        the :class:`Analysis` so far (later sections at their defaults). :func:`rvfem.app.run.run_case`
+        so hands the mesh picture, the stress images and the plots to its render worker early.
 
     Returns
     -------
@@ -343,16 +344,15 @@ def analyse(case: Case | str | os.PathLike[str], options: AnalysisOptions | None
     stages = Stages(progress)
     checked = _checked_case(case, provenance, stages, overrides, options)
     case = checked.case
-    # the P2 model of the stress stage is built in a child process beside the load cycle
-    # (:class:`P2Model`); the process starts now, so that its imports are done meanwhile
+    # the P2 model is built in a child process beside the load cycle (:class:`P2Model`): started now, it imports meanwhile
     child = (start_p2_child() if options.recover_stress and case.analysis.element_order == 1
              and models_in_package(case) else None)
     background = ThreadPoolExecutor(1, thread_name_prefix="rvfem-background")
     try:
         model = _disc_model(case, stages, cache_dir, checked)
-        if on_model is not None:
-            on_model(model.system)
-        return _analyse_from_model(case, checked.provenance, stages, model, background, options, child)
+        if "model" in after:
+            after["model"](model.system)
+        return _analyse_from_model(case, checked.provenance, stages, model, background, options, child, after)
     finally:
         background.shutdown(wait=True, cancel_futures=True)
         if child is not None:
@@ -441,7 +441,8 @@ class StressEnvelope:
 
 def _analyse_from_model(case: Case, provenance: CaseProvenance, stages: Stages, model: _DiscModel,
                         background: ThreadPoolExecutor, options: AnalysisOptions,
-                        child: ChildProcess | None = None) -> Analysis:
+                        child: ChildProcess | None = None,
+                        after: Mapping[str, Callable[[Any], None]] = MappingProxyType({})) -> Analysis:
     """The stages of :func:`analyse` after the model: its fixed front (the rigid references, the load
     cycle and its stress envelope), then every result section (:func:`_compute_sections`)."""
     # the rigid model before the cycle: a case outside every rigid reference fails fast
@@ -484,7 +485,7 @@ def _analyse_from_model(case: Case, provenance: CaseProvenance, stages: Stages, 
         }
         stages.end("evaluation", t)
         computed, seconds = _compute_sections(available, stages, background, release={"stress": p2},
-                                              only=options.sections)
+                                              only=options.sections, after=after)
     finally:
         if p2 is not None:          # the P2 model (a few hundred MB) is not needed any more
             p2.close()
@@ -514,6 +515,10 @@ def _stress_envelope(case: Case, system: DiscSystem, mesh: DiscMesh, cycle: Cycl
 
 _ANALYSIS_FIELDS = tuple(f.name for f in dataclasses.fields(Analysis) if f.name not in ("timings", "extra"))
 """The fields of :class:`~rvfem.results.analysis.Analysis` the results fill (by name)."""
+
+_REQUIRED_FIELDS = tuple(f.name for f in dataclasses.fields(Analysis)
+                         if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
+"""The fields of :class:`~rvfem.results.analysis.Analysis` without a default."""
 
 
 def _analysis_of(results: Mapping[str, Any], timings: dict[str, float]) -> Analysis:
@@ -559,14 +564,18 @@ def selected_sections(only: Sequence[str] | None) -> tuple[Section, ...]:
 
 def _compute_sections(available: dict[str, Any], stages: Stages, background: ThreadPoolExecutor,
                       release: Mapping[str, Any] = MappingProxyType({}),
-                      only: Sequence[str] | None = None) -> tuple[dict[str, Any], dict[str, float]]:
+                      only: Sequence[str] | None = None,
+                      after: Mapping[str, Callable[[Any], None]] = MappingProxyType({}),
+                      ) -> tuple[dict[str, Any], dict[str, float]]:
     """Compute every result section that has a ``compute`` (:func:`rvfem.results.registry.sections`).
 
     The order: by their stage among :data:`STAGES` (the order the user sees), those without a stage
     after them, and those that require ``analysis`` (the whole result so far) last, each group in the
     sections' order. A ``thread`` section starts on ``background`` as soon as the front is done and
     is waited for (its stage) at its turn. ``release[name].close()`` is called once section
-    ``name`` is done (the P2 model after the stress). Returns the results by section name and the
+    ``name`` is done (the P2 model after the stress), then ``after[name](analysis)`` with the
+    :class:`Analysis` of the results so far (those not computed yet at their defaults, None; also
+    for a section that does not apply). Returns the results by section name and the
     wall time of the thread sections' own work (s), by name. With ``only``, just the sections of
     :func:`selected_sections` (the others are left out of the results: None in the analysis).
     """
@@ -592,9 +601,15 @@ def _compute_sections(available: dict[str, Any], stages: Stages, background: Thr
 
     started = {s.name: background.submit(timed, s.compute, inputs(s)) for s in order
                if s.compute is not None and s.executor == "thread" and "analysis" not in s.requires and applies(s)}
+    def done(section: Section) -> None:
+        if section.name in after:   # the fields no section has given yet: None, or their defaults
+            pending = {name: None for name in _REQUIRED_FIELDS if name not in available and name not in results}
+            after[section.name](_analysis_of({**available, **pending, **results}, dict(stages.seconds)))
+
     for s in order:
         if s.compute is None or (s.name not in started and not applies(s)):
             results[s.name] = None
+            done(s)
             continue
         stage = s.stage
         steps = StageSteps(stages, stage) if stage is not None and stage not in stages.seconds else None
@@ -609,6 +624,7 @@ def _compute_sections(available: dict[str, Any], stages: Stages, background: Thr
             stages.seconds[stage] += time.perf_counter() - t
         if s.name in release and release[s.name] is not None:
             release[s.name].close()
+        done(s)
     return results, seconds
 
 

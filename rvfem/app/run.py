@@ -18,7 +18,9 @@ It is :func:`rvfem.app.analysis.analyse` (everything computed, nothing written) 
 of :mod:`rvfem.outputs.summary`, one per format. With images, off-screen rendering is checked by a child
 process (:class:`rvfem.outputs.render.RenderWorker`) started with the run: the check runs while the mesh
 and the model are built, and the run waits for it before the load cycle (a failed check stops the
-run there); the same process then draws the stress images while the other files are written. Nothing is lost: the outputs are written into a temporary
+run there); the same process then draws the stress images, from the end of the ``stress`` section
+on, and the plots, from the end of the crank bearing in depth on, while the other sections are
+computed and the other files written. Nothing is lost: the outputs are written into a temporary
 folder next to DIR (:func:`rvfem.outputs.summary.result_folder`) and moved into place only when complete. An existing non-empty DIR is replaced only with ``overwrite=True`` (and only
 after the new results are complete); a run that fails or is interrupted leaves neither DIR (nor
 the previous results changed) nor the temporary folder.
@@ -227,9 +229,9 @@ def run_case(case: Case | str | os.PathLike, out_dir: str | os.PathLike, *, angl
     try:
         with outputs.result_folder(out_dir, overwrite=overwrite) as tmp:
             try:
-                result, mesh_call = _analyse_for_run(checked, tmp, stages, progress=progress, cache_dir=cache_dir,
-                                                     field_step_deg=field_step_deg)
-                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, mesh_call)
+                result, drawings = _analyse_for_run(checked, tmp, stages, progress=progress, cache_dir=cache_dir,
+                                                    field_step_deg=field_step_deg)
+                summary, files, result = _write_outputs(result, tmp, stages, worker, t_run, drawings)
             finally:
                 if worker is not None:
                     worker.close()   # before the folder is moved or removed: nothing writes into it
@@ -280,30 +282,73 @@ def _checked_run(case: Case | str | os.PathLike, out_dir: Path, stages: Stages, 
 
 def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progress: ProgressCallback | None,
                      cache_dir: str | os.PathLike | None, field_step_deg: float | None):
-    """The analysis of a run (:func:`rvfem.app.analysis.analyse`); returns it and the render worker's
-    call drawing the mesh picture into ``tmp`` (None without a worker).
+    """The analysis of a run (:func:`rvfem.app.analysis.analyse`); returns it and what the render
+    worker was handed meanwhile (:class:`_Drawings`; empty without a worker).
 
     With a render worker the mesh picture is handed to it once the model is built (it draws
-    during the load cycle), the load cycle waits for its rendering check, and the attribution is
+    during the load cycle), the load cycle waits for its rendering check, the stress images are
+    handed to it as soon as the ``stress`` section is computed and the plots once the
+    ``roller_depth`` section is (the last result they show; it draws them while the other sections
+    are computed: the crank bearing in depth, the L10r steps, ...), and the attribution is
     left for :func:`_write_outputs` to compute while the worker draws; the waits for the
-    rendering check count in the ``check`` stage.
+    rendering check count in the ``check`` stage. (Handing the drawings over early: 0.935–1.0 of the
+    run's wall time on the default case, benchmarks/README.md, "Overlap of the run's processes".)
     """
     worker = checked.worker
-    waited, mesh_call = [0.0], []
+    waited, drawings = [0.0], _Drawings()
 
     def draw_mesh(system):   # the worker draws the mesh picture during the load cycle
         t = time.perf_counter()
         try:
-            mesh_call.append(outputs.start_mesh_picture(system, tmp, worker))
+            drawings.mesh_call = outputs.start_mesh_picture(system, tmp, worker)
         finally:
             waited[0] += time.perf_counter() - t   # the rendering check, if not done
+
+    def draw_stress_images(partial):   # the worker draws them beside the sections after the stress
+        drawings.started = time.perf_counter()
+        drawings.images = outputs.submit_images(partial, tmp, worker, mesh_call=drawings.mesh_call)
+        drawings.handover_s = time.perf_counter() - drawings.started
+
+    def draw_plots(partial):           # every result a plot shows is computed by now
+        if drawings.images is not None:
+            t = time.perf_counter()
+            drawings.images.add_calls(outputs.plot_calls(partial, tmp))
+            drawings.plots_handed = True
+            drawings.handover_s += time.perf_counter() - t
 
     # with a render worker the attribution is computed here while the worker draws
     result = analyse(checked.case, provenance=checked.provenance, field_step_deg=field_step_deg,
                      cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
-                     attribute=worker is None, on_model=draw_mesh if worker is not None else None)
+                     attribute=worker is None,
+                     after={"model": draw_mesh, "stress": draw_stress_images, "roller_depth": draw_plots}
+                     if worker is not None else {})
     stages.seconds["check"] += waited[0]
-    return result, (mesh_call[0] if mesh_call else None)
+    return result, drawings
+
+
+@dataclass
+class _Drawings:
+    """What a run's render worker was handed during the analysis (:func:`_analyse_for_run`).
+
+    Attributes
+    ----------
+    mesh_call : int or None
+        The number of the mesh picture's call (:func:`rvfem.outputs.summary.start_mesh_picture`).
+    images : PendingImages or None
+        The stress images, handed over once the ``stress`` section was computed.
+    plots_handed : bool
+        The plots were handed over too (once the ``roller_depth`` section was computed).
+    started : float or None
+        When they were handed over (``time.perf_counter``).
+    handover_s : float
+        The time handing them over took (building the scenes, sending them), s.
+    """
+
+    mesh_call: int | None = None
+    images: outputs.PendingImages | None = None
+    plots_handed: bool = False
+    started: float | None = None
+    handover_s: float = 0.0
 
 
 def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: list[float]) -> ProgressCallback:
@@ -324,7 +369,7 @@ def _checked_before_cycle(progress: ProgressCallback | None, worker, waited: lis
     return report
 
 
-def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh_call: int | None = None):
+def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, drawings: _Drawings | None = None):
     """Write every file of the result folder ``tmp``; returns the summary, the files and the
     analysis (with its attribution).
 
@@ -345,8 +390,8 @@ def _write_outputs(result, tmp: Path, stages: Stages, worker, t_run: float, mesh
         stages.end("attribution", t)
 
     registered = outputs.writers(images=worker is not None)
-    written = _write_files(result, tmp, stages, worker, [w for w in registered if not w.needs_summary], mesh_call,
-                           meanwhile=attribute if result.attribution is None else None)
+    written = _write_files(result, tmp, stages, worker, [w for w in registered if not w.needs_summary],
+                           drawings or _Drawings(), meanwhile=attribute if result.attribution is None else None)
     if computed:
         (value, seconds), = computed
         result = dataclasses.replace(result, attribution=value,
@@ -383,19 +428,26 @@ def outside_stages(timings: dict) -> float:
     return timings["total"] - sum(float(timings.get(stage, 0.0)) for stage in STAGES)
 
 
-def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[outputs.Writer], mesh_call: int | None = None,
+def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[outputs.Writer], drawings: _Drawings,
                  meanwhile: Callable[[], None] | None = None) -> list[Path]:
     """Call the ``registered`` writers (the tables, the VTK files, the plots and the images), each
     run of writers sharing a stage reported as that stage. With ``worker`` the plots and the images
-    are handed to it first (the mesh picture is its call ``mesh_call`` if it was started already)
-    and the writers taking ``pending`` wait for them; ``meanwhile()`` is called before the first
-    of those."""
+    are handed to it first, those that ``drawings`` does not hold already (and the mesh picture
+    unless it was started already), and the writers taking ``pending`` wait for them;
+    ``meanwhile()`` is called before the first of those."""
     t_submit = time.perf_counter()
     pending = None
     if worker is not None:   # the child process draws the plots too (it has matplotlib loaded)
-        pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
-                                        mesh_call=mesh_call)
-    submitted = time.perf_counter() - t_submit
+        if drawings.images is not None:
+            pending = drawings.images
+            if not drawings.plots_handed:
+                pending.add_calls(outputs.plot_calls(result, tmp))
+        else:
+            pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
+                                            mesh_call=drawings.mesh_call)
+    submitted = time.perf_counter() - t_submit + drawings.handover_s
+    if drawings.started is not None:
+        t_submit = drawings.started
 
     written: list[Path] = []
     drawn = t_submit   # when the last writer waiting for the worker's drawings had them

@@ -124,6 +124,7 @@ class RenderWorker:
         self._calls: list[Future] = []
         self._images: list[Future] = []
         self._finish: Future | None = None
+        self._waited = False
         self._child: ChildProcess | None = None
         if isinstance(render_check._probe_result, RenderError):   # this process knows already: no child
             self._checked = render_check._probe_result
@@ -212,10 +213,11 @@ class RenderWorker:
         return self.wait(tick=tick)
 
     def start_calls(self, calls: Sequence[Call]) -> list[int]:
-        """Hand over drawings that need no stress images, which the child process starts in its
-        second thread as soon as its plotter is ready (e.g. the mesh picture while the caller still
-        computes); what they return comes with :meth:`wait_calls` and :meth:`wait` like the calls
-        of :meth:`submit`. Only before :meth:`submit`; returns at once.
+        """Hand over drawings that need no stress images, which the child process makes in its
+        second thread one after the other (e.g. the mesh picture while the caller still computes,
+        or the plots while the stress images are drawn); what they return comes with
+        :meth:`wait_calls` and :meth:`wait` like the calls of :meth:`submit`. Before or after
+        :meth:`submit`, as long as :meth:`wait` has not begun; returns at once.
 
         Parameters
         ----------
@@ -230,11 +232,11 @@ class RenderWorker:
         Raises
         ------
         RenderError
-            Off-screen rendering is not available, or the images were submitted already.
+            Off-screen rendering is not available, or the worker is waited for already.
         """
         self.check()
-        if self._jobs is not None:
-            raise RenderError("calls are started before the images are submitted")
+        if self._waited:
+            raise RenderError("calls are started before the render worker is waited for")
         return self._start(calls)
 
     def _send(self, function: Callable, *args, background: bool = False) -> Future:
@@ -312,6 +314,7 @@ class RenderWorker:
         """
         self._submitted()
         assert self._jobs is not None and self._finish is not None
+        self._waited = True
         try:
             self._opened.result()
             for done, image in enumerate(self._images, 1):

@@ -534,8 +534,13 @@ class PendingImages:
     def __init__(self, image_set: _ImageSet, worker, calls: list[int], mesh_call: int):
         self._set, self._worker, self._calls, self._mesh_call = image_set, worker, calls, mesh_call
 
+    def add_calls(self, calls: Iterable[tuple[Callable, dict]]) -> None:
+        """Hand further drawings to the child's second thread (e.g. :func:`plot_calls` once the
+        results they show are computed); :meth:`calls_result` waits for them with the others."""
+        self._calls = self._calls + self._worker.start_calls(list(calls))
+
     def calls_result(self) -> list:
-        """Wait for the calls given to :func:`submit_images` (the child makes them one after the
+        """Wait for the calls given to :func:`submit_images` and :meth:`add_calls` (the child makes them one after the
         other, after the mesh picture if that was started first, else before it) and return what
         they returned.
 

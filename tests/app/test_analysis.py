@@ -187,15 +187,32 @@ def test_rigid_handbook_curves_balance_the_disc_torque_and_are_shifts_of_each_ot
 @pytest.fixture(scope="module")
 def coarse(tmp_path_factory):
     """The CRV-80E on a coarse mesh at 30° steps (two discs on one carrier, crankshafts), without
-    the P2 stress re-solve; the progress reports recorded."""
-    reports = []
+    the P2 stress re-solve; the progress reports and the results after the ``stress`` and
+    ``roller_depth`` sections (``after``) recorded."""
+    reports, sections = [], {}
     result = analyse(coarse_case("crv80e"), angle_step_deg=STEP_DEG, recover_stress=False,
-                     cache_dir=tmp_path_factory.mktemp("meshes"), progress=lambda *r: reports.append(r))
-    return result, reports
+                     cache_dir=tmp_path_factory.mktemp("meshes"), progress=lambda *r: reports.append(r),
+                     after={name: lambda a, name=name: sections.setdefault(name, a)
+                            for name in ("model", "stress", "roller_depth")})
+    return result, reports, sections
+
+
+def test_after_gives_the_model_and_the_results_so_far_after_each_named_section(coarse):
+    """What a run hands its render worker early: after ``model`` the disc's system; after
+    ``stress`` the stress result that the analysis ends with and none of the later sections; after
+    ``roller_depth`` that one too."""
+    a, _, partial = coarse
+    assert list(partial) == ["model", "stress", "roller_depth"]
+    assert partial["model"] is a.system
+    assert a.roller_depth is not None
+    early = partial["stress"]
+    assert early.stress is a.stress and early.cycle is a.cycle and early.hertz is a.hertz
+    assert early.roller_depth is None and early.roller_life_steps is None and early.warnings == ()
+    assert partial["roller_depth"].roller_depth is a.roller_depth and partial["roller_depth"].stress is a.stress
 
 
 def test_the_cycle_is_in_equilibrium(coarse):
-    a, _ = coarse
+    a, _, _ = coarse
     case, cyc = a.case, a.cycle
     np.testing.assert_array_equal(a.theta, load_cycle_angles(STEP_DEG))
     np.testing.assert_array_equal(cyc.theta, a.theta)
@@ -214,7 +231,7 @@ def test_the_cycle_is_in_equilibrium(coarse):
 
 
 def test_the_comparison_holds_the_cycle_and_the_handbook_loads(coarse):
-    a, _ = coarse
+    a, _, _ = coarse
     loads = a.cycle.bearing_loads
     p = a.case.analysis.equivalent_load_exponent
     rigid = analyse_rigid(a.case, a.theta)
@@ -234,7 +251,7 @@ def test_the_comparison_holds_the_cycle_and_the_handbook_loads(coarse):
 
 
 def test_every_stage_is_timed_and_reported_in_order(coarse):
-    a, reports = coarse
+    a, reports, _ = coarse
     ran = ["check", "mesh", "model", "rigid", "cycle", "evaluation", "stress", "attribution", "accuracy",
            "roller_slices"]
     started = [stage for stage, done, _ in reports if done == 0]
@@ -253,7 +270,7 @@ def test_every_stage_is_timed_and_reported_in_order(coarse):
 
 
 def test_the_kept_fields_are_the_saved_angles_and_the_largest_load(coarse):
-    a, _ = coarse
+    a, _, _ = coarse
     kept = {round(s.theta_deg, 9) for s in a.stress.snapshots}
     k, _ = a.max_load_index
     assert set(a.case.analysis.saved_angles_deg) <= kept

@@ -210,17 +210,21 @@ def test_a_render_worker_makes_other_calls_meanwhile(scenes, tmp_path):
         with pytest.raises(FileNotFoundError):
             worker.wait_calls()
     # calls started before the images (a run's mesh picture during its load cycle) are numbered
-    # first; those of the images follow
+    # first; those of the images follow, then those started after the images (a run's plots once
+    # the results they show are computed); once the worker is waited for, no more
     with render.RenderWorker(SIZE) as worker:
         early = worker.start_calls([(shutil.copyfile, dict(src=source, dst=tmp_path / "early.txt"))])
         later = worker.submit([(tmp_path / "image3.png", scenes[0][0], {})],
                               calls=[(shutil.copyfile, dict(src=source, dst=tmp_path / "late.txt"))])
-        assert (early, later) == ([0], [1])
+        last = worker.start_calls([(shutil.copyfile, dict(src=source, dst=tmp_path / "last.txt"))])
+        assert (early, later, last) == ([0], [1], [2])
         assert worker.wait_calls(later) == [tmp_path / "late.txt"]
-        assert worker.wait() == [tmp_path / "image3.png", tmp_path / "early.txt", tmp_path / "late.txt"]
-        with pytest.raises(RenderError, match="before the images"):
+        assert worker.wait() == [tmp_path / "image3.png", tmp_path / "early.txt", tmp_path / "late.txt",
+                                 tmp_path / "last.txt"]
+        with pytest.raises(RenderError, match="before the render worker is waited for"):
             worker.start_calls([(shutil.copyfile, dict(src=source, dst=tmp_path / "too_late.txt"))])
-    assert (tmp_path / "early.txt").read_text() == "x"
+    assert (tmp_path / "early.txt").read_text() == "x" and (tmp_path / "last.txt").read_text() == "x"
+    assert not (tmp_path / "too_late.txt").exists()
 
 
 def test_a_crashing_render_worker_is_the_rendering_error(monkeypatch):
