@@ -601,6 +601,7 @@ def _compute_sections(available: dict[str, Any], stages: Stages, background: Thr
 
     started = {s.name: background.submit(timed, s.compute, inputs(s)) for s in order
                if s.compute is not None and s.executor == "thread" and "analysis" not in s.requires and applies(s)}
+
     def done(section: Section) -> None:
         if section.name in after:   # the fields no section has given yet: None, or their defaults
             pending = {name: None for name in _REQUIRED_FIELDS if name not in available and name not in results}
