@@ -18,9 +18,9 @@ It is :func:`rvfem.app.analysis.analyse` (everything computed, nothing written) 
 of :mod:`rvfem.outputs.summary`, one per format. With images, off-screen rendering is checked by a child
 process (:class:`rvfem.outputs.render.RenderWorker`) started with the run: the check runs while the mesh
 and the model are built, and the run waits for it before the load cycle (a failed check stops the
-run there); the same process then draws the stress images, from the end of the ``stress`` section
-on, and the plots, from the end of the crank bearing in depth on, while the other sections are
-computed and the other files written. Nothing is lost: the outputs are written into a temporary
+run there); the same process then draws the stress images and the plots of the load cycle, from
+the end of the ``stress`` section on, and the plots of the crank bearing in depth, from its end on,
+while the other sections are computed and the other files written. Nothing is lost: the outputs are written into a temporary
 folder next to DIR (:func:`rvfem.outputs.summary.result_folder`) and moved into place only when complete. An existing non-empty DIR is replaced only with ``overwrite=True`` (and only
 after the new results are complete); a run that fails or is interrupted leaves neither DIR (nor
 the previous results changed) nor the temporary folder.
@@ -286,13 +286,13 @@ def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progres
     worker was handed meanwhile (:class:`_Drawings`; empty without a worker).
 
     With a render worker the mesh picture is handed to it once the model is built (it draws
-    during the load cycle), the load cycle waits for its rendering check, the stress images are
-    handed to it as soon as the ``stress`` section is computed and the plots once the
-    ``roller_depth`` section is (the last result they show; it draws them while the other sections
-    are computed: the crank bearing in depth, the L10r steps, ...), and the attribution is
+    during the load cycle), the load cycle waits for its rendering check, the stress images and
+    the plots of the load cycle are handed to it as soon as the ``stress`` section is computed and
+    the plots of the crank bearing in depth once the ``roller_depth`` section is (it draws them
+    while the other sections are computed: the crank bearing in depth, the L10r steps, ...), and the attribution is
     left for :func:`_write_outputs` to compute while the worker draws; the waits for the
-    rendering check count in the ``check`` stage. (Handing the drawings over early: 0.935–1.0 of the
-    run's wall time on the default case, benchmarks/README.md, "Overlap of the run's processes".)
+    rendering check count in the ``check`` stage. (Handing the drawings over early: 0.91 of the run's
+    wall time on the default case, benchmarks/README.md, "Overlap of the run's processes".)
     """
     worker = checked.worker
     waited, drawings = [0.0], _Drawings()
@@ -306,13 +306,14 @@ def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progres
 
     def draw_stress_images(partial):   # the worker draws them beside the sections after the stress
         drawings.started = time.perf_counter()
-        drawings.images = outputs.submit_images(partial, tmp, worker, mesh_call=drawings.mesh_call)
+        drawings.images = outputs.submit_images(partial, tmp, worker, mesh_call=drawings.mesh_call,
+                                                calls=outputs.plot_calls(partial, tmp, group="cycle"))
         drawings.handover_s = time.perf_counter() - drawings.started
 
-    def draw_plots(partial):           # every result a plot shows is computed by now
+    def draw_roller_plots(partial):    # every result the other plots show is computed by now
         if drawings.images is not None:
             t = time.perf_counter()
-            drawings.images.add_calls(outputs.plot_calls(partial, tmp))
+            drawings.images.add_calls(outputs.plot_calls(partial, tmp, group="roller_depth"))
             drawings.plots_handed = True
             drawings.handover_s += time.perf_counter() - t
 
@@ -320,7 +321,7 @@ def _analyse_for_run(checked: _CheckedRun, tmp: Path, stages: Stages, *, progres
     result = analyse(checked.case, provenance=checked.provenance, field_step_deg=field_step_deg,
                      cache_dir=cache_dir, progress=_checked_before_cycle(progress, worker, waited),
                      attribute=worker is None,
-                     after={"model": draw_mesh, "stress": draw_stress_images, "roller_depth": draw_plots}
+                     after={"model": draw_mesh, "stress": draw_stress_images, "roller_depth": draw_roller_plots}
                      if worker is not None else {})
     stages.seconds["check"] += waited[0]
     return result, drawings
@@ -335,9 +336,11 @@ class _Drawings:
     mesh_call : int or None
         The number of the mesh picture's call (:func:`rvfem.outputs.summary.start_mesh_picture`).
     images : PendingImages or None
-        The stress images, handed over once the ``stress`` section was computed.
+        The stress images and the plots of the load cycle, handed over once the ``stress`` section
+        was computed.
     plots_handed : bool
-        The plots were handed over too (once the ``roller_depth`` section was computed).
+        The plots of the crank bearing in depth were handed over too (once the ``roller_depth``
+        section was computed).
     started : float or None
         When they were handed over (``time.perf_counter``).
     handover_s : float
@@ -441,7 +444,7 @@ def _write_files(result, tmp: Path, stages: Stages, worker, registered: list[out
         if drawings.images is not None:
             pending = drawings.images
             if not drawings.plots_handed:
-                pending.add_calls(outputs.plot_calls(result, tmp))
+                pending.add_calls(outputs.plot_calls(result, tmp, group="roller_depth"))
         else:
             pending = outputs.submit_images(result, tmp, worker, calls=outputs.plot_calls(result, tmp),
                                             mesh_call=drawings.mesh_call)

@@ -535,14 +535,13 @@ class PendingImages:
         self._set, self._worker, self._calls, self._mesh_call = image_set, worker, calls, mesh_call
 
     def add_calls(self, calls: Iterable[tuple[Callable, dict]]) -> None:
-        """Hand further drawings to the child's second thread (e.g. :func:`plot_calls` once the
-        results they show are computed); :meth:`calls_result` waits for them with the others."""
+        """Hand further drawings (:func:`plot_calls`) to the child; :meth:`calls_result` waits for them too."""
         self._calls = self._calls + self._worker.start_calls(list(calls))
 
     def calls_result(self) -> list:
-        """Wait for the calls given to :func:`submit_images` and :meth:`add_calls` (the child makes them one after the
-        other, after the mesh picture if that was started first, else before it) and return what
-        they returned.
+        """Wait for the calls given to :func:`submit_images` and :meth:`add_calls` (the child makes
+        them one after the other, after the mesh picture if that was started first, else before it)
+        and return what they returned.
 
         Raises
         ------
@@ -663,17 +662,20 @@ def write_images(analysis, folder: str | os.PathLike, *, tick: TickCallback | No
     return out
 
 
-def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict]]:
+def plot_calls(analysis, folder: str | os.PathLike, group: str | None = None) -> list[tuple[Callable, dict]]:
     """The plots of :func:`write_plots` as calls: (function of :mod:`rvfem.outputs.plots`, keyword
-    arguments), each drawing one PNG file and returning its path (``plots/`` is created).
-
-    :func:`write_plots` makes the calls; a render worker can make them in its child process
-    (:func:`submit_images`).
+    arguments), each drawing one PNG file and returning its path (``plots/`` is created); with
+    ``group`` only those of the load cycle (``"cycle"``) or of the crank bearing in depth
+    (``"roller_depth"``), which a render worker's child process can draw as soon as those exist.
     """
-
-    a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
+    if group not in (None, "cycle", "roller_depth"):
+        raise ValueError(f"no plot group {group!r}; the groups are 'cycle' and 'roller_depth'")
     folder = Path(folder) / "plots"
     folder.mkdir(exist_ok=True)
+    roller = [] if group == "cycle" else roller_pressure_calls(analysis, folder) + roller_damage_calls(analysis, folder)
+    if group == "roller_depth":
+        return roller
+    a, case, cy, th = analysis, analysis.case, analysis.cycle, analysis.theta
     k_max, _ = a.max_load_index
     th_max = math.degrees(float(th[k_max]))
     classical = None if a.classical is None else a.classical.magnitude
@@ -694,7 +696,7 @@ def plot_calls(analysis, folder: str | os.PathLike) -> list[tuple[Callable, dict
     calls.append((plots.pins_in_contact_plot, dict(
         path=folder / "pins_in_contact.png", theta=th, count=cy.pins_in_contact, total=case.pins.count,
         classical=None if classical is None else np.count_nonzero(classical > 0, axis=0))))
-    return calls + roller_pressure_calls(analysis, folder) + roller_damage_calls(analysis, folder)
+    return calls + roller
 
 
 @register_writer("plots", order=40, stage="plots", options=("pending",),

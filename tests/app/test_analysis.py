@@ -211,6 +211,24 @@ def test_after_gives_the_model_and_the_results_so_far_after_each_named_section(c
     assert partial["roller_depth"].roller_depth is a.roller_depth and partial["roller_depth"].stress is a.stress
 
 
+def test_the_plot_groups_handed_over_early_make_up_the_plots(coarse, tmp_path):
+    """A run hands its render worker the load cycle's plots after the ``stress`` section and the
+    crank bearing's after ``roller_depth``: from those partial analyses, the two groups are the
+    plots of the whole analysis, in their order."""
+    from rvfem.outputs import summary as outputs
+
+    a, _, partial = coarse
+
+    def names(calls):
+        return [(function.__name__, kwargs["path"].name) for function, kwargs in calls]
+
+    cycle = names(outputs.plot_calls(partial["stress"], tmp_path, group="cycle"))
+    roller = names(outputs.plot_calls(partial["roller_depth"], tmp_path, group="roller_depth"))
+    assert roller and cycle + roller == names(outputs.plot_calls(a, tmp_path))
+    with pytest.raises(ValueError, match="no plot group 'stress'"):
+        outputs.plot_calls(a, tmp_path, group="stress")
+
+
 def test_the_cycle_is_in_equilibrium(coarse):
     a, _, _ = coarse
     case, cyc = a.case, a.cycle
