@@ -236,7 +236,7 @@ class RenderWorker:
         """
         self.check()
         if self._waited:
-            raise RenderError("calls are started before the render worker is waited for")
+            raise RenderError("calls must be started before the render worker is waited for")
         return self._start(calls)
 
     def _send(self, function: Callable, *args, background: bool = False) -> Future:
